@@ -1,0 +1,81 @@
+//! One error type for the tools, carrying the exit code DESIGN.md documents.
+
+use std::fmt;
+use std::path::Path;
+
+/// Documented exit codes: 0 ok, 1 usage, 2 input unreadable or invalid,
+/// 3 output could not be written, 4 internal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExitCode {
+    Ok = 0,
+    Usage = 1,
+    Input = 2,
+    Output = 3,
+    Internal = 4,
+}
+
+/// An error with a message meant for a person and the exit code it maps to.
+#[derive(Debug, Clone)]
+pub struct Error {
+    pub code: ExitCode,
+    pub message: String,
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    pub fn usage(msg: impl Into<String>) -> Self {
+        Self { code: ExitCode::Usage, message: msg.into() }
+    }
+    pub fn input(msg: impl Into<String>) -> Self {
+        Self { code: ExitCode::Input, message: msg.into() }
+    }
+    /// An input error that names the file: "FILE: what is wrong".
+    pub fn input_file(path: &Path, msg: impl fmt::Display) -> Self {
+        Self::input(format!("{}: {}", path.display(), msg))
+    }
+    pub fn output(msg: impl Into<String>) -> Self {
+        Self { code: ExitCode::Output, message: msg.into() }
+    }
+    pub fn output_file(path: &Path, msg: impl fmt::Display) -> Self {
+        Self::output(format!("{}: {}", path.display(), msg))
+    }
+    pub fn internal(msg: impl Into<String>) -> Self {
+        Self { code: ExitCode::Internal, message: msg.into() }
+    }
+    /// Prefix the message with context, keeping the code.
+    pub fn context(mut self, ctx: impl fmt::Display) -> Self {
+        self.message = format!("{ctx}: {}", self.message);
+        self
+    }
+    pub fn exit_code(&self) -> i32 {
+        self.code as i32
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// Run a tool's main body: print the error to stderr as `TOOL: error: ...` and
+/// exit with its code. A panic (a bug) exits 4 through the default hook's code
+/// path being replaced here.
+pub fn run_main(tool: &str, body: impl FnOnce() -> Result<()>) -> ! {
+    let tool_name = tool.to_string();
+    std::panic::set_hook(Box::new(move |info| {
+        eprintln!("{tool_name}: internal error (a bug, please report): {info}");
+    }));
+    let code = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(body)) {
+        Ok(Ok(())) => 0,
+        Ok(Err(e)) => {
+            eprintln!("{tool}: error: {e}");
+            e.exit_code()
+        }
+        Err(_) => ExitCode::Internal as i32,
+    };
+    std::process::exit(code)
+}

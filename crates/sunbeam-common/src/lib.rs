@@ -1,0 +1,10 @@
+//! Conventions every Sunbeam tool follows (see DESIGN.md "Conventions"):
+//! quantities with units on the command line, documented exit codes, outputs
+//! written atomically, Make-style depfiles.
+
+pub mod depfile;
+pub mod error;
+pub mod output;
+pub mod units;
+
+pub use error::{Error, ExitCode, Result};

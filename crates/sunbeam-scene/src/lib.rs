@@ -1,0 +1,191 @@
+//! The scene format (JSON), shared by `sunbeam-play`, `sunbeam-eval render` and
+//! `sunbeam-pack --scene`. Documented in docs/SCENE.md. Paths inside a scene are
+//! relative to the scene file. World space is right-handed, y up.
+//!
+//! The `--mesh M.glb --pack P.ktx2` form of the tools builds [`Scene::default_for`],
+//! so the defaults live in exactly one place.
+
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use sunbeam_common::{Error, Result};
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    pub camera: Camera,
+    #[serde(default = "default_lights")]
+    pub lights: Vec<Light>,
+    pub meshes: Vec<MeshInstance>,
+    /// Exposure in stops (EV): linear colour is multiplied by 2^exposure before tone mapping.
+    #[serde(default)]
+    pub exposure: f64,
+    /// Background, linear sRGB.
+    #[serde(default = "default_background")]
+    pub background: [f64; 3],
+    /// Output size in pixels (width, height) for headless renders.
+    #[serde(default = "default_size")]
+    pub size: [u32; 2],
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    pub eye: [f64; 3],
+    pub target: [f64; 3],
+    #[serde(default = "default_up")]
+    pub up: [f64; 3],
+    /// Vertical field of view, degrees.
+    #[serde(default = "default_fov")]
+    pub fov_y_deg: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Light {
+    /// Direction *towards* the light (world space); normalised on load.
+    pub direction: [f64; 3],
+    /// Scale on the light's spectrum.
+    #[serde(default = "one")]
+    pub intensity: f64,
+    /// Spectral power distribution: "D65" (the default; the only one for now).
+    #[serde(default = "default_spectrum")]
+    pub spectrum: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshInstance {
+    /// glTF/GLB file (baked by sunbeam-bake so it has TANGENT / _ORIENTATION).
+    pub mesh: PathBuf,
+    /// Diffraction pack (KTX2). None: the mesh is shaded with its base colour only.
+    #[serde(default)]
+    pub pack: Option<PathBuf>,
+    /// Base (diffuse) colour, linear sRGB.
+    #[serde(default = "default_base")]
+    pub base_color: [f64; 3],
+    /// Weight of the diffuse base colour blended with the diffraction colour (thesis' diffuse weight).
+    #[serde(default = "default_diffuse_weight")]
+    pub diffuse_weight: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+fn default_up() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+fn default_fov() -> f64 {
+    35.0
+}
+fn default_spectrum() -> String {
+    "D65".into()
+}
+fn default_base() -> [f64; 3] {
+    [0.05, 0.05, 0.05]
+}
+fn default_diffuse_weight() -> f64 {
+    0.2
+}
+fn default_background() -> [f64; 3] {
+    [0.0, 0.0, 0.0]
+}
+fn default_size() -> [u32; 2] {
+    [512, 512]
+}
+fn default_lights() -> Vec<Light> {
+    vec![Light::default_light()]
+}
+
+impl Light {
+    /// The documented default light: D65 from above and a little behind the viewer.
+    pub fn default_light() -> Self {
+        Light { direction: [0.3, 1.0, 0.6], intensity: 1.0, spectrum: default_spectrum() }
+    }
+}
+
+impl Scene {
+    /// The scene the `--mesh M --pack P` form of the tools renders: the default
+    /// camera looks at the mesh's bounding box centre from +z (the caller passes
+    /// the bounds once the mesh is loaded), the default light, exposure 0.
+    pub fn default_for(mesh: PathBuf, pack: Option<PathBuf>, bounds: ([f64; 3], [f64; 3])) -> Self {
+        let (lo, hi) = bounds;
+        let c = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, (lo[2] + hi[2]) / 2.0];
+        let r = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt() / 2.0;
+        let r = if r > 0.0 && r.is_finite() { r } else { 1.0 };
+        let fov = default_fov();
+        let dist = r / (fov.to_radians() / 2.0).sin() * 1.05;
+        Scene {
+            camera: Camera { eye: [c[0], c[1], c[2] + dist], target: c, up: default_up(), fov_y_deg: fov },
+            lights: default_lights(),
+            meshes: vec![MeshInstance {
+                mesh,
+                pack,
+                base_color: default_base(),
+                diffuse_weight: default_diffuse_weight(),
+            }],
+            exposure: 0.0,
+            background: default_background(),
+            size: default_size(),
+        }
+    }
+
+    /// Read a scene file; relative paths are resolved against its folder.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::input_file(path, e))?;
+        let mut s: Scene =
+            serde_json::from_str(&text).map_err(|e| Error::input_file(path, format!("invalid scene: {e}")))?;
+        let base = path.parent().unwrap_or(Path::new(""));
+        for m in &mut s.meshes {
+            if m.mesh.is_relative() {
+                m.mesh = base.join(&m.mesh);
+            }
+            if let Some(p) = &mut m.pack {
+                if p.is_relative() {
+                    *p = base.join(&*p);
+                }
+            }
+        }
+        s.validate().map_err(|e| e.context(path.display()))?;
+        Ok(s)
+    }
+
+    /// Check values a JSON schema cannot: non-zero directions, sane field of view.
+    pub fn validate(&mut self) -> Result<()> {
+        if self.meshes.is_empty() {
+            return Err(Error::input("scene has no meshes"));
+        }
+        if !(self.camera.fov_y_deg > 0.1 && self.camera.fov_y_deg < 179.0) {
+            return Err(Error::input("camera.fov_y_deg must be in (0.1, 179)"));
+        }
+        for (i, l) in self.lights.iter_mut().enumerate() {
+            let n = (l.direction.iter().map(|v| v * v).sum::<f64>()).sqrt();
+            if !(n.is_finite() && n > 0.0) {
+                return Err(Error::input(format!("lights[{i}].direction must be a non-zero vector")));
+            }
+            l.direction = l.direction.map(|v| v / n);
+            if l.spectrum != "D65" {
+                return Err(Error::input(format!("lights[{i}].spectrum '{}': only D65 is supported", l.spectrum)));
+            }
+        }
+        if self.size[0] == 0 || self.size[1] == 0 || self.size[0] > 16384 || self.size[1] > 16384 {
+            return Err(Error::input("size must be 1..16384 pixels per side"));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn parses_minimal_and_refuses_unknown() {
+        let mut s: Scene = serde_json::from_str(
+            r#"{"camera":{"eye":[0,0,3],"target":[0,0,0]},"meshes":[{"mesh":"a.glb","pack":"p.ktx2"}]}"#,
+        )
+        .unwrap();
+        s.validate().unwrap();
+        assert_eq!(s.lights.len(), 1);
+        assert!((s.lights[0].direction.iter().map(|v| v * v).sum::<f64>() - 1.0).abs() < 1e-12);
+        assert!(serde_json::from_str::<Scene>(r#"{"camera":{"eye":[0,0,3],"target":[0,0,0]},"meshes":[],"bogus":1}"#).is_err());
+    }
+}
