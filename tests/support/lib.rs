@@ -1,5 +1,5 @@
-//! Helpers shared by the end-to-end tests in `tests/`: where the tool binaries
-//! and the shared data are, and how a test that needs them skips or fails.
+//! Helpers shared by the end-to-end tests in `tests/`: where the tool binaries are.
+//! Shared data and system tools: `sunbeam_common::testdata`.
 
 use std::path::{Path, PathBuf};
 
@@ -24,31 +24,6 @@ pub fn tool(name: &str) -> PathBuf {
         p.display()
     );
     p
-}
-
-/// True when CI demands every test to run (`SUNBEAM_REQUIRE_ALL=1`).
-pub fn require_all() -> bool {
-    std::env::var("SUNBEAM_REQUIRE_ALL").is_ok_and(|v| v == "1")
-}
-
-/// `../shared/data` (or `$SUNBEAM_SHARED_DATA`), if present. When missing: panics
-/// under `SUNBEAM_REQUIRE_ALL=1`, otherwise prints why and returns None so the
-/// test can skip.
-pub fn shared_data() -> Option<PathBuf> {
-    let p = std::env::var_os("SUNBEAM_SHARED_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| workspace_root().join("../shared/data"));
-    if p.is_dir() {
-        return Some(p);
-    }
-    if require_all() {
-        panic!(
-            "shared data not found at {} and SUNBEAM_REQUIRE_ALL=1",
-            p.display()
-        );
-    }
-    eprintln!("SKIP: shared data not found at {}", p.display());
-    None
 }
 
 /// A fresh temporary directory under target/ for one test.

@@ -5,6 +5,7 @@
 pub mod depfile;
 pub mod error;
 pub mod output;
+pub mod testdata;
 pub mod units;
 
 pub use error::{Error, ExitCode, Result};
