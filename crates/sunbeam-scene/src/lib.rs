@@ -5,6 +5,9 @@
 //! The `--mesh M.glb --pack P.ktx2` form of the tools builds [`Scene::default_for`],
 //! so the defaults live in exactly one place.
 
+pub mod camera;
+pub mod geometry;
+
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use sunbeam_common::{Error, Result};
@@ -136,7 +139,7 @@ impl Scene {
             serde_json::from_str(&text).map_err(|e| Error::input_file(path, format!("invalid scene: {e}")))?;
         let base = path.parent().unwrap_or(Path::new(""));
         for m in &mut s.meshes {
-            if m.mesh.is_relative() {
+            if m.mesh.is_relative() && !geometry::is_builtin(&m.mesh) {
                 m.mesh = base.join(&m.mesh);
             }
             if let Some(p) = &mut m.pack {

@@ -1,6 +1,409 @@
-//! sunbeam-import (placeholder until its issue lands).
+//! sunbeam-import: read an AFM/SPM scan, pick a channel, convert to metres,
+//! optionally level / align rows / fill / remove scars / rotate / flip / crop /
+//! resample, and write a height field (`.exr` or `.gsf`). See docs/IMPORT.md.
+
+use clap::Parser;
+use std::path::{Path, PathBuf};
+use sunbeam_afm::{Channel, Format, ReadOptions};
+use sunbeam_common::units::{format_length, parse_positive_length, parse_size};
+use sunbeam_common::{Error, Result};
+use sunbeam_field::align::AlignRows;
+use sunbeam_field::geom::CropSpec;
+use sunbeam_field::io::{self, Kind};
+use sunbeam_field::pipeline::{self, FlipAxis, Level, Step};
+use sunbeam_field::resample::Target;
+use sunbeam_field::stats::Stats;
+use sunbeam_field::HeightField;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "sunbeam-import",
+    version,
+    about = "Read an AFM scan and write a calibrated height field (.exr or .gsf)",
+    after_help = "Exit codes: 0 ok, 1 usage, 2 input unreadable or invalid, 3 output not written, 4 internal.\n\
+                  Processing order: crop, fill-nonfinite, level, align-rows, remove-scars, zero-mean, rotate, flip, resample.\n\
+                  See docs/IMPORT.md."
+)]
+struct Cli {
+    /// The scan (format detected from content).
+    input: PathBuf,
+    /// Output height field: .exr (float32, metres) or .gsf.
+    #[arg(short, long, required_unless_present = "list")]
+    output: Option<PathBuf>,
+    /// Force the input format (nanoscope, gwy, gsf, ibw, sxm, park, jpk, png, tiff, bmp, ascii, xyz, exr).
+    #[arg(long, value_name = "NAME")]
+    format: Option<String>,
+    /// List the channels (name, size, physical size, units) and exit.
+    #[arg(long)]
+    list: bool,
+    /// Channel by name or index; default: the first height channel.
+    #[arg(long, value_name = "NAME|INDEX")]
+    channel: Option<String>,
+    /// Background levelling: plane (Gwyddion's Plane Level) or poly:N.
+    #[arg(long, value_name = "plane|poly:N")]
+    level: Option<String>,
+    /// Row alignment: median, median-diff or none (Gwyddion's Align Rows).
+    #[arg(long, value_name = "METHOD")]
+    align_rows: Option<String>,
+    /// Replace NaN/Inf values by Laplace interpolation.
+    #[arg(long)]
+    fill_nonfinite: bool,
+    /// Shift the mean height to zero.
+    #[arg(long)]
+    zero_mean: bool,
+    /// Mark and interpolate scars (short horizontal streaks).
+    #[arg(long)]
+    remove_scars: bool,
+    /// Rotate counter-clockwise by 0, 90, 180 or 270 degrees.
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    rotate: Option<i32>,
+    /// Mirror along x (left-right) or y (top-bottom).
+    #[arg(long, value_name = "x|y")]
+    flip: Option<String>,
+    /// Crop X,Y,W,H from the top-left corner: pixels (10,10,256,256) or lengths (0um,0um,1um,1um).
+    #[arg(long, value_name = "X,Y,W,H")]
+    crop: Option<String>,
+    /// Pixel size. For files without lateral calibration (plain images, bare
+    /// ASCII matrices, EXRs from other tools) it IS the calibration; for
+    /// calibrated files it resamples to square pixels of this size.
+    /// Give `DX,DY` to calibrate non-square pixels.
+    #[arg(long, value_name = "LEN")]
+    pixel_size: Option<String>,
+    /// Resample to square pixels of this size (always resamples, never calibrates).
+    #[arg(long, value_name = "LEN", conflicts_with = "size")]
+    resample_to: Option<String>,
+    /// Resample to WxH pixels (square pixels; the longer side is cropped if the aspect differs).
+    #[arg(long, value_name = "WxH")]
+    size: Option<String>,
+    /// Calibration for uncalibrated images: height of the full grey range.
+    #[arg(long, value_name = "LEN")]
+    z_range: Option<String>,
+    /// Calibration for uncalibrated data: metres per grey level / per number.
+    #[arg(long, value_name = "LEN")]
+    z_scale: Option<String>,
+    /// Also write a false-colour PNG preview with a scale bar.
+    #[arg(long, value_name = "PNG")]
+    preview: Option<PathBuf>,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write a Make-style depfile.
+    #[arg(long, value_name = "FILE")]
+    depfile: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(short, long, conflicts_with = "verbose")]
+    quiet: bool,
+    /// Print the steps.
+    #[arg(short, long)]
+    verbose: bool,
+}
+
+/// Everything parsed and checked before the input is touched.
+struct Plan {
+    steps: Vec<Step>,
+    /// --pixel-size: calibration or resampling target, decided once the file is read.
+    pixel_size: Option<(f64, f64)>,
+    read: ReadOptions,
+}
+
+fn parse_pixel_size(s: &str) -> Result<(f64, f64)> {
+    match s.split_once(',') {
+        Some((a, b)) => Ok((parse_positive_length(a)?, parse_positive_length(b)?)),
+        None => {
+            let p = parse_positive_length(s)?;
+            Ok((p, p))
+        }
+    }
+}
+
+fn plan(cli: &Cli) -> Result<Plan> {
+    let ctx = |flag: &'static str| move |e: Error| e.context(flag);
+    let mut steps = Vec::new();
+    if let Some(c) = &cli.crop {
+        steps.push(Step::Crop(CropSpec::parse(c)?));
+    }
+    if cli.fill_nonfinite {
+        steps.push(Step::FillNonFinite);
+    }
+    if let Some(l) = &cli.level {
+        steps.push(Step::Level(l.parse::<Level>().map_err(ctx("--level"))?));
+    }
+    if let Some(a) = &cli.align_rows {
+        steps.push(Step::AlignRows(a.parse::<AlignRows>().map_err(ctx("--align-rows"))?));
+    }
+    if cli.remove_scars {
+        steps.push(Step::RemoveScars);
+    }
+    if cli.zero_mean {
+        steps.push(Step::ZeroMean);
+    }
+    if let Some(r) = cli.rotate {
+        if r % 90 != 0 {
+            return Err(Error::usage(format!("--rotate {r}: use 0, 90, 180 or 270")));
+        }
+        steps.push(Step::Rotate(r));
+    }
+    if let Some(f) = &cli.flip {
+        steps.push(Step::Flip(f.parse::<FlipAxis>().map_err(ctx("--flip"))?));
+    }
+    if let Some(r) = &cli.resample_to {
+        steps.push(Step::Resample(Target::PixelSize(parse_positive_length(r).map_err(ctx("--resample-to"))?)));
+    }
+    if let Some(s) = &cli.size {
+        let (w, h) = parse_size(s).map_err(ctx("--size"))?;
+        steps.push(Step::Resample(Target::Size(w, h)));
+    }
+    steps.sort_by_key(Step::canonical_order);
+    let pixel_size = cli.pixel_size.as_deref().map(parse_pixel_size).transpose().map_err(ctx("--pixel-size"))?;
+    let format = cli
+        .format
+        .as_deref()
+        .map(|f| Format::from_name(f).ok_or_else(|| Error::usage(format!("--format {f}: unknown format"))))
+        .transpose()?;
+    let z_range = cli.z_range.as_deref().map(parse_positive_length).transpose().map_err(ctx("--z-range"))?;
+    let z_scale = cli.z_scale.as_deref().map(parse_positive_length).transpose().map_err(ctx("--z-scale"))?;
+    if let Some(o) = &cli.output {
+        Kind::from_path(o)?;
+        if same_file(o, &cli.input) {
+            return Err(Error::usage(format!("{}: the output would overwrite the input", o.display())));
+        }
+    }
+    if let Some(p) = &cli.preview {
+        let ok = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !ok {
+            return Err(Error::usage(format!("--preview {}: the preview is a .png", p.display())));
+        }
+    }
+    Ok(Plan { steps, pixel_size, read: ReadOptions { format, pixel_size: None, z_range, z_scale } })
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// A channel of an EXR height field (read here: sunbeam-afm leaves EXR to sunbeam-field).
+fn read_exr(bytes: &[u8], pixel_size: Option<(f64, f64)>) -> Result<(Vec<Channel>, bool)> {
+    let raw = io::exr::decode_raw(bytes)?;
+    let (dx, dy, xy_unit, calibrated_by_user) = match (raw.dx, raw.dy, pixel_size) {
+        (Some(dx), dy, _) => (dx, dy.unwrap_or(dx), "m", false),
+        (None, _, Some((dx, dy))) => (dx, dy, "m", true),
+        (None, _, None) => (1.0, 1.0, "", false),
+    };
+    let z_unit = raw.z_unit.clone().unwrap_or_else(|| "m".into());
+    let mut field = HeightField::new(raw.width, raw.height, dx, dy, raw.data)?;
+    field.provenance = raw.provenance;
+    let name = if field.provenance.channel.is_empty() { raw.channel_name } else { field.provenance.channel.clone() };
+    Ok((
+        vec![Channel { name, is_height: z_unit == "m", z_unit, field, xy_unit: xy_unit.into(), offset: (0.0, 0.0) }],
+        calibrated_by_user,
+    ))
+}
+
+/// Read all channels; returns them, the format, and whether --pixel-size served as calibration.
+fn read_channels(bytes: &[u8], plan: &Plan) -> Result<(Vec<Channel>, Format, bool)> {
+    let format = plan.read.format.or_else(|| sunbeam_afm::detect(bytes));
+    if format == Some(Format::Exr) {
+        let (c, cal) = read_exr(bytes, plan.pixel_size)?;
+        return Ok((c, Format::Exr, cal));
+    }
+    let fmt = format.unwrap_or(Format::Ascii);
+    // XYZ points: the pixel size is the grid the points are sampled onto.
+    if fmt == Format::Xyz && plan.pixel_size.is_some() {
+        let opts = ReadOptions { pixel_size: plan.pixel_size, ..plan.read.clone() };
+        return Ok((sunbeam_afm::read_bytes(bytes, &opts)?, fmt, true));
+    }
+    match sunbeam_afm::read_bytes(bytes, &plan.read) {
+        Ok(c) => Ok((c, fmt, false)),
+        Err(e) => match plan.pixel_size {
+            // Files without calibration refuse to load without a pixel size.
+            Some(p) => {
+                let opts = ReadOptions { pixel_size: Some(p), ..plan.read.clone() };
+                Ok((sunbeam_afm::read_bytes(bytes, &opts)?, fmt, true))
+            }
+            None => Err(e),
+        },
+    }
+}
+
+fn list(cli: &Cli, chans: &[Channel], fmt: Format) {
+    if cli.json {
+        let v: Vec<serde_json::Value> = chans
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                serde_json::json!({
+                    "index": i, "name": c.name, "is_height": c.is_height,
+                    "width": c.field.width, "height": c.field.height,
+                    "size_x": c.field.size_x(), "size_y": c.field.size_y(),
+                    "dx": c.field.dx, "dy": c.field.dy,
+                    "xy_unit": c.xy_unit, "z_unit": c.z_unit, "format": fmt.name(),
+                })
+            })
+            .collect();
+        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "file": cli.input, "channels": v })).unwrap_or_default());
+    } else {
+        println!("{} ({}):", cli.input.display(), fmt.name());
+        for (i, c) in chans.iter().enumerate() {
+            let size = |v: f64| if c.xy_unit == "m" { format_length(v) } else { format!("{v} {}", c.xy_unit) };
+            println!(
+                "  {i}: {:<24} {}x{} px, {} x {}, z unit {}{}",
+                format!("\"{}\"", c.name),
+                c.field.width,
+                c.field.height,
+                size(c.field.size_x()),
+                size(c.field.size_y()),
+                if c.z_unit.is_empty() { "(none)" } else { &c.z_unit },
+                if c.is_height { ", height" } else { "" }
+            );
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    let plan = plan(&cli)?;
+    let input = &cli.input;
+    let bytes = std::fs::read(input).map_err(|e| Error::input_file(input, format!("cannot read: {e}")))?;
+    let in_file = |e: Error| e.context(input.display());
+    let (chans, fmt, calibrated_by_user) = read_channels(&bytes, &plan).map_err(in_file)?;
+    if cli.list {
+        list(&cli, &chans, fmt);
+        return Ok(());
+    }
+    let ch = sunbeam_afm::select_channel(&chans, cli.channel.as_deref()).map_err(in_file)?;
+    if ch.z_unit != "m" {
+        return Err(in_file(Error::input(format!(
+            "channel '{}' is in '{}', not metres: not a height field (pick a height channel with --channel; --list shows them)",
+            ch.name,
+            if ch.z_unit.is_empty() { "no unit" } else { &ch.z_unit }
+        ))));
+    }
+    let mut field = ch.field.clone();
+    let mut processing = Vec::new();
+    let mut steps = plan.steps.clone();
+    let pixel_size_role;
+    if ch.xy_unit != "m" {
+        match plan.pixel_size {
+            Some((dx, dy)) => {
+                field.dx = dx;
+                field.dy = dy;
+                pixel_size_role = "calibration";
+            }
+            None => {
+                return Err(in_file(Error::input(format!(
+                    "channel '{}' has no lateral calibration (unit '{}'): give --pixel-size",
+                    ch.name, ch.xy_unit
+                ))))
+            }
+        }
+    } else if let Some((dx, dy)) = plan.pixel_size {
+        if calibrated_by_user {
+            pixel_size_role = "calibration";
+        } else {
+            if dx != dy {
+                return Err(Error::usage(format!(
+                    "--pixel-size {}: the file is calibrated, so --pixel-size resamples, to square pixels: give one length",
+                    cli.pixel_size.as_deref().unwrap_or("")
+                )));
+            }
+            if steps.iter().any(|s| matches!(s, Step::Resample(_))) {
+                return Err(Error::usage(
+                    "the file is calibrated, so --pixel-size would resample; it cannot be combined with --resample-to/--size",
+                ));
+            }
+            steps.push(Step::Resample(Target::PixelSize(dx)));
+            pixel_size_role = "resample";
+        }
+    } else {
+        pixel_size_role = "none";
+    }
+    if pixel_size_role == "calibration" {
+        let d = format!("calibrate pixel size {} x {}", format_length(field.dx), format_length(field.dy));
+        field.provenance.processing.push(d.clone());
+        processing.push(d);
+    }
+    field.provenance.source_file = input.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    field.provenance.source_format = fmt.name().to_string();
+    field.provenance.channel = ch.name.clone();
+    if cli.verbose {
+        eprintln!(
+            "sunbeam-import: {}: {} channel '{}', {}x{} px of {} x {}",
+            input.display(),
+            fmt.name(),
+            ch.name,
+            field.width,
+            field.height,
+            format_length(field.dx),
+            format_length(field.dy)
+        );
+    }
+    for step in &steps {
+        if let Some(d) = pipeline::apply(&mut field, step).map_err(in_file)? {
+            if cli.verbose {
+                eprintln!("sunbeam-import: {d}");
+            }
+            processing.push(d);
+        }
+    }
+    if !cli.quiet && field.count_nonfinite() > 0 {
+        eprintln!(
+            "sunbeam-import: warning: {} non-finite values kept (use --fill-nonfinite)",
+            field.count_nonfinite()
+        );
+    }
+    let output = cli.output.as_ref().ok_or_else(|| Error::usage("-o/--output is required"))?;
+    io::write(output, &field)?;
+    if let Some(p) = &cli.preview {
+        sunbeam_field::preview::write_png(p, &field)?;
+    }
+    if let Some(d) = &cli.depfile {
+        let mut outs: Vec<&Path> = vec![output.as_path()];
+        if let Some(p) = &cli.preview {
+            outs.push(p.as_path());
+        }
+        sunbeam_common::depfile::write(d, &outs, &[input.as_path()])?;
+    }
+    let st = Stats::of(&field);
+    if cli.json {
+        let num = |v: f64| if v.is_finite() { serde_json::json!(v) } else { serde_json::Value::Null };
+        let report = serde_json::json!({
+            "input": input, "output": output, "preview": cli.preview,
+            "source_format": fmt.name(), "channel": ch.name,
+            "width": field.width, "height": field.height, "dx_m": field.dx, "dy_m": field.dy,
+            "size_x_m": field.size_x(), "size_y_m": field.size_y(),
+            "z_min_m": num(st.min), "z_max_m": num(st.max), "z_mean_m": num(st.mean), "z_rms_m": num(st.rms),
+            "nonfinite": st.nonfinite, "pixel_size_role": pixel_size_role,
+            "processing": processing,
+        });
+        println!("{}", serde_json::to_string_pretty(&report).unwrap_or_default());
+    } else if !cli.quiet {
+        eprintln!(
+            "sunbeam-import: wrote {} ({}x{} px of {}, z {} .. {})",
+            output.display(),
+            field.width,
+            field.height,
+            format_length(field.dx),
+            format_length(st.min),
+            format_length(st.max)
+        );
+    }
+    Ok(())
+}
+
 fn main() {
-    sunbeam_common::error::run_main("sunbeam-import", || {
-        Err(sunbeam_common::Error::internal("sunbeam-import is not implemented yet"))
-    })
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            let code = match e.kind() {
+                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => 0,
+                _ => 1,
+            };
+            let _ = e.print();
+            std::process::exit(code);
+        }
+    };
+    sunbeam_common::error::run_main("sunbeam-import", || run(cli))
 }

@@ -1,6 +1,261 @@
-//! sunbeam-play (placeholder until its issue lands).
+//! sunbeam-play: render a scene with diffraction colour from term packs, in a
+//! window (orbit camera, movable light, exposure) or headless to PNG. Docs: docs/PLAY.md.
+
+use clap::Parser;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Duration;
+use sunbeam_common::{units, Error, Result};
+use sunbeam_optics::colour::ToneCurve;
+use sunbeam_raster::{Image, Prepared};
+use sunbeam_render::window::{self, WindowOptions};
+use sunbeam_render::{Backend, Gpu, Mode, Settings};
+use sunbeam_scene::Scene;
+
+#[derive(Parser, Debug)]
+#[command(name = "sunbeam-play", version, about = "Diffraction colour from term packs: window or headless frames")]
+struct Cli {
+    /// Scene file (JSON, docs/SCENE.md). Or use --mesh and --pack.
+    scene: Option<PathBuf>,
+    /// Mesh (GLB/glTF/OBJ, or builtin:quad / builtin:sphere) for the default scene.
+    #[arg(long)]
+    mesh: Option<PathBuf>,
+    /// Pack (KTX2/EXR) for the default scene.
+    #[arg(long)]
+    pack: Option<PathBuf>,
+    /// Render offscreen (no window) and write -o.
+    #[arg(long)]
+    headless: bool,
+    /// Output PNG (headless), or the screenshot of the window (with --frames).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Frame size WxH (headless: default the scene's size; window: initial size).
+    #[arg(long)]
+    size: Option<String>,
+    /// Headless: frames rendered (the last one is written). Window: exit after N frames.
+    #[arg(long)]
+    frames: Option<u32>,
+    /// Window: seconds to keep showing after --frames.
+    #[arg(long, default_value_t = 0.0)]
+    hold_secs: f64,
+    /// GPU backend.
+    #[arg(long, default_value = "auto")]
+    backend: String,
+    /// Shading: default, thesis (39 terms, 5 nm, nearest bin), lambert (base colour only).
+    #[arg(long, default_value = "default")]
+    mode: String,
+    /// Same as --mode thesis.
+    #[arg(long)]
+    thesis: bool,
+    /// Same as --mode lambert.
+    #[arg(long)]
+    lambert: bool,
+    /// Wavelength samples of the default mode.
+    #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES)]
+    lambda_samples: usize,
+    /// Truncation bound on |dR| per fragment (default: the pack's).
+    #[arg(long)]
+    term_tolerance: Option<f64>,
+    /// Tone curve after exposure: clamp or reinhard.
+    #[arg(long, default_value = "clamp")]
+    tone: String,
+    /// Exposure in stops (overrides the scene's).
+    #[arg(long, allow_hyphen_values = true)]
+    exposure: Option<f64>,
+    /// Render with the CPU reference (sunbeam-raster) instead of the GPU.
+    #[arg(long)]
+    cpu: bool,
+    /// Compare the frame with a reference PNG (CIEDE2000 mean / p99 / max in the report).
+    #[arg(long)]
+    compare: Option<PathBuf>,
+    /// Headless benchmark: time --frames frames (default 10) and print the frame times.
+    #[arg(long)]
+    bench: bool,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write a Make depfile for -o.
+    #[arg(long)]
+    depfile: Option<PathBuf>,
+    /// Less output.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn load_scene(cli: &Cli) -> Result<Scene> {
+    let mut scene = match (&cli.scene, &cli.mesh) {
+        (Some(_), Some(_)) => return Err(Error::usage("give either SCENE.json or --mesh/--pack, not both")),
+        (Some(s), None) => {
+            if cli.pack.is_some() {
+                return Err(Error::usage("--pack goes with --mesh (a scene file names its own packs)"));
+            }
+            Scene::load(s)?
+        }
+        (None, Some(m)) => sunbeam_raster::default_scene(m, cli.pack.as_deref())?,
+        (None, None) => return Err(Error::usage("nothing to render: give SCENE.json or --mesh M.glb --pack P.ktx2")),
+    };
+    if let Some(ev) = cli.exposure {
+        if !ev.is_finite() {
+            return Err(Error::usage("--exposure must be finite"));
+        }
+        scene.exposure = ev;
+    }
+    if let Some(s) = &cli.size {
+        let (w, h) = units::parse_size(s)?;
+        scene.size = [w as u32, h as u32];
+        scene.validate()?;
+    }
+    Ok(scene)
+}
+
+fn settings(cli: &Cli) -> Result<Settings> {
+    let mut mode: Mode = cli.mode.parse()?;
+    if cli.thesis && cli.lambert {
+        return Err(Error::usage("--thesis and --lambert exclude each other"));
+    }
+    if cli.thesis {
+        mode = Mode::Thesis;
+    }
+    if cli.lambert {
+        mode = Mode::Lambert;
+    }
+    if cli.lambda_samples == 0 || cli.lambda_samples > 4096 {
+        return Err(Error::usage("--lambda-samples must be 1..4096"));
+    }
+    if let Some(t) = cli.term_tolerance {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(Error::usage("--term-tolerance must be positive"));
+        }
+    }
+    let curve: ToneCurve = cli.tone.parse()?;
+    Ok(Settings { mode, lambda_samples: cli.lambda_samples, curve, term_tolerance: cli.term_tolerance })
+}
+
+fn inputs(p: &Prepared, cli: &Cli) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = cli.scene.iter().cloned().collect();
+    for m in &p.scene.meshes {
+        if !sunbeam_scene::geometry::is_builtin(&m.mesh) {
+            v.push(m.mesh.clone());
+        }
+        v.extend(m.pack.iter().cloned());
+    }
+    v.dedup();
+    v
+}
+
+fn run(cli: Cli) -> Result<()> {
+    let scene = load_scene(&cli)?;
+    let st = settings(&cli)?;
+    let backend: Backend = cli.backend.parse()?;
+    let prepared = sunbeam_raster::prepare(&scene)?;
+    let headless = cli.headless || cli.bench || cli.cpu;
+    if !headless {
+        if cli.compare.is_some() || cli.depfile.is_some() {
+            return Err(Error::usage("--compare and --depfile need --headless"));
+        }
+        let opts = WindowOptions {
+            backend,
+            settings: st,
+            size: scene.size,
+            frames: cli.frames,
+            hold: Duration::from_secs_f64(cli.hold_secs.max(0.0)),
+            screenshot: cli.output.clone(),
+            title: "sunbeam-play".into(),
+        };
+        return window::run(prepared, opts);
+    }
+    if cli.output.is_none() && !cli.bench {
+        return Err(Error::usage("--headless needs -o FRAME.png"));
+    }
+    let size = scene.size;
+    let mut report = serde_json::json!({
+        "tool": "sunbeam-play",
+        "size": size,
+        "mode": format!("{:?}", st.mode).to_lowercase(),
+    });
+    let image: Image = if cli.cpu {
+        let t = std::time::Instant::now();
+        let opts = sunbeam_raster::Options { curve: st.curve, ..Default::default() };
+        let img = sunbeam_raster::render_prepared(&prepared, &opts);
+        report["renderer"] = "cpu reference (sunbeam-raster)".into();
+        report["render_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
+        img
+    } else {
+        let gpu = Gpu::headless(backend)?;
+        report["adapter"] = gpu.describe().into();
+        if cli.bench {
+            let frames = cli.frames.unwrap_or(10).max(2);
+            let (times, img) = sunbeam_render::bench_headless(&gpu, &prepared, &st, size, frames)?;
+            report["setup_ms"] = times.setup_ms.into();
+            report["first_frame_ms"] = times.first_ms.into();
+            report["frame_ms_median"] = times.median_ms().into();
+            report["frame_ms_mean"] = times.mean_ms().into();
+            report["frame_ms"] = times.rest_ms.clone().into();
+            if !cli.json {
+                println!(
+                    "{} {:?} {}x{}: setup {:.0} ms, first frame {:.1} ms, then median {:.2} ms / mean {:.2} ms over {} frames ({:.1} fps)",
+                    gpu.describe(),
+                    st.mode,
+                    size[0],
+                    size[1],
+                    times.setup_ms,
+                    times.first_ms,
+                    times.median_ms(),
+                    times.mean_ms(),
+                    times.rest_ms.len(),
+                    1e3 / times.median_ms().max(1e-6)
+                );
+            }
+            img
+        } else {
+            let r = sunbeam_render::Renderer::new(&gpu, &prepared, &st, sunbeam_render::OFFSCREEN_FORMAT)?;
+            for w in &r.warnings {
+                eprintln!("sunbeam-play: warning: {w}");
+            }
+            let target = sunbeam_render::Offscreen::new(&gpu, size[0], size[1])?;
+            let state = sunbeam_render::FrameState::from_scene(&prepared);
+            for _ in 1..cli.frames.unwrap_or(1).max(1) {
+                target.draw(&gpu, &r, &state)?;
+            }
+            target.render(&gpu, &r, &state)?
+        }
+    };
+    if let Some(refp) = &cli.compare {
+        let reference = Image::read_png(refp)?;
+        let q = Image::from_rgba8(image.width, image.height, &image.to_rgba8());
+        let d = sunbeam_raster::compare(&q, &reference).map_err(|e| e.context(refp.display()))?;
+        report["ciede2000"] = serde_json::json!({"mean": d.mean, "p99": d.p99, "max": d.max});
+        if !cli.json && !cli.quiet {
+            println!("against {}: {d}", refp.display());
+        }
+    }
+    if let Some(out) = &cli.output {
+        image.write_png(out)?;
+        report["output"] = out.display().to_string().into();
+        if let Some(dep) = &cli.depfile {
+            let ins = inputs(&prepared, &cli);
+            let refs: Vec<&std::path::Path> = ins.iter().map(|p| p.as_path()).collect();
+            sunbeam_common::depfile::write(dep, &[out.as_path()], &refs)?;
+        }
+        if !cli.json && !cli.quiet && std::io::stderr().is_terminal() {
+            eprintln!("wrote {}", out.display());
+        }
+    }
+    if cli.json {
+        println!("{report}");
+    }
+    Ok(())
+}
+
 fn main() {
     sunbeam_common::error::run_main("sunbeam-play", || {
-        Err(sunbeam_common::Error::internal("sunbeam-play is not implemented yet"))
+        let cli = Cli::try_parse().map_err(|e| {
+            if matches!(e.kind(), clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                std::process::exit(0);
+            }
+            Error::usage(e.to_string())
+        })?;
+        run(cli)
     })
 }

@@ -1,0 +1,17 @@
+//! Optics for Sunbeam (PHYSICS.md): CIE tables, colour science, the gain `G`,
+//! and the float64 ground truth `R(u, v, w, lambda)` that every fast path is
+//! tested against.
+//!
+//! - [`cie`]: CIE 1931 2-degree colour matching functions and D65 at 1 nm, and
+//!   the spectral integral of PHYSICS.md 2.
+//! - [`colour`]: XYZ -> linear sRGB, CIELAB, CIEDE2000, and THE tone mapping +
+//!   sRGB encoding shared by the player and the CPU reference renderer.
+//! - [`gain`]: `G(wi, wr)` with Schlick's Fresnel (n = 1.5 by default).
+//! - [`truth`]: the ground truth (window and tiled models), sharing no code
+//!   with `sunbeam-pack`.
+
+pub mod cie;
+mod cie_data;
+pub mod colour;
+pub mod gain;
+pub mod truth;

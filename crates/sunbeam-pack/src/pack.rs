@@ -1,0 +1,175 @@
+//! A pack in memory and the CPU evaluator (the player's math, docs/PACK_FORMAT.md).
+
+use crate::kernel;
+use crate::manifest::{Manifest, Model};
+use crate::series;
+use std::path::Path;
+use sunbeam_common::{Error, Result};
+
+/// A diffraction term pack: the manifest plus the complex terms.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pack {
+    pub manifest: Manifest,
+    /// Interleaved (re, im) float32: texel (n, ty, tx) at `2 * ((n * height + ty) * width + tx)`.
+    pub terms: Vec<f32>,
+}
+
+/// Taps of one axis: texel index (None outside the crop) and weight.
+struct Taps {
+    idx: [i64; 64],
+    w: [f64; 64],
+    n: usize,
+}
+
+impl Pack {
+    /// Read a pack (KTX2 or EXR, detected from the content).
+    pub fn read(path: &Path) -> Result<Pack> {
+        let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, e))?;
+        if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+            return crate::exr_io::read_path(path, &bytes);
+        }
+        Self::from_bytes(&bytes).map_err(|e| e.context(path.display()))
+    }
+
+    /// Parse a pack from bytes (KTX2 or single-file EXR).
+    pub fn from_bytes(bytes: &[u8]) -> Result<Pack> {
+        if bytes.starts_with(&crate::ktx2::IDENTIFIER) {
+            crate::ktx2::decode(bytes)
+        } else if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+            crate::exr_io::decode(bytes)
+        } else {
+            Err(Error::input("not a KTX2 or EXR pack"))
+        }
+    }
+
+    /// Checks shared by the readers: sizes and finiteness.
+    pub fn new(manifest: Manifest, terms: Vec<f32>) -> Result<Pack> {
+        manifest.validate()?;
+        let want = manifest.terms.checked_mul(manifest.layer_texels()).and_then(|v| v.checked_mul(2));
+        if want != Some(terms.len()) {
+            return Err(Error::input(format!(
+                "pack holds {} values, manifest says {} terms of {}x{}",
+                terms.len() / 2,
+                manifest.terms,
+                manifest.crop.width,
+                manifest.crop.height
+            )));
+        }
+        if terms.iter().any(|v| !v.is_finite()) {
+            return Err(Error::input("pack holds NaN or Inf values"));
+        }
+        Ok(Pack { manifest, terms })
+    }
+
+    /// Term `n` at texel (tx, ty) as (re, im).
+    #[inline]
+    pub fn texel(&self, n: usize, tx: usize, ty: usize) -> [f32; 2] {
+        let m = &self.manifest;
+        let i = 2 * ((n * m.crop.height + ty) * m.crop.width + tx);
+        [self.terms[i], self.terms[i + 1]]
+    }
+
+    /// `t = (2 pi / lambda) w H`.
+    pub fn t(&self, w: f64, lambda_m: f64) -> f64 {
+        2.0 * std::f64::consts::PI / lambda_m * w * self.manifest.height_half_range_m
+    }
+
+    fn taps(&self, kappa: f64, k_half: i64, axis: usize) -> Taps {
+        let m = &self.manifest;
+        let taps = m.kernel.taps;
+        let k0 = kernel::first_tap(kappa, taps);
+        let mut t = Taps { idx: [0; 64], w: [0.0; 64], n: 0 };
+        for j in 0..taps {
+            let k = k0 + j as i64;
+            if k < -k_half || k > k_half {
+                continue; // outside the crop: contributes 0
+            }
+            let d = kappa - k as f64;
+            let wt = match m.model {
+                Model::Window => kernel::kb(d, taps, m.kernel.beta),
+                Model::Tiled => kernel::gauss(d, m.kernel.sigma_bins[axis]),
+            };
+            t.idx[t.n] = k + k_half;
+            t.w[t.n] = wt;
+            t.n += 1;
+        }
+        t
+    }
+
+    /// Relative reflectance R at `(u, v, w) = -wi - wr` and wavelength `lambda_m`
+    /// (PHYSICS.md 2), with the interpolation the player uses.
+    pub fn reflectance(&self, u: f64, v: f64, w: f64, lambda_m: f64) -> f64 {
+        let m = &self.manifest;
+        if !(u.is_finite() && v.is_finite() && w.is_finite() && lambda_m.is_finite() && lambda_m > 0.0) {
+            return 0.0;
+        }
+        let c = series::coefficients_f64(m.basis, self.t(w, lambda_m), m.terms);
+        let kappa_x = -u / lambda_m * m.bin_scale_m[0];
+        let kappa_y = -v / lambda_m * m.bin_scale_m[1];
+        if kappa_x.abs() > 1e9 || kappa_y.abs() > 1e9 {
+            return 0.0;
+        }
+        let tx = self.taps(kappa_x, m.crop.kx, 0);
+        let ty = self.taps(kappa_y, m.crop.ky, 1);
+        let layer = m.layer_texels();
+        let mut amp = [0.0f64; 2];
+        let mut power = 0.0f64;
+        for jy in 0..ty.n {
+            for jx in 0..tx.n {
+                let base = 2 * (ty.idx[jy] as usize * m.crop.width + tx.idx[jx] as usize);
+                // Sum the terms as complex numbers at this tap.
+                let mut a = [0.0f64; 2];
+                for (n, cn) in c.iter().enumerate() {
+                    let i = base + 2 * n * layer;
+                    let (re, im) = (self.terms[i] as f64, self.terms[i + 1] as f64);
+                    a[0] += cn[0] * re - cn[1] * im;
+                    a[1] += cn[0] * im + cn[1] * re;
+                }
+                let wgt = tx.w[jx] * ty.w[jy];
+                match m.model {
+                    Model::Window => {
+                        amp[0] += wgt * a[0];
+                        amp[1] += wgt * a[1];
+                    }
+                    Model::Tiled => power += wgt * (a[0] * a[0] + a[1] * a[1]),
+                }
+            }
+        }
+        match m.model {
+            Model::Window => amp[0] * amp[0] + amp[1] * amp[1],
+            Model::Tiled => power,
+        }
+    }
+
+    /// XYZ for local directions `wi` (to the light) and `wr` (to the viewer),
+    /// PHYSICS.md 2: `G(wi, wr) * sum_i R(lambda_i) S(lambda_i) cmf(lambda_i) / sum_i S(lambda_i) ybar(lambda_i)`
+    /// over `lambda_samples` midpoint samples of the pack's wavelength range
+    /// (so a flat mirror at normal incidence gives Y = 1 exactly).
+    pub fn colour_xyz(&self, wi_local: [f64; 3], wr_local: [f64; 3], lambda_samples: usize) -> [f64; 3] {
+        use sunbeam_optics::{cie, gain};
+        let m = &self.manifest;
+        let g = gain::g(wi_local, wr_local, gain::DEFAULT_IOR);
+        if !(g.is_finite() && g > 0.0) || lambda_samples == 0 {
+            return [0.0; 3];
+        }
+        let (u, v, w) = (-wi_local[0] - wr_local[0], -wi_local[1] - wr_local[1], -wi_local[2] - wr_local[2]);
+        let (l0, l1) = (m.lambda_min_m, m.lambda_max_m);
+        let dl = (l1 - l0) / lambda_samples as f64;
+        let mut xyz = [0.0; 3];
+        let mut norm = 0.0;
+        for i in 0..lambda_samples {
+            let l = l0 + (i as f64 + 0.5) * dl;
+            let s = cie::d65_at(l);
+            let c = cie::cmf_at(l);
+            let r = self.reflectance(u, v, w, l);
+            for k in 0..3 {
+                xyz[k] += r * s * c[k];
+            }
+            norm += s * c[1];
+        }
+        if norm <= 0.0 {
+            return [0.0; 3];
+        }
+        xyz.map(|c| c * g / norm)
+    }
+}

@@ -1,0 +1,135 @@
+//! Display images (sRGB-encoded floats, before 8-bit quantisation), PNG I/O and
+//! the colour difference between two images (CIEDE2000, PHYSICS.md 4).
+
+use std::path::Path;
+use sunbeam_common::{Error, Result};
+use sunbeam_optics::colour;
+
+/// An image of display values: sRGB-encoded, each channel in [0, 1], row 0 at the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub rgb: Vec<[f32; 3]>,
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32) -> Image {
+        Image { width, height, rgb: vec![[0.0; 3]; width as usize * height as usize] }
+    }
+
+    pub fn pixel(&self, x: u32, y: u32) -> [f32; 3] {
+        self.rgb[(y * self.width + x) as usize]
+    }
+
+    /// 8-bit RGBA (alpha 255), quantised with `sunbeam_optics::colour::quantise8`.
+    pub fn to_rgba8(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.rgb.len() * 4);
+        for p in &self.rgb {
+            for c in p {
+                out.push(colour::quantise8(*c as f64));
+            }
+            out.push(255);
+        }
+        out
+    }
+
+    /// From 8-bit RGBA.
+    pub fn from_rgba8(width: u32, height: u32, rgba: &[u8]) -> Image {
+        let rgb = rgba.chunks_exact(4).map(|p| [0, 1, 2].map(|k| p[k] as f32 / 255.0)).collect();
+        Image { width, height, rgb }
+    }
+
+    /// PNG bytes (8-bit RGB, sRGB chunk; deterministic).
+    pub fn png_bytes(&self) -> Result<Vec<u8>> {
+        let mut out = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut out, self.width, self.height);
+            enc.set_color(png::ColorType::Rgb);
+            enc.set_depth(png::BitDepth::Eight);
+            enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+            let mut wr = enc.write_header().map_err(|e| Error::internal(format!("png: {e}")))?;
+            let data: Vec<u8> = self.to_rgba8().chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+            wr.write_image_data(&data).map_err(|e| Error::internal(format!("png: {e}")))?;
+        }
+        Ok(out)
+    }
+
+    /// Write a PNG atomically.
+    pub fn write_png(&self, path: &Path) -> Result<()> {
+        sunbeam_common::output::write_atomic(path, &self.png_bytes()?)
+    }
+
+    /// Read an 8-bit RGB or RGBA PNG.
+    pub fn read_png(path: &Path) -> Result<Image> {
+        let f = std::fs::File::open(path).map_err(|e| Error::input_file(path, e))?;
+        let mut dec = png::Decoder::new(std::io::BufReader::new(f));
+        dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+        let mut reader = dec.read_info().map_err(|e| Error::input_file(path, e))?;
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).map_err(|e| Error::input_file(path, e))?;
+        let ch = match info.color_type {
+            png::ColorType::Rgb => 3,
+            png::ColorType::Rgba => 4,
+            png::ColorType::Grayscale => 1,
+            png::ColorType::GrayscaleAlpha => 2,
+            other => return Err(Error::input_file(path, format!("unsupported PNG colour type {other:?}"))),
+        };
+        let rgb = buf[..info.buffer_size()]
+            .chunks_exact(ch)
+            .map(|p| {
+                let g = |k: usize| p[if ch < 3 { 0 } else { k }] as f32 / 255.0;
+                [g(0), g(1), g(2)]
+            })
+            .collect();
+        Ok(Image { width: info.width, height: info.height, rgb })
+    }
+
+    /// Mean and standard deviation of all channels (a blank-image check).
+    pub fn mean_sd(&self) -> (f64, f64) {
+        let n = (self.rgb.len() * 3).max(1) as f64;
+        let mean = self.rgb.iter().flatten().map(|&v| v as f64).sum::<f64>() / n;
+        let var = self.rgb.iter().flatten().map(|&v| (v as f64 - mean).powi(2)).sum::<f64>() / n;
+        (mean, var.sqrt())
+    }
+}
+
+/// CIEDE2000 statistics between two images of the same size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ColourDiff {
+    pub mean: f64,
+    pub p99: f64,
+    pub max: f64,
+    pub pixels: usize,
+}
+
+impl std::fmt::Display for ColourDiff {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "CIEDE2000 mean {:.3} p99 {:.3} max {:.3} over {} px", self.mean, self.p99, self.max, self.pixels)
+    }
+}
+
+/// Decode a display pixel to XYZ (sRGB EOTF, then the sRGB matrix).
+pub fn display_to_xyz(p: [f32; 3]) -> [f64; 3] {
+    colour::linear_srgb_to_xyz(p.map(|v| colour::srgb_eotf(v as f64)))
+}
+
+/// CIEDE2000 between the same pixels of two images (PHYSICS.md 4): mean, 99th percentile, max.
+pub fn compare(a: &Image, b: &Image) -> Result<ColourDiff> {
+    if a.width != b.width || a.height != b.height {
+        return Err(Error::input(format!(
+            "image sizes differ: {}x{} vs {}x{}",
+            a.width, a.height, b.width, b.height
+        )));
+    }
+    let mut d: Vec<f64> =
+        a.rgb.iter().zip(&b.rgb).map(|(p, q)| colour::ciede2000_xyz(display_to_xyz(*p), display_to_xyz(*q))).collect();
+    let n = d.len();
+    if n == 0 {
+        return Ok(ColourDiff { mean: 0.0, p99: 0.0, max: 0.0, pixels: 0 });
+    }
+    let mean = d.iter().sum::<f64>() / n as f64;
+    d.sort_by(|x, y| x.total_cmp(y));
+    let p99 = d[((n as f64 * 0.99).ceil() as usize).clamp(1, n) - 1];
+    Ok(ColourDiff { mean, p99, max: d[n - 1], pixels: n })
+}

@@ -1,0 +1,175 @@
+//! The CPU reference renderer of a Sunbeam scene: what `sunbeam-play` must show,
+//! pixel for pixel (docs/PLAY.md "The reference"). No GPU; float64 throughout.
+//!
+//! - Rasterisation follows the GPU's rules: vertices snapped to 1/256 pixel,
+//!   coverage tested at pixel centres with the top-left rule, back faces culled
+//!   (counter-clockwise fronts), depth test "less", attributes interpolated
+//!   perspective-correctly, triangles clipped at the near plane.
+//! - Shading per pixel (PHYSICS.md 1-2): local frame from the interpolated normal
+//!   `n` and orientation `t` (made orthogonal to `n`), `b = n x t`;
+//!   `R` from `sunbeam_pack::Pack::reflectance` (the pack's CPU evaluator, the
+//!   player's math), the colour integral at 1 nm (`sunbeam_optics::cie`), the gain
+//!   `G` (`sunbeam_optics::gain`), then linear sRGB, the diffuse blend, exposure,
+//!   tone curve and sRGB encoding (`sunbeam_optics::colour`).
+//!
+//! `render(&Scene)` is what `sunbeam-eval render` calls.
+
+pub mod image;
+pub mod raster;
+pub mod shade;
+pub mod spectral;
+
+pub use image::{compare, ColourDiff, Image};
+pub use sunbeam_scene::geometry::Mesh;
+
+use std::path::Path;
+use std::sync::Arc;
+use sunbeam_common::{Error, Result};
+use sunbeam_optics::colour::ToneCurve;
+use sunbeam_pack::Pack;
+use sunbeam_scene::Scene;
+
+/// How the reference renders (all defaults are the documented reference).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    /// Wavelength samples of the colour integral: None = the 1 nm reference sum
+    /// of `sunbeam_optics::cie::integrate_xyz_1nm` over 380..=780 nm; Some(n) = the
+    /// n midpoint samples the player uses (`spectral::Samples::uniform`).
+    pub lambda_samples: Option<usize>,
+    /// Tone curve after exposure (the scene's `exposure`).
+    pub curve: ToneCurve,
+    /// Worker threads (0 = available parallelism). The image does not depend on it.
+    pub threads: usize,
+    /// Output size override (None: the scene's `size`).
+    pub size: Option<[u32; 2]>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options { lambda_samples: None, curve: ToneCurve::default(), threads: 0, size: None }
+    }
+}
+
+/// What one mesh instance is shaded with.
+#[derive(Debug, Clone)]
+pub struct Material {
+    pub pack: Option<Arc<Pack>>,
+    /// Linear sRGB.
+    pub base_color: [f64; 3],
+    pub diffuse_weight: f64,
+}
+
+/// A scene with its meshes and packs loaded (shared by both renderers).
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    pub scene: Scene,
+    pub meshes: Vec<(Arc<Mesh>, Material)>,
+}
+
+/// Load a mesh named by a scene: `builtin:quad`, `builtin:sphere`, or a glTF/GLB/OBJ
+/// file through `sunbeam_mesh::load_scene_mesh` (its orientation field becomes `t`).
+pub fn load_mesh(path: &Path) -> Result<Mesh> {
+    if let Some(b) = Mesh::builtin(path) {
+        return b.map_err(Error::input);
+    }
+    let tm = sunbeam_mesh::load_scene_mesh(path)?;
+    let tangents = tm
+        .orientation
+        .iter()
+        .zip(&tm.tangents)
+        .map(|(o, t)| [o[0], o[1], o[2], if t[3] < 0.0 { -1.0 } else { 1.0 }])
+        .collect();
+    let m = Mesh { positions: tm.positions, normals: tm.normals, uvs: tm.uvs, tangents, indices: tm.indices };
+    m.check().map_err(|e| Error::input_file(path, e))?;
+    Ok(m)
+}
+
+/// Bounds of the mesh a `--mesh M` form names (for `Scene::default_for`).
+pub fn mesh_bounds(path: &Path) -> Result<([f64; 3], [f64; 3])> {
+    Ok(load_mesh(path)?.bounds())
+}
+
+/// The scene the `--mesh M --pack P` form of `sunbeam-play` and `sunbeam-eval render` draws.
+pub fn default_scene(mesh: &Path, pack: Option<&Path>) -> Result<Scene> {
+    let b = mesh_bounds(mesh)?;
+    let mut s = Scene::default_for(mesh.to_path_buf(), pack.map(Path::to_path_buf), b);
+    s.validate()?;
+    Ok(s)
+}
+
+/// Load every mesh and pack of a scene (each file once).
+pub fn prepare(scene: &Scene) -> Result<Prepared> {
+    let mut meshes = Vec::new();
+    let mut mesh_cache: Vec<(std::path::PathBuf, Arc<Mesh>)> = Vec::new();
+    let mut pack_cache: Vec<(std::path::PathBuf, Arc<Pack>)> = Vec::new();
+    for (i, mi) in scene.meshes.iter().enumerate() {
+        let mesh = match mesh_cache.iter().find(|(p, _)| *p == mi.mesh) {
+            Some((_, m)) => m.clone(),
+            None => {
+                let m = Arc::new(load_mesh(&mi.mesh).map_err(|e| e.context(format!("meshes[{i}].mesh")))?);
+                mesh_cache.push((mi.mesh.clone(), m.clone()));
+                m
+            }
+        };
+        let pack = match &mi.pack {
+            None => None,
+            Some(pp) => Some(match pack_cache.iter().find(|(p, _)| p == pp) {
+                Some((_, k)) => k.clone(),
+                None => {
+                    let k = Arc::new(Pack::read(pp).map_err(|e| e.context(format!("meshes[{i}].pack")))?);
+                    pack_cache.push((pp.clone(), k.clone()));
+                    k
+                }
+            }),
+        };
+        if !(mi.diffuse_weight.is_finite() && (0.0..=1.0).contains(&mi.diffuse_weight)) {
+            return Err(Error::input(format!("meshes[{i}].diffuse_weight must be in [0, 1]")));
+        }
+        meshes.push((mesh, Material { pack, base_color: mi.base_color, diffuse_weight: mi.diffuse_weight }));
+    }
+    Ok(Prepared { scene: scene.clone(), meshes })
+}
+
+/// Render a scene with the reference settings (`Options::default()`).
+pub fn render(scene: &Scene) -> Result<Image> {
+    render_with(scene, &Options::default())
+}
+
+/// Render a scene with explicit options.
+pub fn render_with(scene: &Scene, opts: &Options) -> Result<Image> {
+    let p = prepare(scene)?;
+    Ok(render_prepared(&p, opts))
+}
+
+/// Render an already prepared scene.
+pub fn render_prepared(p: &Prepared, opts: &Options) -> Image {
+    let [w, h] = opts.size.unwrap_or(p.scene.size);
+    let gbuf = raster::rasterise(p, w, h);
+    let shader = shade::Shader::new(p, opts);
+    let threads = if opts.threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        opts.threads
+    };
+    let mut rgb = vec![[0.0f32; 3]; (w as usize) * (h as usize)];
+    let rows: Vec<&mut [[f32; 3]]> = rgb.chunks_mut(w as usize).collect();
+    let mut per_thread: Vec<Vec<(usize, &mut [[f32; 3]])>> = (0..threads).map(|_| Vec::new()).collect();
+    for (j, row) in rows.into_iter().enumerate() {
+        per_thread[j % threads].push((j, row));
+    }
+    std::thread::scope(|s| {
+        for work in per_thread {
+            let gbuf = &gbuf;
+            let shader = &shader;
+            s.spawn(move || {
+                for (j, row) in work {
+                    for (i, px) in row.iter_mut().enumerate() {
+                        let frag = &gbuf[j * w as usize + i];
+                        *px = shader.display(frag).map(|v| v as f32);
+                    }
+                }
+            });
+        }
+    });
+    Image { width: w, height: h, rgb }
+}

@@ -1,0 +1,110 @@
+//! Per-pixel shading: the reference definition of what the player computes
+//! (docs/PLAY.md "Shading"). For each light (directional, D65, `intensity`):
+//!
+//! ```text
+//! n = normalize(N), t = normalize(T - n (n.T)), b = n x t
+//! wi = light direction, wr = normalize(eye - p); local d' = (d.t, d.b, d.n)
+//! diffraction XYZ = G(wi', wr') * sum_l R(u, v, w, l) weight(l)   (0 unless wi'.z > 0 and wr'.z > 0)
+//! rgb += intensity * ( dw * base * max(wi'.z, 0) + (1 - dw) * M_srgb XYZ )
+//! ```
+//! with `(u, v, w) = -wi' - wr'`, `dw` the mesh's diffuse weight (1 for a mesh
+//! without a pack: base colour only). The background is its linear colour.
+//! Display value = sRGB OETF(tone curve(2^exposure * rgb)).
+
+use crate::raster::Fragment;
+use crate::spectral::Samples;
+use crate::{Options, Prepared};
+use sunbeam_optics::colour::{self, ToneMap};
+use sunbeam_optics::{cie, gain};
+
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+pub(crate) fn normalize(a: [f64; 3]) -> Option<[f64; 3]> {
+    let l = dot(a, a).sqrt();
+    (l > 1e-20 && l.is_finite()).then(|| [a[0] / l, a[1] / l, a[2] / l])
+}
+
+/// The shading frame at a fragment: (t, b, n), or None when the normal is degenerate.
+pub fn frame(normal: [f64; 3], tangent: [f64; 3]) -> Option<([f64; 3], [f64; 3], [f64; 3])> {
+    let n = normalize(normal)?;
+    let d = dot(n, tangent);
+    let t = normalize([tangent[0] - d * n[0], tangent[1] - d * n[1], tangent[2] - d * n[2]]).or_else(|| {
+        // no usable orientation: any perpendicular (the mesh loader never gives this)
+        let a = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+        let d = dot(n, a);
+        normalize([a[0] - d * n[0], a[1] - d * n[1], a[2] - d * n[2]])
+    })?;
+    Some((t, cross(n, t), n))
+}
+
+/// The reference shader of a prepared scene.
+pub struct Shader<'a> {
+    p: &'a Prepared,
+    samples: Option<Samples>,
+    tone: ToneMap,
+}
+
+impl<'a> Shader<'a> {
+    pub fn new(p: &'a Prepared, opts: &Options) -> Shader<'a> {
+        Shader {
+            p,
+            samples: opts.lambda_samples.map(|n| Samples::uniform(n, cie::DEFAULT_RANGE_NM)),
+            tone: ToneMap { exposure_ev: p.scene.exposure, curve: opts.curve },
+        }
+    }
+
+    /// Diffraction XYZ of mesh `mi` for local directions (before the light's intensity).
+    pub fn diffraction_xyz(&self, mi: usize, wi: [f64; 3], wr: [f64; 3]) -> [f64; 3] {
+        let Some(pack) = &self.p.meshes[mi].1.pack else { return [0.0; 3] };
+        if !(wi[2] > 0.0 && wr[2] > 0.0) {
+            return [0.0; 3];
+        }
+        let (u, v, w) = (-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
+        let r = |l: f64| pack.reflectance(u, v, w, l);
+        let xyz = match &self.samples {
+            None => cie::integrate_xyz_1nm(cie::DEFAULT_RANGE_NM, r),
+            Some(s) => s.integrate(r),
+        };
+        let g = gain::g(wi, wr, gain::DEFAULT_IOR);
+        xyz.map(|c| c * g)
+    }
+
+    /// Linear sRGB radiance of a fragment (the background colour for none).
+    pub fn linear(&self, f: &Fragment) -> [f64; 3] {
+        let Some(mi) = f.mesh else { return self.p.scene.background };
+        let mi = mi as usize;
+        let mat = &self.p.meshes[mi].1;
+        let Some((t, b, n)) = frame(f.normal, f.tangent) else { return [0.0; 3] };
+        let eye = self.p.scene.camera.eye;
+        let Some(wr) = normalize([eye[0] - f.pos[0], eye[1] - f.pos[1], eye[2] - f.pos[2]]) else {
+            return [0.0; 3];
+        };
+        let local = |d: [f64; 3]| [dot(d, t), dot(d, b), dot(d, n)];
+        let wr_l = local(wr);
+        let dw = if mat.pack.is_some() { mat.diffuse_weight } else { 1.0 };
+        let mut rgb = [0.0; 3];
+        for light in &self.p.scene.lights {
+            let Some(wi) = normalize(light.direction) else { continue };
+            let wi_l = local(wi);
+            let cos_i = wi_l[2].max(0.0);
+            let diff = if dw < 1.0 {
+                colour::xyz_to_linear_srgb(self.diffraction_xyz(mi, wi_l, wr_l))
+            } else {
+                [0.0; 3]
+            };
+            for k in 0..3 {
+                rgb[k] += light.intensity * (dw * mat.base_color[k] * cos_i + (1.0 - dw) * diff[k]);
+            }
+        }
+        rgb
+    }
+
+    /// Display value (sRGB-encoded, [0, 1]) of a fragment.
+    pub fn display(&self, f: &Fragment) -> [f64; 3] {
+        colour::display_encode(self.linear(f), &self.tone)
+    }
+}

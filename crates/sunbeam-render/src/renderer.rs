@@ -1,0 +1,655 @@
+//! The diffraction renderer: buffers for meshes and packs, the pipeline of
+//! shaders/diffraction.wgsl, drawing into any colour target, and headless frames.
+
+use crate::gpu::Gpu;
+use std::sync::Arc;
+use sunbeam_common::{Error, Result};
+use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
+use sunbeam_optics::{cie, gain};
+use sunbeam_pack::{Basis, Model, Pack};
+use sunbeam_raster::spectral::Samples;
+use sunbeam_raster::{Image, Prepared};
+use sunbeam_scene::{camera, Camera, Light};
+use wgpu::util::DeviceExt;
+
+/// The WGSL source (shaders/diffraction.wgsl).
+pub const SHADER: &str = include_str!("../../../shaders/diffraction.wgsl");
+
+/// Most lights a frame shades with.
+pub const MAX_LIGHTS: usize = 4;
+/// Most series terms the shader evaluates (packs with more are cut, with a warning).
+pub const MAX_TERMS: usize = 64;
+/// Most kernel taps per axis the shader supports.
+pub const MAX_TAPS: usize = 16;
+/// Entries of the per-|t| term-count table.
+pub const TERM_TABLE: usize = 256;
+/// Term count of the thesis mode.
+pub const THESIS_TERMS: u32 = 39;
+
+/// Which shading the pipeline does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    /// PHYSICS.md 2 with the pack's basis, model and interpolation (the default).
+    #[default]
+    Default,
+    /// The thesis' shader: fixed 39 terms, 5 nm steps, nearest bin.
+    Thesis,
+    /// Plain Lambert with the base colour (benchmark baseline).
+    Lambert,
+}
+
+impl std::str::FromStr for Mode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "default" => Ok(Mode::Default),
+            "thesis" => Ok(Mode::Thesis),
+            "lambert" => Ok(Mode::Lambert),
+            _ => Err(Error::usage(format!("unknown mode '{s}' (default, thesis, lambert)"))),
+        }
+    }
+}
+
+/// Renderer settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    pub mode: Mode,
+    /// Wavelength samples of the default mode (midpoints over 380..780 nm).
+    pub lambda_samples: usize,
+    pub curve: ToneCurve,
+    /// Bound on |dR| from truncating the series per fragment (None: the pack's own
+    /// tolerance or series bound, whichever is larger).
+    pub term_tolerance: Option<f64>,
+}
+
+/// Default wavelength sample count (docs/PLAY.md: chosen by measurement).
+pub const DEFAULT_LAMBDA_SAMPLES: usize = 48;
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            mode: Mode::Default,
+            lambda_samples: DEFAULT_LAMBDA_SAMPLES,
+            curve: ToneCurve::default(),
+            term_tolerance: None,
+        }
+    }
+}
+
+/// What can change between frames (the window's orbit camera, light, exposure).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameState {
+    pub camera: Camera,
+    pub lights: Vec<Light>,
+    pub exposure: f64,
+    pub background: [f64; 3],
+}
+
+impl FrameState {
+    pub fn from_scene(p: &Prepared) -> FrameState {
+        FrameState {
+            camera: p.scene.camera.clone(),
+            lights: p.scene.lights.clone(),
+            exposure: p.scene.exposure,
+            background: p.scene.background,
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Vertex {
+    pos: [f32; 3],
+    normal: [f32; 3],
+    tangent: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Globals {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+    lights: [[f32; 4]; MAX_LIGHTS],
+    xyz_to_rgb: [[f32; 4]; 3],
+    background: [f32; 4],
+    n_lights: u32,
+    mode: u32,
+    curve: u32,
+    output: u32,
+    exposure_scale: f32,
+    n_lambda: u32,
+    f0: f32,
+    _pad: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
+struct MaterialU {
+    base: [f32; 4],
+    has_pack: u32,
+    basis: u32,
+    model: u32,
+    taps: u32,
+    crop_w: u32,
+    crop_h: u32,
+    kx: i32,
+    ky: i32,
+    terms: u32,
+    fixed_terms: u32,
+    n_table: u32,
+    _p0: u32,
+    bin_scale_um: [f32; 2],
+    half_range_um: f32,
+    beta: f32,
+    sigma_bins: [f32; 2],
+    kb_norm: f32,
+    table_dt: f32,
+}
+
+struct GpuMesh {
+    vbuf: wgpu::Buffer,
+    ibuf: wgpu::Buffer,
+    count: u32,
+    bind: wgpu::BindGroup,
+}
+
+/// Smallest term count whose truncation bound stays below `tol` for every |t| up to `t`.
+fn terms_for(basis: Basis, t: f64, tol: f64, start: usize, cap: usize) -> usize {
+    let mut n = start.max(1);
+    while n < cap && sunbeam_pack::series::tail_bound_upto(basis, t, n) >= tol {
+        n += 1;
+    }
+    n
+}
+
+/// The per-|t| term table of a pack: entry i covers |t| <= (i + 1) dt.
+pub fn term_table(pack: &Pack, t_max: f64, tol: f64) -> (Vec<u32>, f64) {
+    let m = &pack.manifest;
+    let cap = m.terms.min(MAX_TERMS);
+    let dt = (t_max / TERM_TABLE as f64).max(1e-6);
+    let mut out = Vec::with_capacity(TERM_TABLE);
+    let mut n = 1;
+    for i in 0..TERM_TABLE {
+        n = terms_for(m.basis, (i + 1) as f64 * dt, tol, n, cap);
+        out.push(n as u32);
+    }
+    (out, dt)
+}
+
+/// The renderer of one prepared scene.
+pub struct Renderer {
+    pipeline: wgpu::RenderPipeline,
+    globals: wgpu::Buffer,
+    global_bind: wgpu::BindGroup,
+    meshes: Vec<GpuMesh>,
+    settings: Settings,
+    n_lambda: u32,
+    /// Colour target format the pipeline writes.
+    pub format: wgpu::TextureFormat,
+    /// Notes for the user (packs cut to MAX_TERMS, ...).
+    pub warnings: Vec<String>,
+}
+
+/// Depth format of every pass.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+impl Renderer {
+    pub fn new(gpu: &Gpu, p: &Prepared, settings: &Settings, format: wgpu::TextureFormat) -> Result<Renderer> {
+        let device = &gpu.device;
+        let mut warnings = Vec::new();
+        let samples = match settings.mode {
+            Mode::Thesis => Samples::stepped(380, 780, 5),
+            _ => Samples::uniform(settings.lambda_samples.max(1), cie::DEFAULT_RANGE_NM),
+        };
+        let spec: Vec<[f32; 4]> = samples
+            .0
+            .iter()
+            .map(|s| [s.weight[0] as f32, s.weight[1] as f32, s.weight[2] as f32, (1e-6 / s.lambda_m) as f32])
+            .collect();
+        let lambda_min = samples.0.iter().map(|s| s.lambda_m).fold(f64::INFINITY, f64::min);
+        let spectrum = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("spectrum"),
+            contents: bytemuck::cast_slice(&spec),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let globals = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("globals"),
+            size: std::mem::size_of::<Globals>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let storage_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let uniform_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let gl0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("globals"),
+            entries: &[uniform_entry(0), storage_entry(1)],
+        });
+        let gl1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("material"),
+            entries: &[uniform_entry(0), storage_entry(1), storage_entry(2)],
+        });
+        let global_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("globals"),
+            layout: &gl0,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: spectrum.as_entire_binding() },
+            ],
+        });
+
+        // Packs: one terms buffer per distinct pack.
+        let max_binding = device.limits().max_storage_buffer_binding_size as u64;
+        let mut pack_bufs: Vec<(*const Pack, Arc<wgpu::Buffer>, usize)> = Vec::new();
+        let mut meshes = Vec::new();
+        for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
+            let verts: Vec<Vertex> = (0..mesh.positions.len())
+                .map(|i| Vertex { pos: mesh.positions[i], normal: mesh.normals[i], tangent: mesh.tangents[i] })
+                .collect();
+            let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("vertices"),
+                contents: bytemuck::cast_slice(if verts.is_empty() { &[Vertex::zeroed()][..] } else { &verts }),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            let ibuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("indices"),
+                contents: bytemuck::cast_slice(if mesh.indices.is_empty() { &[0u32][..] } else { &mesh.indices }),
+                usage: wgpu::BufferUsages::INDEX,
+            });
+            let mut mu = MaterialU {
+                base: [
+                    mat.base_color[0] as f32,
+                    mat.base_color[1] as f32,
+                    mat.base_color[2] as f32,
+                    mat.diffuse_weight as f32,
+                ],
+                n_table: 1,
+                table_dt: 1.0,
+                ..Default::default()
+            };
+            let (terms_buf, table): (Arc<wgpu::Buffer>, Vec<u32>) = match &mat.pack {
+                Some(pack) if settings.mode != Mode::Lambert => {
+                    let m = &pack.manifest;
+                    if m.kernel.taps > MAX_TAPS {
+                        return Err(Error::input(format!(
+                            "meshes[{mi}].pack: kernel has {} taps, the player supports up to {MAX_TAPS}",
+                            m.kernel.taps
+                        )));
+                    }
+                    let used = m.terms.min(MAX_TERMS);
+                    if m.terms > MAX_TERMS {
+                        warnings.push(format!(
+                            "meshes[{mi}].pack has {} terms; the player uses the first {MAX_TERMS}",
+                            m.terms
+                        ));
+                    }
+                    let key = Arc::as_ptr(pack);
+                    let buf = match pack_bufs.iter().find(|(k, _, _)| *k == key) {
+                        Some((_, b, _)) => b.clone(),
+                        None => {
+                            let n = used * m.layer_texels() * 2;
+                            let bytes = (n * 4) as u64;
+                            if bytes > max_binding {
+                                return Err(Error::input(format!(
+                                    "meshes[{mi}].pack: {used} terms of {}x{} ({} MiB) exceed this GPU's storage \
+                                     buffer limit ({} MiB); build the pack with fewer terms or a smaller crop",
+                                    m.crop.width,
+                                    m.crop.height,
+                                    bytes >> 20,
+                                    max_binding >> 20
+                                )));
+                            }
+                            let b = Arc::new(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                                label: Some("terms"),
+                                contents: bytemuck::cast_slice(&pack.terms[..n]),
+                                usage: wgpu::BufferUsages::STORAGE,
+                            }));
+                            pack_bufs.push((key, b.clone(), used));
+                            b
+                        }
+                    };
+                    let h = m.height_half_range_m;
+                    let t_max = 4.0 * std::f64::consts::PI * h / lambda_min;
+                    let tol = settings
+                        .term_tolerance
+                        .unwrap_or_else(|| m.error.tolerance.unwrap_or(0.0).max(m.error.series_bound))
+                        .max(1e-12);
+                    let (table, dt) = term_table(pack, t_max, tol);
+                    let w = m.kernel.taps as f64;
+                    mu.has_pack = 1;
+                    mu.basis = match m.basis {
+                        Basis::Chebyshev => 0,
+                        Basis::Taylor => 1,
+                    };
+                    mu.model = match m.model {
+                        Model::Window => 0,
+                        Model::Tiled => 1,
+                    };
+                    mu.taps = m.kernel.taps as u32;
+                    mu.crop_w = m.crop.width as u32;
+                    mu.crop_h = m.crop.height as u32;
+                    mu.kx = m.crop.kx as i32;
+                    mu.ky = m.crop.ky as i32;
+                    mu.terms = used as u32;
+                    mu.fixed_terms = if settings.mode == Mode::Thesis { THESIS_TERMS } else { 0 };
+                    mu.n_table = table.len() as u32;
+                    mu.bin_scale_um = [(m.bin_scale_m[0] * 1e-6) as f32, (m.bin_scale_m[1] * 1e-6) as f32];
+                    mu.half_range_um = (h * 1e6) as f32;
+                    mu.beta = m.kernel.beta as f32;
+                    mu.sigma_bins = [m.kernel.sigma_bins[0] as f32, m.kernel.sigma_bins[1] as f32];
+                    mu.kb_norm =
+                        if m.kernel.beta > 0.0 { (m.kernel.beta / (w * m.kernel.beta.sinh())) as f32 } else { 0.0 };
+                    mu.table_dt = dt as f32;
+                    (buf, table)
+                }
+                _ => (
+                    Arc::new(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("no terms"),
+                        contents: bytemuck::cast_slice(&[0.0f32; 4]),
+                        usage: wgpu::BufferUsages::STORAGE,
+                    })),
+                    vec![1u32],
+                ),
+            };
+            let mbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("material"),
+                contents: bytemuck::bytes_of(&mu),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let tbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("term table"),
+                contents: bytemuck::cast_slice(&table),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("material"),
+                layout: &gl1,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: mbuf.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: terms_buf.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: tbuf.as_entire_binding() },
+                ],
+            });
+            meshes.push(GpuMesh { vbuf, ibuf, count: mesh.indices.len() as u32, bind });
+        }
+
+        device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("diffraction.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("diffraction"),
+            bind_group_layouts: &[Some(&gl0), Some(&gl1)],
+            immediate_size: 0,
+        });
+        let vlayout = wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<Vertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4],
+        };
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("diffraction"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(vlayout)],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: Some(wgpu::Face::Back),
+                front_face: wgpu::FrontFace::Ccw,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        if let Some(e) = pollster::block_on(device.pop_error_scope()) {
+            return Err(Error::internal(format!("shader/pipeline creation failed: {e}")));
+        }
+        Ok(Renderer {
+            pipeline,
+            globals,
+            global_bind,
+            meshes,
+            settings: settings.clone(),
+            n_lambda: spec.len() as u32,
+            format,
+            warnings,
+        })
+    }
+
+    /// Upload the per-frame uniforms for a `w x h` target.
+    pub fn update(&self, gpu: &Gpu, state: &FrameState, w: u32, h: u32) {
+        let vp = camera::to_f32(&state.camera.view_proj(w, h));
+        let mut lights = [[0.0f32; 4]; MAX_LIGHTS];
+        let mut n = 0;
+        for l in state.lights.iter().take(MAX_LIGHTS) {
+            let d = l.direction;
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if !(len > 0.0 && len.is_finite()) {
+                continue;
+            }
+            lights[n] = [(d[0] / len) as f32, (d[1] / len) as f32, (d[2] / len) as f32, l.intensity as f32];
+            n += 1;
+        }
+        let m = colour::XYZ_TO_SRGB;
+        let row = |r: usize| [m[r][0] as f32, m[r][1] as f32, m[r][2] as f32, 0.0];
+        let g = Globals {
+            view_proj: vp,
+            eye: [state.camera.eye[0] as f32, state.camera.eye[1] as f32, state.camera.eye[2] as f32, 1.0],
+            lights,
+            xyz_to_rgb: [row(0), row(1), row(2)],
+            background: [state.background[0] as f32, state.background[1] as f32, state.background[2] as f32, 1.0],
+            n_lights: n as u32,
+            mode: match self.settings.mode {
+                Mode::Default => 0,
+                Mode::Thesis => 1,
+                Mode::Lambert => 2,
+            },
+            curve: match self.settings.curve {
+                ToneCurve::Clamp => 0,
+                ToneCurve::Reinhard => 1,
+            },
+            output: u32::from(self.format.is_srgb()),
+            exposure_scale: state.exposure.exp2() as f32,
+            n_lambda: self.n_lambda,
+            f0: gain::f0(gain::DEFAULT_IOR) as f32,
+            _pad: 0.0,
+        };
+        gpu.queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
+    }
+
+    /// The clear colour: the background through the display transform (linear for an sRGB target).
+    pub fn clear_colour(&self, state: &FrameState) -> wgpu::Color {
+        let tm = ToneMap { exposure_ev: state.exposure, curve: self.settings.curve };
+        let mut e = colour::display_encode(state.background, &tm);
+        if self.format.is_srgb() {
+            e = e.map(colour::srgb_eotf);
+        }
+        wgpu::Color { r: e[0], g: e[1], b: e[2], a: 1.0 }
+    }
+
+    /// Record a frame into `colour` (with `depth` of the same size).
+    pub fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+        state: &FrameState,
+    ) {
+        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("frame"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: colour,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(self.clear_colour(state)), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        rp.set_pipeline(&self.pipeline);
+        rp.set_bind_group(0, &self.global_bind, &[]);
+        for m in &self.meshes {
+            if m.count == 0 {
+                continue;
+            }
+            rp.set_bind_group(1, &m.bind, &[]);
+            rp.set_vertex_buffer(0, m.vbuf.slice(..));
+            rp.set_index_buffer(m.ibuf.slice(..), wgpu::IndexFormat::Uint32);
+            rp.draw_indexed(0..m.count, 0, 0..1);
+        }
+    }
+}
+
+/// A depth texture view of the given size.
+pub fn depth_view(gpu: &Gpu, w: u32, h: u32) -> wgpu::TextureView {
+    gpu.device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("depth"),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+}
+
+/// An offscreen float target with readback: frames come back as display values.
+pub struct Offscreen {
+    pub width: u32,
+    pub height: u32,
+    tex: wgpu::Texture,
+    view: wgpu::TextureView,
+    depth: wgpu::TextureView,
+    readback: wgpu::Buffer,
+    padded_row: u32,
+}
+
+/// Colour format of offscreen frames (exact display values, quantised only when written).
+pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+impl Offscreen {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Offscreen> {
+        let lim = gpu.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > lim || height > lim {
+            return Err(Error::usage(format!("size {width}x{height}: each side must be 1..{lim} on this GPU")));
+        }
+        let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("frame"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: OFFSCREEN_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = tex.create_view(&Default::default());
+        let padded_row = (width * 16).div_ceil(256) * 256;
+        let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: padded_row as u64 * height as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Offscreen { width, height, tex, view, depth: depth_view(gpu, width, height), readback, padded_row })
+    }
+
+    /// Render one frame and wait for it (no readback).
+    pub fn draw(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<()> {
+        r.update(gpu, state, self.width, self.height);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        r.encode(&mut enc, &self.view, &self.depth, state);
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait()?;
+        gpu.take_errors()
+    }
+
+    /// Render one frame and read it back.
+    pub fn render(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<Image> {
+        r.update(gpu, state, self.width, self.height);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        r.encode(&mut enc, &self.view, &self.depth, state);
+        enc.copy_texture_to_buffer(
+            self.tex.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row),
+                    rows_per_image: None,
+                },
+            },
+            wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
+        );
+        gpu.queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        self.readback.map_async(wgpu::MapMode::Read, .., move |res| {
+            let _ = tx.send(res);
+        });
+        gpu.wait()?;
+        rx.recv()
+            .map_err(|e| Error::internal(format!("readback: {e}")))?
+            .map_err(|e| Error::internal(format!("readback: {e}")))?;
+        gpu.take_errors()?;
+        let mut img = Image::new(self.width, self.height);
+        {
+            let data = self.readback.get_mapped_range(..).map_err(|e| Error::internal(format!("readback: {e}")))?;
+            let px: &[f32] = bytemuck::cast_slice(&data);
+            let stride = (self.padded_row / 4) as usize;
+            for y in 0..self.height as usize {
+                for x in 0..self.width as usize {
+                    let i = y * stride + x * 4;
+                    img.rgb[y * self.width as usize + x] = [px[i], px[i + 1], px[i + 2]];
+                }
+            }
+        }
+        self.readback.unmap();
+        Ok(img)
+    }
+}
+
+use bytemuck::Zeroable;

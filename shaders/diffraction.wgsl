@@ -1,0 +1,428 @@
+// Sunbeam diffraction shader (PHYSICS.md 1-3, docs/PLAY.md "Shading").
+//
+// Per fragment: local frame (t, b, n) with b = n x t, (u, v, w) = -wi - wr,
+// for each wavelength sample that can reach a stored frequency:
+//   t_l = 2 pi w H / lambda, c_n(t_l) (Chebyshev: i^n eps_n J_n by Miller's
+//   backward recurrence; Taylor: (i t)^n / n!), only the terms |t_l| needs,
+//   amplitude = sum over Kaiser-Bessel taps of weight * sum_n c_n F_n[tap]
+//   (window model, squared after the sum) or power = sum of weight * |sum_n c_n F_n|^2
+//   (tiled model), exactly as sunbeam_pack::Pack::reflectance;
+// XYZ = G * sum_l R_l weight_l; linear sRGB; diffuse blend; exposure; tone curve; sRGB OETF.
+//
+// Modes: 0 = default (above), 1 = thesis (fixed term count, 5 nm samples, nearest
+// texel, no interpolation), 2 = Lambert (base colour only).
+
+const MAX_TERMS: u32 = 64u;
+const MAX_TAPS: u32 = 16u;
+const TAU: f32 = 6.283185307179586;
+
+struct Globals {
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+    // xyz: direction towards the light (unit), w: intensity
+    lights: array<vec4<f32>, 4>,
+    // rows of the XYZ -> linear sRGB matrix
+    xyz_to_rgb: array<vec4<f32>, 3>,
+    background: vec4<f32>,
+    n_lights: u32,
+    mode: u32,
+    curve: u32,
+    // 0: write display values (UNORM/float target); 1: write their linear value (sRGB target)
+    output: u32,
+    exposure_scale: f32,
+    n_lambda: u32,
+    f0: f32,
+    _pad: f32,
+};
+
+struct Material {
+    // rgb: linear base colour, w: diffuse weight
+    base: vec4<f32>,
+    has_pack: u32,
+    basis: u32,   // 0 Chebyshev, 1 Taylor
+    model: u32,   // 0 window (Kaiser-Bessel on amplitudes), 1 tiled (Gaussian on power)
+    taps: u32,
+    crop_w: u32,
+    crop_h: u32,
+    kx: i32,
+    ky: i32,
+    terms: u32,       // terms stored (capped at MAX_TERMS)
+    fixed_terms: u32, // thesis mode: use exactly this many; 0 = per-fragment from the bound
+    n_table: u32,     // entries in term_table
+    _p0: u32,
+    // bins per (cycle per micrometre), x and y
+    bin_scale_um: vec2<f32>,
+    half_range_um: f32,
+    beta: f32,
+    sigma_bins: vec2<f32>,
+    kb_norm: f32,      // beta / (W sinh beta)
+    table_dt: f32,     // |t| step of term_table
+};
+
+@group(0) @binding(0) var<uniform> g: Globals;
+// xyz: colour weight of the sample, w: 1 / lambda in 1/um
+@group(0) @binding(1) var<storage, read> spectrum: array<vec4<f32>>;
+
+@group(1) @binding(0) var<uniform> mat: Material;
+// texel (n, ty, tx) at (n * crop_h + ty) * crop_w + tx, (re, im)
+@group(1) @binding(1) var<storage, read> terms: array<vec2<f32>>;
+// term_table[i] = terms needed for |t| <= (i + 1) * table_dt
+@group(1) @binding(2) var<storage, read> term_table: array<u32>;
+
+struct VsIn {
+    @location(0) pos: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec4<f32>,
+};
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec3<f32>,
+};
+
+@vertex
+fn vs_main(v: VsIn) -> VsOut {
+    var o: VsOut;
+    o.clip = g.view_proj * vec4<f32>(v.pos, 1.0);
+    o.world = v.pos;
+    o.normal = v.normal;
+    o.tangent = v.tangent.xyz;
+    return o;
+}
+
+// ---------------------------------------------------------------- series
+var<private> coef: array<vec2<f32>, MAX_TERMS>;
+
+// J_0..J_{n-1}(t) into coef[].x by Miller's backward recurrence, exactly as
+// sunbeam_pack::series::bessel_j_f32.
+fn bessel_j(t: f32, n: u32) {
+    let a = abs(t);
+    if (a < 1e-4) {
+        let half = t / 2.0;
+        var term = 1.0;
+        for (var k = 0u; k < n; k = k + 1u) {
+            if (k > 0u) {
+                term = term * half / f32(k);
+            }
+            coef[k] = vec2<f32>(term, 0.0);
+        }
+        return;
+    }
+    for (var k = 0u; k < n; k = k + 1u) {
+        coef[k] = vec2<f32>(0.0);
+    }
+    let mm = max(f32(n), a);
+    let m = 2u * u32(ceil((mm + 16.0 + sqrt(40.0 * mm)) / 2.0));
+    var jp1 = 0.0;
+    var j = 1.0;
+    var sum = 2.0; // m is even: 2 J_m
+    var k = m;
+    loop {
+        if (k < 1u) {
+            break;
+        }
+        let jm1 = (2.0 * f32(k) / a) * j - jp1;
+        let idx = k - 1u;
+        if (idx < n) {
+            coef[idx].x = jm1;
+        }
+        if (idx == 0u) {
+            sum = sum + jm1;
+        } else if ((idx & 1u) == 0u) {
+            sum = sum + 2.0 * jm1;
+        }
+        jp1 = j;
+        j = jm1;
+        if (abs(j) > 1e10) {
+            j = j * 1e-10;
+            jp1 = jp1 * 1e-10;
+            sum = sum * 1e-10;
+            for (var q = idx; q < n; q = q + 1u) {
+                coef[q].x = coef[q].x * 1e-10;
+            }
+        }
+        k = k - 1u;
+    }
+    let inv = 1.0 / sum;
+    for (var q = 0u; q < n; q = q + 1u) {
+        var v = coef[q].x * inv;
+        if (t < 0.0 && (q & 1u) == 1u) {
+            v = -v;
+        }
+        coef[q].x = v;
+    }
+}
+
+// c_n(t), n = 0..count-1, into coef[].
+fn coefficients(t: f32, count: u32) {
+    if (mat.basis == 0u) {
+        bessel_j(t, count);
+        for (var k = 0u; k < count; k = k + 1u) {
+            var e = coef[k].x;
+            if (k > 0u) {
+                e = 2.0 * e;
+            }
+            switch (k & 3u) {
+                case 0u: { coef[k] = vec2<f32>(e, 0.0); }
+                case 1u: { coef[k] = vec2<f32>(0.0, e); }
+                case 2u: { coef[k] = vec2<f32>(-e, 0.0); }
+                default: { coef[k] = vec2<f32>(0.0, -e); }
+            }
+        }
+    } else {
+        var c = vec2<f32>(1.0, 0.0);
+        for (var k = 0u; k < count; k = k + 1u) {
+            if (k > 0u) {
+                let s = t / f32(k);
+                c = vec2<f32>(-c.y * s, c.x * s);
+            }
+            coef[k] = c;
+        }
+    }
+}
+
+// Terms the bound asks for at |t| (never more than stored).
+fn terms_needed(at: f32) -> u32 {
+    if (mat.fixed_terms > 0u) {
+        return min(mat.fixed_terms, mat.terms);
+    }
+    let i = min(u32(floor(at / mat.table_dt)), mat.n_table - 1u);
+    return min(term_table[i], mat.terms);
+}
+
+// ---------------------------------------------------------------- kernel
+fn bessel_i0(x: f32) -> f32 {
+    let q = x * x / 4.0;
+    var term = 1.0;
+    var sum = 1.0;
+    for (var k = 1; k < 60; k = k + 1) {
+        let kk = f32(k);
+        term = term * q / (kk * kk);
+        sum = sum + term;
+        if (term < 1e-8 * sum) {
+            break;
+        }
+    }
+    return sum;
+}
+
+fn tap_weight(d: f32, axis: u32) -> f32 {
+    let w = f32(mat.taps);
+    if (mat.model == 0u) {
+        let r = 2.0 * d / w;
+        if (abs(r) >= 1.0) {
+            return 0.0;
+        }
+        return mat.kb_norm * bessel_i0(mat.beta * sqrt(1.0 - r * r));
+    }
+    let s = mat.sigma_bins[axis];
+    return exp(-d * d / (2.0 * s * s));
+}
+
+var<private> wx: array<f32, MAX_TAPS>;
+var<private> wy: array<f32, MAX_TAPS>;
+
+fn term_at(n: u32, tx: u32, ty: u32) -> vec2<f32> {
+    return terms[(n * mat.crop_h + ty) * mat.crop_w + tx];
+}
+
+fn cmul(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
+}
+
+// R at fractional bin (kappa_x, kappa_y) with coef[0..count] set.
+fn reflectance(kappa: vec2<f32>, count: u32) -> f32 {
+    let taps = i32(mat.taps);
+    let k0x = i32(floor(kappa.x)) - taps / 2 + 1;
+    let k0y = i32(floor(kappa.y)) - taps / 2 + 1;
+    for (var j = 0; j < taps; j = j + 1) {
+        let kx = k0x + j;
+        if (kx < -mat.kx || kx > mat.kx) {
+            wx[j] = 0.0;
+        } else {
+            wx[j] = tap_weight(kappa.x - f32(kx), 0u);
+        }
+        let ky = k0y + j;
+        if (ky < -mat.ky || ky > mat.ky) {
+            wy[j] = 0.0;
+        } else {
+            wy[j] = tap_weight(kappa.y - f32(ky), 1u);
+        }
+    }
+    var amp = vec2<f32>(0.0);
+    var power = 0.0;
+    for (var jy = 0; jy < taps; jy = jy + 1) {
+        if (wy[jy] == 0.0) {
+            continue;
+        }
+        let ty = u32(k0y + jy + mat.ky);
+        for (var jx = 0; jx < taps; jx = jx + 1) {
+            if (wx[jx] == 0.0) {
+                continue;
+            }
+            let tx = u32(k0x + jx + mat.kx);
+            var a = vec2<f32>(0.0);
+            for (var n = 0u; n < count; n = n + 1u) {
+                a = a + cmul(coef[n], term_at(n, tx, ty));
+            }
+            let wgt = wx[jx] * wy[jy];
+            if (mat.model == 0u) {
+                amp = amp + wgt * a;
+            } else {
+                power = power + wgt * dot(a, a);
+            }
+        }
+    }
+    if (mat.model == 0u) {
+        return dot(amp, amp);
+    }
+    return power;
+}
+
+// Thesis mode: the nearest stored texel, no interpolation.
+fn reflectance_nearest(kappa: vec2<f32>, count: u32) -> f32 {
+    let kx = i32(round(kappa.x));
+    let ky = i32(round(kappa.y));
+    if (kx < -mat.kx || kx > mat.kx || ky < -mat.ky || ky > mat.ky) {
+        return 0.0;
+    }
+    let tx = u32(kx + mat.kx);
+    let ty = u32(ky + mat.ky);
+    var a = vec2<f32>(0.0);
+    for (var n = 0u; n < count; n = n + 1u) {
+        a = a + cmul(coef[n], term_at(n, tx, ty));
+    }
+    return dot(a, a);
+}
+
+// XYZ of the diffraction term (without G) for local directions wi, wr.
+fn diffraction_xyz(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    let u = -wi.x - wr.x;
+    let v = -wi.y - wr.y;
+    let w = -wi.z - wr.z;
+    // reachable kappa: within the crop plus half the kernel
+    let reach = vec2<f32>(f32(mat.kx), f32(mat.ky)) + 0.5 * f32(mat.taps);
+    var xyz = vec3<f32>(0.0);
+    for (var l = 0u; l < g.n_lambda; l = l + 1u) {
+        let s = spectrum[l];
+        let kappa = -vec2<f32>(u, v) * s.w * mat.bin_scale_um;
+        if (abs(kappa.x) > reach.x || abs(kappa.y) > reach.y) {
+            continue;
+        }
+        let t = TAU * w * mat.half_range_um * s.w;
+        let count = terms_needed(abs(t));
+        coefficients(t, count);
+        var r: f32;
+        if (g.mode == 1u) {
+            r = reflectance_nearest(kappa, count);
+        } else {
+            r = reflectance(kappa, count);
+        }
+        xyz = xyz + r * s.xyz;
+    }
+    return xyz;
+}
+
+// ---------------------------------------------------------------- colour
+fn schlick(c: f32) -> f32 {
+    let m = 1.0 - clamp(c, 0.0, 1.0);
+    return g.f0 + (1.0 - g.f0) * m * m * m * m * m;
+}
+
+// sunbeam_optics::gain::g
+fn gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    let ci = wi.z;
+    let cr = wr.z;
+    if (!(ci > 0.0 && cr > 0.0)) {
+        return 0.0;
+    }
+    let s = wi + wr;
+    let len = length(s);
+    var ch = 0.0;
+    if (len > 0.0) {
+        ch = dot(wi, s) / len;
+    }
+    let f = schlick(ch);
+    let d = 1.0 + dot(wi, wr);
+    return (f * f * d * d) / (g.f0 * g.f0 * (ci + cr) * (ci + cr) * cr);
+}
+
+fn srgb_oetf(y: f32) -> f32 {
+    let c = clamp(y, 0.0, 1.0);
+    if (c <= 0.0031308) {
+        return 12.92 * c;
+    }
+    return 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+}
+
+fn srgb_eotf(v: f32) -> f32 {
+    let c = clamp(v, 0.0, 1.0);
+    if (c <= 0.04045) {
+        return c / 12.92;
+    }
+    return pow((c + 0.055) / 1.055, 2.4);
+}
+
+// sunbeam_optics::colour::display_encode
+fn display(rgb: vec3<f32>) -> vec4<f32> {
+    var out = vec3<f32>(0.0);
+    for (var k = 0; k < 3; k = k + 1) {
+        var x = rgb[k] * g.exposure_scale;
+        if (x != x) {
+            x = 0.0;
+        }
+        x = max(x, 0.0);
+        if (g.curve == 0u) {
+            x = min(x, 1.0);
+        } else {
+            x = x / (1.0 + x);
+        }
+        var e = srgb_oetf(x);
+        if (g.output == 1u) {
+            e = srgb_eotf(e);
+        }
+        out[k] = e;
+    }
+    return vec4<f32>(out, 1.0);
+}
+
+fn xyz_to_rgb(c: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(g.xyz_to_rgb[0].xyz, c), dot(g.xyz_to_rgb[1].xyz, c), dot(g.xyz_to_rgb[2].xyz, c));
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    let n = normalize(in.normal);
+    var t = in.tangent - n * dot(n, in.tangent);
+    if (length(t) < 1e-12) {
+        var a = vec3<f32>(1.0, 0.0, 0.0);
+        if (abs(n.x) >= 0.9) {
+            a = vec3<f32>(0.0, 1.0, 0.0);
+        }
+        t = a - n * dot(n, a);
+    }
+    t = normalize(t);
+    let b = cross(n, t);
+    let wr = normalize(g.eye.xyz - in.world);
+    let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
+    let base = mat.base.xyz;
+    var dw = mat.base.w;
+    let diffract = mat.has_pack == 1u && g.mode != 2u;
+    if (!diffract) {
+        dw = 1.0;
+    }
+    var rgb = vec3<f32>(0.0);
+    for (var i = 0u; i < g.n_lights; i = i + 1u) {
+        let wi = g.lights[i].xyz;
+        let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
+        let cos_i = max(wi_l.z, 0.0);
+        var diff = vec3<f32>(0.0);
+        if (diffract && dw < 1.0 && wi_l.z > 0.0 && wr_l.z > 0.0) {
+            diff = xyz_to_rgb(diffraction_xyz(wi_l, wr_l) * gain(wi_l, wr_l));
+        }
+        rgb = rgb + g.lights[i].w * (dw * base * cos_i + (1.0 - dw) * diff);
+    }
+    return display(rgb);
+}

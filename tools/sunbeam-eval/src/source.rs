@@ -1,0 +1,132 @@
+//! One interface over the two things that give `R(u, v, w, lambda)`: the
+//! float64 ground truth of a height field, and a pack's CPU evaluator.
+
+use crate::input::{self, HeightArgs};
+use std::path::Path;
+use sunbeam_common::{units, Error, Result};
+use sunbeam_field::HeightField;
+use sunbeam_optics::truth::{Model, Params, Truth};
+
+/// Model options of the ground truth.
+#[derive(Debug, Clone, clap::Args)]
+pub struct TruthArgs {
+    /// What lies beyond the patch: `window` (default) or `tiled` (the thesis).
+    #[arg(long, default_value = "window")]
+    pub model: String,
+    /// Spatial coherence length of the light.
+    #[arg(long, default_value = "65um", value_name = "LEN")]
+    pub coherence: String,
+}
+
+impl TruthArgs {
+    pub fn params(&self) -> Result<Params> {
+        Ok(Params {
+            model: self.model.parse::<Model>()?,
+            coherence_m: units::parse_positive_length(&self.coherence)?,
+        })
+    }
+}
+
+pub enum Source {
+    Truth { truth: Truth, field: HeightField },
+    Pack(Box<sunbeam_pack::Pack>),
+}
+
+impl Source {
+    /// Open `path` as a pack (KTX2, or EXR with a manifest) unless `force_truth`,
+    /// else as a height field with its ground truth.
+    pub fn open(path: &Path, heights: &HeightArgs, truth: &TruthArgs, force_truth: bool) -> Result<Source> {
+        if input::is_pack(path)? {
+            if force_truth {
+                return Err(Error::usage(format!(
+                    "{}: is a pack; the ground truth needs the height field it was made from",
+                    path.display()
+                )));
+            }
+            let p = sunbeam_pack::Pack::read(path)?;
+            return Ok(Source::Pack(Box::new(p)));
+        }
+        let field = input::read_height(path, heights)?;
+        Self::from_field(field, &truth.params()?).map_err(|e| e.context(path.display()))
+    }
+
+    pub fn from_field(field: HeightField, p: &Params) -> Result<Source> {
+        let truth = Truth::new(&field, p)?;
+        Ok(Source::Truth { truth, field })
+    }
+
+    pub fn reflectance(&self, u: f64, v: f64, w: f64, lambda_m: f64) -> f64 {
+        match self {
+            Source::Truth { truth, .. } => truth.reflectance(u, v, w, lambda_m),
+            Source::Pack(p) => p.reflectance(u, v, w, lambda_m),
+        }
+    }
+
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Source::Truth { .. } => "truth",
+            Source::Pack(_) => "pack",
+        }
+    }
+
+    /// Patch size (Lx, Ly) in metres.
+    pub fn patch_size(&self) -> (f64, f64) {
+        match self {
+            Source::Truth { field, .. } => (field.size_x(), field.size_y()),
+            Source::Pack(p) => crate::packinfo::patch_size(p),
+        }
+    }
+
+    /// Model name ("window"/"tiled").
+    pub fn model_name(&self) -> String {
+        match self {
+            Source::Truth { truth, .. } => truth.params().model.name().to_string(),
+            Source::Pack(p) => crate::packinfo::model_name(p),
+        }
+    }
+
+    /// Width of the specular lobe in cycles per metre (peaks closer to f = 0 are
+    /// taken as specular): half a bin for the tiled model, 0.6/sigma for the window.
+    pub fn specular_halfwidth(&self) -> f64 {
+        let (lx, ly) = self.patch_size();
+        let half_bin = 0.5 / lx.min(ly);
+        match self {
+            Source::Truth { truth, .. } => match truth.params().model {
+                Model::Tiled => half_bin,
+                Model::Window => half_bin.max(0.6 / truth.window_sigma_m()),
+            },
+            Source::Pack(p) => half_bin.max(crate::packinfo::specular_halfwidth(p)),
+        }
+    }
+}
+
+/// Evaluate `f(i)` for `i in 0..n` on all cores, in order (deterministic).
+pub fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).clamp(1, 64);
+    if threads == 1 || n < 2 {
+        return (0..n).map(f).collect();
+    }
+    let chunk = n.div_ceil(threads * 4).max(1);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut parts: Vec<(usize, Vec<T>)> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                s.spawn(|| {
+                    let mut out = Vec::new();
+                    loop {
+                        let start = next.fetch_add(chunk, std::sync::atomic::Ordering::Relaxed);
+                        if start >= n {
+                            break;
+                        }
+                        let end = (start + chunk).min(n);
+                        out.push((start, (start..end).map(&f).collect::<Vec<T>>()));
+                    }
+                    out
+                })
+            })
+            .collect();
+        handles.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+    });
+    parts.sort_by_key(|p| p.0);
+    parts.into_iter().flat_map(|p| p.1).collect()
+}
