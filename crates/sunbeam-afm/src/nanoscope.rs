@@ -288,7 +288,7 @@ fn images(b: &[u8]) -> Result<Vec<Image>> {
         // Lines fewer than samples: the slow axis is shorter (square pixels).
         yreal *= yres as f64 / xres as f64;
         // Name: `@2:Image Data: S [Height] "Height"` or old `Image data: Height`.
-        let name = if let Some(v) = s.get("@2:Image Data") {
+        let name = if let Some(v) = s.get("@2:Image Data").or_else(|| s.get("@Image Data")) {
             let quoted = v.split('"').nth(1).filter(|q| !q.trim().is_empty());
             let bracket = v.find('[').and_then(|a| {
                 v[a + 1..]

@@ -267,3 +267,38 @@ fn sunbeam_exr_and_gsf_round_trip() {
         assert_eq!(cut.code, ExitCode::Input);
     }
 }
+
+/// A v4.3-style Nanoscope header (`@Z scale` without `@2:`, one-number scan
+/// size in nm, CR LF lines) against the closed form z = raw/65536 * Z scale * sens.
+#[test]
+fn nanoscope_v43_header_closed_form() {
+    let mut hdr = String::from(
+        "\\*File list\r\n\\Version: 0x04320003\r\n\\Data length: HLEN\r\n\\*Scanner list\r\n\
+         \\@Sens. Zscan: V 12.50000 nm/V\r\n\\*Ciao scan list\r\n\\Scan size: 1769.08 nm\r\n\\Samps/line: 4\r\n\\Lines: 2\r\n\
+         \\*Ciao image list\r\n\\Data offset: HLEN\r\n\\Data length: 16\r\n\\Bytes/pixel: 2\r\n\\Samps/line: 4\r\n\
+         \\Number of lines: 2\r\n\\Scan size: 1769.08 nm\r\n\\Image data: Height\r\n\
+         \\@Z scale: V [Sens. Zscan] (0.006713867 V/LSB) 20.00000 V\r\n\\*File list end\r\n",
+    );
+    let len = hdr.len() + 4 + (64 - (hdr.len() + 4) % 64);
+    hdr = hdr.replace("HLEN", &format!("{len:<4}"));
+    let mut b = hdr.into_bytes();
+    b.resize(len, 0);
+    let raw: [i16; 8] = [0, 1, -1, 32767, -32768, 100, 200, 300];
+    for r in raw {
+        b.extend_from_slice(&r.to_le_bytes());
+    }
+    assert_eq!(detect(&b), Some(Format::Nanoscope));
+    let c = &read_bytes(&b, &ReadOptions::default()).unwrap()[0];
+    assert_eq!((c.name.as_str(), c.field.width, c.field.height), ("Height", 4, 2));
+    assert!(c.is_height && c.z_unit == "m");
+    assert!((c.field.size_x() - 1769.08e-9).abs() < 1e-15);
+    // 2 lines of 4 samples: the slow axis is half as long (square pixels).
+    assert!((c.field.size_y() - 1769.08e-9 / 2.0).abs() < 1e-15);
+    let q = 20.0 * 12.5e-9 / 65536.0;
+    // stored bottom row first: file row 1 is our row 0
+    for (k, r) in raw.iter().enumerate() {
+        let (fr, col) = (k / 4, k % 4);
+        let v = c.field.at(1 - fr, col);
+        assert!((v - *r as f64 * q).abs() <= 1e-12 * q * 32768.0, "{k}: {v}");
+    }
+}

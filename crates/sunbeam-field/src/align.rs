@@ -23,7 +23,9 @@ impl std::str::FromStr for AlignRows {
             "none" => Ok(Self::None),
             "median" => Ok(Self::Median),
             "median-diff" | "median-of-differences" => Ok(Self::MedianDiff),
-            _ => Err(Error::usage(format!("'{s}': unknown row alignment (median, median-diff, none)"))),
+            _ => Err(Error::usage(format!(
+                "'{s}': unknown row alignment (median, median-diff, none)"
+            ))),
         }
     }
 }
@@ -64,12 +66,22 @@ pub fn row_shifts(f: &HeightField, method: AlignRows) -> Result<Vec<f64>> {
         AlignRows::None => {}
         AlignRows::Median => {
             let mut all: Vec<f64> = f.data.iter().copied().filter(|v| v.is_finite()).collect();
-            let total = median(&mut all).ok_or_else(|| Error::input("align rows: the field has no finite values"))?;
+            let total = median(&mut all)
+                .ok_or_else(|| Error::input("align rows: the field has no finite values"))?;
             drop(all);
             for (i, s) in shifts.iter_mut().enumerate() {
                 buf.clear();
-                buf.extend(f.data[i * w..(i + 1) * w].iter().copied().filter(|v| v.is_finite()));
-                *s = if buf.len() >= mincount { median(&mut buf).unwrap_or(total) } else { total };
+                buf.extend(
+                    f.data[i * w..(i + 1) * w]
+                        .iter()
+                        .copied()
+                        .filter(|v| v.is_finite()),
+                );
+                *s = if buf.len() >= mincount {
+                    median(&mut buf).unwrap_or(total)
+                } else {
+                    total
+                };
             }
             let mean = shifts.iter().sum::<f64>() / h as f64;
             shifts.iter_mut().for_each(|s| *s -= mean);
@@ -78,8 +90,17 @@ pub fn row_shifts(f: &HeightField, method: AlignRows) -> Result<Vec<f64>> {
             for i in 1..h {
                 buf.clear();
                 let (a, b) = (&f.data[(i - 1) * w..i * w], &f.data[i * w..(i + 1) * w]);
-                buf.extend(a.iter().zip(b).filter(|(x, y)| x.is_finite() && y.is_finite()).map(|(x, y)| y - x));
-                let d = if buf.len() >= mincount { median(&mut buf).unwrap_or(0.0) } else { 0.0 };
+                buf.extend(
+                    a.iter()
+                        .zip(b)
+                        .filter(|(x, y)| x.is_finite() && y.is_finite())
+                        .map(|(x, y)| y - x),
+                );
+                let d = if buf.len() >= mincount {
+                    median(&mut buf).unwrap_or(0.0)
+                } else {
+                    0.0
+                };
                 shifts[i] = shifts[i - 1] + d;
             }
             // Subtract the least-squares line through the shifts (index units).
@@ -133,8 +154,10 @@ mod tests {
     fn removes_row_offsets() {
         let (w, h) = (32, 16);
         let offs: Vec<f64> = (0..h).map(|i| ((i * 7) % 5) as f64).collect();
-        let data: Vec<f64> =
-            (0..h).flat_map(|i| (0..w).map(move |j| (i, j))).map(|(i, j)| ((j * 3) % 7) as f64 * 0.1 + offs[i]).collect();
+        let data: Vec<f64> = (0..h)
+            .flat_map(|i| (0..w).map(move |j| (i, j)))
+            .map(|(i, j)| ((j * 3) % 7) as f64 * 0.1 + offs[i])
+            .collect();
         for m in [AlignRows::Median, AlignRows::MedianDiff] {
             let mut f = HeightField::new(w, h, 1.0, 1.0, data.clone()).unwrap();
             align_rows(&mut f, m).unwrap();

@@ -38,7 +38,9 @@ impl HeightField {
     /// A validated height field: sizes match, pixel sizes finite and positive.
     pub fn new(width: usize, height: usize, dx: f64, dy: f64, data: Vec<f64>) -> Result<Self> {
         if width == 0 || height == 0 {
-            return Err(Error::input(format!("empty height field ({width}x{height})")));
+            return Err(Error::input(format!(
+                "empty height field ({width}x{height})"
+            )));
         }
         if width > MAX_SIDE || height > MAX_SIDE {
             return Err(Error::input(format!(
@@ -52,9 +54,18 @@ impl HeightField {
             )));
         }
         if !(dx.is_finite() && dx > 0.0 && dy.is_finite() && dy > 0.0) {
-            return Err(Error::input(format!("pixel size must be finite and positive (dx={dx}, dy={dy})")));
+            return Err(Error::input(format!(
+                "pixel size must be finite and positive (dx={dx}, dy={dy})"
+            )));
         }
-        Ok(Self { width, height, dx, dy, data, provenance: Provenance::default() })
+        Ok(Self {
+            width,
+            height,
+            dx,
+            dy,
+            data,
+            provenance: Provenance::default(),
+        })
     }
 
     /// Height at row `r` (0 = top), column `c`.

@@ -24,7 +24,9 @@ pub fn fill_masked(f: &mut HeightField, mask: &[bool]) -> Result<usize> {
         return Ok(0);
     }
     if n == w * h {
-        return Err(Error::input("cannot fill non-finite values: the field has no finite values at all"));
+        return Err(Error::input(
+            "cannot fill non-finite values: the field has no finite values at all",
+        ));
     }
     let mut index = vec![usize::MAX; w * h];
     for (k, &p) in unknown.iter().enumerate() {
@@ -52,7 +54,9 @@ pub fn fill_masked(f: &mut HeightField, mask: &[bool]) -> Result<usize> {
         }
     }
     // Initial guess: mean of the known values.
-    let (s, c) = (0..w * h).filter(|&p| !mask[p]).fold((0.0, 0usize), |(s, c), p| (s + f.data[p], c + 1));
+    let (s, c) = (0..w * h)
+        .filter(|&p| !mask[p])
+        .fold((0.0, 0usize), |(s, c), p| (s + f.data[p], c + 1));
     let mean = s / c as f64;
     let mut x = vec![mean; n];
     let apply = |x: &[f64], out: &mut [f64]| {
@@ -72,7 +76,13 @@ pub fn fill_masked(f: &mut HeightField, mask: &[bool]) -> Result<usize> {
     let mut z: Vec<f64> = (0..n).map(|k| r[k] / diag[k]).collect();
     let mut p = z.clone();
     let mut rz: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
-    let bnorm = b.iter().map(|v| v * v).sum::<f64>().sqrt().max(mean.abs() * (n as f64).sqrt()).max(1e-300);
+    let bnorm = b
+        .iter()
+        .map(|v| v * v)
+        .sum::<f64>()
+        .sqrt()
+        .max(mean.abs() * (n as f64).sqrt())
+        .max(1e-300);
     let max_iter = 20 * (w + h) + 1000;
     let mut ap = vec![0.0; n];
     for _ in 0..max_iter {
@@ -112,7 +122,9 @@ mod tests {
     fn fills_harmonic_exactly() {
         // A linear function is harmonic: Laplace interpolation restores it.
         let (w, h) = (24, 20);
-        let truth: Vec<f64> = (0..w * h).map(|p| 0.3 * (p % w) as f64 - 0.7 * (p / w) as f64 + 2.0).collect();
+        let truth: Vec<f64> = (0..w * h)
+            .map(|p| 0.3 * (p % w) as f64 - 0.7 * (p / w) as f64 + 2.0)
+            .collect();
         let mut data = truth.clone();
         for i in 5..12 {
             for j in 3..15 {

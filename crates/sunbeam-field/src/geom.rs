@@ -9,7 +9,9 @@ pub fn rotate(f: &HeightField, degrees: i32) -> Result<HeightField> {
     let (w, h) = (f.width, f.height);
     let turns = degrees.rem_euclid(360);
     if degrees % 90 != 0 {
-        return Err(Error::usage(format!("rotation {degrees} is not a multiple of 90 degrees")));
+        return Err(Error::usage(format!(
+            "rotation {degrees} is not a multiple of 90 degrees"
+        )));
     }
     let mut out = f.clone();
     match turns {
@@ -23,7 +25,11 @@ pub fn rotate(f: &HeightField, degrees: i32) -> Result<HeightField> {
             for r in 0..w {
                 for c in 0..h {
                     // 90 CCW: new[r][c] = old[c][w-1-r]; 270: new[r][c] = old[h-1-c][r].
-                    out.data[r * h + c] = if turns == 90 { f.data[c * w + (w - 1 - r)] } else { f.data[(h - 1 - c) * w + r] };
+                    out.data[r * h + c] = if turns == 90 {
+                        f.data[c * w + (w - 1 - r)]
+                    } else {
+                        f.data[(h - 1 - c) * w + r]
+                    };
                 }
             }
         }
@@ -51,7 +57,11 @@ pub fn flip_y(f: &mut HeightField) {
 
 /// Crop to columns `x..x+w`, rows `y..y+h` (row 0 at the top).
 pub fn crop(f: &HeightField, x: usize, y: usize, w: usize, h: usize) -> Result<HeightField> {
-    if w == 0 || h == 0 || x.checked_add(w).is_none_or(|e| e > f.width) || y.checked_add(h).is_none_or(|e| e > f.height) {
+    if w == 0
+        || h == 0
+        || x.checked_add(w).is_none_or(|e| e > f.width)
+        || y.checked_add(h).is_none_or(|e| e > f.height)
+    {
         return Err(Error::usage(format!(
             "crop {x},{y},{w},{h} (pixels) is empty or outside the {}x{} field",
             f.width, f.height
@@ -69,8 +79,18 @@ pub fn crop(f: &HeightField, x: usize, y: usize, w: usize, h: usize) -> Result<H
 /// A crop rectangle in pixels or physical units (metres).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum CropSpec {
-    Pixels { x: usize, y: usize, w: usize, h: usize },
-    Metres { x: f64, y: f64, w: f64, h: f64 },
+    Pixels {
+        x: usize,
+        y: usize,
+        w: usize,
+        h: usize,
+    },
+    Metres {
+        x: f64,
+        y: f64,
+        w: f64,
+        h: f64,
+    },
 }
 
 impl CropSpec {
@@ -83,17 +103,30 @@ impl CropSpec {
         }
         if parts.iter().all(|p| p.parse::<usize>().is_ok()) {
             let v: Vec<usize> = parts.iter().map(|p| p.parse().unwrap_or(0)).collect();
-            return Ok(CropSpec::Pixels { x: v[0], y: v[1], w: v[2], h: v[3] });
+            return Ok(CropSpec::Pixels {
+                x: v[0],
+                y: v[1],
+                w: v[2],
+                h: v[3],
+            });
         }
         let mut v = [0.0; 4];
         for (k, p) in parts.iter().enumerate() {
-            v[k] = sunbeam_common::units::parse_length(p)
-                .map_err(|e| Error::usage(format!("--crop '{s}': {e} (give all four in pixels or all with units)")))?;
+            v[k] = sunbeam_common::units::parse_length(p).map_err(|e| {
+                Error::usage(format!(
+                    "--crop '{s}': {e} (give all four in pixels or all with units)"
+                ))
+            })?;
             if v[k] < 0.0 {
                 return Err(Error::usage(format!("--crop '{s}': negative value")));
             }
         }
-        Ok(CropSpec::Metres { x: v[0], y: v[1], w: v[2], h: v[3] })
+        Ok(CropSpec::Metres {
+            x: v[0],
+            y: v[1],
+            w: v[2],
+            h: v[3],
+        })
     }
 
     /// The pixel rectangle for a field (physical values rounded to the nearest pixel).
@@ -125,7 +158,10 @@ mod tests {
         assert_eq!(r90.data, vec![2.0, 5.0, 1.0, 4.0, 0.0, 3.0]);
         let r270 = rotate(&f, 270).unwrap();
         assert_eq!(r270.data, vec![3.0, 0.0, 4.0, 1.0, 5.0, 2.0]);
-        assert_eq!(rotate(&f, 180).unwrap().data, vec![5.0, 4.0, 3.0, 2.0, 1.0, 0.0]);
+        assert_eq!(
+            rotate(&f, 180).unwrap().data,
+            vec![5.0, 4.0, 3.0, 2.0, 1.0, 0.0]
+        );
         assert_eq!(rotate(&rotate(&f, 90).unwrap(), -90).unwrap(), f);
         assert!(rotate(&f, 45).is_err());
     }
@@ -140,9 +176,20 @@ mod tests {
         let c = crop(&f32x2(), 1, 1, 2, 1).unwrap();
         assert_eq!((c.width, c.height, c.data.clone()), (2, 1, vec![4.0, 5.0]));
         assert!(crop(&f32x2(), 2, 0, 2, 1).is_err());
-        assert_eq!(CropSpec::parse("1,2,3,4").unwrap(), CropSpec::Pixels { x: 1, y: 2, w: 3, h: 4 });
+        assert_eq!(
+            CropSpec::parse("1,2,3,4").unwrap(),
+            CropSpec::Pixels {
+                x: 1,
+                y: 2,
+                w: 3,
+                h: 4
+            }
+        );
         let m = CropSpec::parse("1nm,2nm,3nm,4nm").unwrap();
-        assert_eq!(m.to_pixels(&HeightField::new(9, 9, 1e-9, 2e-9, vec![0.0; 81]).unwrap()), (1, 1, 3, 2));
+        assert_eq!(
+            m.to_pixels(&HeightField::new(9, 9, 1e-9, 2e-9, vec![0.0; 81]).unwrap()),
+            (1, 1, 3, 2)
+        );
         assert!(CropSpec::parse("1,2nm,3,4").is_err());
     }
 }

@@ -52,8 +52,9 @@ pub fn fit_plane(f: &HeightField) -> Option<(f64, f64, f64)> {
 /// plane's value at the pixel position (W/2, H/2) stays (the mean is kept to
 /// within half a pixel of slope), i.e. `z -= bx*(j - W/2) + by*(i - H/2)`.
 pub fn level_plane(f: &mut HeightField) -> Result<()> {
-    let (_, bx, by) = fit_plane(f)
-        .ok_or_else(|| Error::input("plane level needs at least 3 finite values that are not collinear"))?;
+    let (_, bx, by) = fit_plane(f).ok_or_else(|| {
+        Error::input("plane level needs at least 3 finite values that are not collinear")
+    })?;
     let (w, h) = (f.width, f.height);
     let (xc, yc) = (w as f64 / 2.0, h as f64 / 2.0);
     for i in 0..h {
@@ -94,12 +95,15 @@ pub const MAX_POLY_DEGREE: usize = 12;
 /// Legendre basis on [-1, 1] for a well-conditioned fit.
 pub fn level_poly(f: &mut HeightField, degree: usize) -> Result<()> {
     if degree > MAX_POLY_DEGREE {
-        return Err(Error::usage(format!("polynomial degree {degree} is above {MAX_POLY_DEGREE}")));
+        return Err(Error::usage(format!(
+            "polynomial degree {degree} is above {MAX_POLY_DEGREE}"
+        )));
     }
     let (w, h) = (f.width, f.height);
     let n1 = degree + 1;
-    let terms: Vec<(usize, usize)> =
-        (0..=degree).flat_map(|q| (0..=degree - q).map(move |p| (p, q))).collect();
+    let terms: Vec<(usize, usize)> = (0..=degree)
+        .flat_map(|q| (0..=degree - q).map(move |p| (p, q)))
+        .collect();
     let k = terms.len();
     let mut px = vec![0.0; w * n1];
     for j in 0..w {
@@ -155,7 +159,9 @@ pub fn level_poly(f: &mut HeightField, degree: usize) -> Result<()> {
         )));
     }
     let c = solve(&m, &rhs).ok_or_else(|| {
-        Error::input(format!("poly:{degree} level: the fit is singular (too few or degenerate finite values)"))
+        Error::input(format!(
+            "poly:{degree} level: the fit is singular (too few or degenerate finite values)"
+        ))
     })?;
     // Subtract: per row, collapse the y factor first.
     let mut cx = vec![0.0; n1];
@@ -191,12 +197,19 @@ pub fn zero_mean(f: &mut HeightField) -> Result<()> {
 /// None when (numerically) singular.
 pub(crate) fn solve(m: &[Vec<f64>], r: &[f64]) -> Option<Vec<f64>> {
     let n = r.len();
-    let mut a: Vec<Vec<f64>> = m.iter().zip(r).map(|(row, &b)| {
-        let mut v = row.clone();
-        v.push(b);
-        v
-    }).collect();
-    let scale = a.iter().flat_map(|r| r[..n].iter()).fold(0.0f64, |s, v| s.max(v.abs()));
+    let mut a: Vec<Vec<f64>> = m
+        .iter()
+        .zip(r)
+        .map(|(row, &b)| {
+            let mut v = row.clone();
+            v.push(b);
+            v
+        })
+        .collect();
+    let scale = a
+        .iter()
+        .flat_map(|r| r[..n].iter())
+        .fold(0.0f64, |s, v| s.max(v.abs()));
     if scale == 0.0 || !scale.is_finite() {
         return None;
     }
@@ -209,8 +222,9 @@ pub(crate) fn solve(m: &[Vec<f64>], r: &[f64]) -> Option<Vec<f64>> {
         for row in col + 1..n {
             let fct = a[row][col] / a[col][col];
             if fct != 0.0 {
-                for c in col..=n {
-                    a[row][c] -= fct * a[col][c];
+                let (top, bottom) = a.split_at_mut(row);
+                for (x, &p) in bottom[0][col..=n].iter_mut().zip(&top[col][col..=n]) {
+                    *x -= fct * p;
                 }
             }
         }
@@ -228,7 +242,10 @@ mod tests {
     use super::*;
 
     fn field(w: usize, h: usize, f: impl Fn(f64, f64) -> f64) -> HeightField {
-        let data = (0..h).flat_map(|i| (0..w).map(move |j| (j, i))).map(|(j, i)| f(j as f64, i as f64)).collect();
+        let data = (0..h)
+            .flat_map(|i| (0..w).map(move |j| (j, i)))
+            .map(|(j, i)| f(j as f64, i as f64))
+            .collect();
         HeightField::new(w, h, 1e-9, 1e-9, data).unwrap()
     }
 
@@ -244,7 +261,9 @@ mod tests {
 
     #[test]
     fn poly_removes_quadratic_with_holes() {
-        let mut f = field(20, 15, |x, y| 1.0 + 0.1 * x * x - 0.05 * x * y + 0.2 * y + 3e-3 * y * y);
+        let mut f = field(20, 15, |x, y| {
+            1.0 + 0.1 * x * x - 0.05 * x * y + 0.2 * y + 3e-3 * y * y
+        });
         f.data[7] = f64::NAN;
         f.data[100] = f64::NAN;
         level_poly(&mut f, 2).unwrap();

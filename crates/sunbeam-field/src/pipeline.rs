@@ -24,13 +24,20 @@ impl std::str::FromStr for Level {
             return Ok(Level::Plane);
         }
         if let Some(n) = s.strip_prefix("poly:") {
-            let d: usize = n.parse().map_err(|_| Error::usage(format!("'{s}': degree must be an integer (poly:2)")))?;
+            let d: usize = n
+                .parse()
+                .map_err(|_| Error::usage(format!("'{s}': degree must be an integer (poly:2)")))?;
             if d > crate::level::MAX_POLY_DEGREE {
-                return Err(Error::usage(format!("'{s}': degree above {}", crate::level::MAX_POLY_DEGREE)));
+                return Err(Error::usage(format!(
+                    "'{s}': degree above {}",
+                    crate::level::MAX_POLY_DEGREE
+                )));
             }
             return Ok(Level::Poly(d));
         }
-        Err(Error::usage(format!("'{s}': unknown levelling (plane, poly:N)")))
+        Err(Error::usage(format!(
+            "'{s}': unknown levelling (plane, poly:N)"
+        )))
     }
 }
 

@@ -112,6 +112,18 @@ fn nice_length(max: f64) -> f64 {
     b
 }
 
+/// The colour range: the 0.1 % and 99.9 % quantiles of the finite values, so
+/// a few spikes or bad lines do not wash the picture out.
+pub fn colour_range(f: &HeightField) -> (f64, f64) {
+    let mut v: Vec<f64> = f.data.iter().copied().filter(|v| v.is_finite()).collect();
+    if v.is_empty() {
+        return (0.0, 1.0);
+    }
+    v.sort_by(f64::total_cmp);
+    let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+    (q(0.001), q(0.999))
+}
+
 /// Render the preview as RGB pixels: (width, height, rgb bytes).
 pub fn render(f: &HeightField) -> (usize, usize, Vec<u8>) {
     let (lx, ly) = (f.size_x(), f.size_y());
@@ -124,17 +136,28 @@ pub fn render(f: &HeightField) -> (usize, usize, Vec<u8>) {
     let ih = ((natural_h * s).round() as usize).max(1);
     let scale = if iw.max(ih) >= 400 { 2 } else { 1 };
     let strip = 14 * scale;
-    let (w, h) = (iw.max(text_width("0000 nm  z: 000.0 nm", scale) + 8), ih + strip);
-    let mut cv = Canvas { w, h, px: vec![0u8; w * h * 3] };
+    let (w, h) = (
+        iw.max(text_width("0000 nm  z: 000.0 nm", scale) + 8),
+        ih + strip,
+    );
+    let mut cv = Canvas {
+        w,
+        h,
+        px: vec![0u8; w * h * 3],
+    };
     let st = Stats::of(f);
-    let (lo, hi) = (st.min, st.max);
+    let (lo, hi) = colour_range(f);
     let span = if hi > lo { hi - lo } else { 1.0 };
     for y in 0..ih {
         let r = ((y as f64 + 0.5) / ih as f64 * f.height as f64) as usize;
         for x in 0..iw {
             let c = ((x as f64 + 0.5) / iw as f64 * f.width as f64) as usize;
             let v = f.data[r.min(f.height - 1) * f.width + c.min(f.width - 1)];
-            let col = if v.is_finite() { colour((v - lo) / span) } else { [255, 0, 255] };
+            let col = if v.is_finite() {
+                colour((v - lo) / span)
+            } else {
+                [255, 0, 255]
+            };
             cv.set(x, y, col);
         }
     }
@@ -144,10 +167,15 @@ pub fn render(f: &HeightField) -> (usize, usize, Vec<u8>) {
     let bar_px = ((bar_m / lx * iw as f64).round() as usize).max(1);
     let y0 = ih + 3 * scale;
     cv.rect(2 * scale, y0 + 2 * scale, bar_px, 3 * scale, white);
-    let label = format_length(bar_m).replace(' ', " ");
+    let label = format_length(bar_m);
     let tx = 2 * scale + bar_px + 4 * scale;
     let used = cv.text(tx, y0, scale, &label, white);
-    let zlabel = if st.finite > 0 { format!("z: {}", format_length(hi - lo)) } else { String::new() };
+    // The colour span (0.1 %..99.9 % of the heights).
+    let zlabel = if st.finite > 0 {
+        format!("z: {}", format_length(hi - lo))
+    } else {
+        String::new()
+    };
     let zx = (tx + used + 6 * scale).max(w.saturating_sub(text_width(&zlabel, scale) + 2 * scale));
     cv.text(zx, y0, scale, &zlabel, white);
     let _ = ly;
@@ -162,8 +190,11 @@ pub fn encode_png(f: &HeightField) -> Result<Vec<u8>> {
         let mut enc = png::Encoder::new(&mut out, w as u32, h as u32);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
-        let mut wr = enc.write_header().map_err(|e| Error::internal(format!("PNG encoder: {e}")))?;
-        wr.write_image_data(&px).map_err(|e| Error::internal(format!("PNG encoder: {e}")))?;
+        let mut wr = enc
+            .write_header()
+            .map_err(|e| Error::internal(format!("PNG encoder: {e}")))?;
+        wr.write_image_data(&px)
+            .map_err(|e| Error::internal(format!("PNG encoder: {e}")))?;
     }
     Ok(out)
 }
@@ -179,8 +210,14 @@ mod tests {
 
     #[test]
     fn renders_deterministically() {
-        let f = HeightField::new(64, 32, 10e-9, 20e-9, (0..2048).map(|v| (v as f64 * 0.01).sin() * 1e-9).collect())
-            .unwrap();
+        let f = HeightField::new(
+            64,
+            32,
+            10e-9,
+            20e-9,
+            (0..2048).map(|v| (v as f64 * 0.01).sin() * 1e-9).collect(),
+        )
+        .unwrap();
         let (w, h, px) = render(&f);
         assert!(w >= 64 && h == 64 + 14, "{w}x{h}");
         assert_eq!(px.len(), w * h * 3);

@@ -62,7 +62,9 @@ pub fn target_grid(f: &HeightField, t: Target) -> Result<(usize, usize, f64)> {
         }
         Target::Size(w, h) => {
             if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-                return Err(Error::usage(format!("size {w}x{h} must be 1..{MAX_SIDE} per side")));
+                return Err(Error::usage(format!(
+                    "size {w}x{h} must be 1..{MAX_SIDE} per side"
+                )));
             }
             (w, h, (lx / w as f64).min(ly / h as f64))
         }
@@ -116,7 +118,11 @@ fn mirror(j: i64, n: usize) -> usize {
 fn axis(n_in: usize, d_in: f64, n_out: usize, d_out: f64) -> Axis {
     let scale = d_out / d_in;
     // Cutoff in cycles per input sample, then the sinc's zero spacing (input samples).
-    let fc = if scale > 1.0 { 0.5 * DOWN_CUTOFF / scale } else { 0.5 * UP_CUTOFF };
+    let fc = if scale > 1.0 {
+        0.5 * DOWN_CUTOFF / scale
+    } else {
+        0.5 * UP_CUTOFF
+    };
     let spacing = 1.0 / (2.0 * fc);
     let radius = LOBES * spacing;
     let taps = 2 * radius.ceil() as usize + 1;
@@ -150,7 +156,10 @@ fn axis(n_in: usize, d_in: f64, n_out: usize, d_out: f64) -> Axis {
 }
 
 fn threads() -> usize {
-    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(16)
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .min(16)
 }
 
 /// Apply `axis` along rows: `rows` rows of `n_in` values -> rows of `n_out`.
@@ -163,7 +172,10 @@ fn apply_rows(src: &[f64], n_in: usize, ax: &Axis, n_out: usize) -> Vec<f64> {
             s.spawn(move || {
                 for (orow, irow) in chunk_out.chunks_mut(n_out).zip(chunk_in.chunks(n_in)) {
                     for (k, o) in orow.iter_mut().enumerate() {
-                        let (ix, wt) = (&ax.idx[k * ax.taps..(k + 1) * ax.taps], &ax.w[k * ax.taps..(k + 1) * ax.taps]);
+                        let (ix, wt) = (
+                            &ax.idx[k * ax.taps..(k + 1) * ax.taps],
+                            &ax.w[k * ax.taps..(k + 1) * ax.taps],
+                        );
                         *o = ix.iter().zip(wt).map(|(&j, &w)| irow[j] * w).sum();
                     }
                 }
@@ -182,7 +194,10 @@ fn apply_cols(src: &[f64], width: usize, ax: &Axis, n_out: usize) -> Vec<f64> {
             s.spawn(move || {
                 for (r, orow) in chunk.chunks_mut(width).enumerate() {
                     let k = c * per + r;
-                    let (ix, wt) = (&ax.idx[k * ax.taps..(k + 1) * ax.taps], &ax.w[k * ax.taps..(k + 1) * ax.taps]);
+                    let (ix, wt) = (
+                        &ax.idx[k * ax.taps..(k + 1) * ax.taps],
+                        &ax.w[k * ax.taps..(k + 1) * ax.taps],
+                    );
                     for (&j, &w) in ix.iter().zip(wt) {
                         if w == 0.0 {
                             continue;
@@ -205,8 +220,15 @@ pub fn resample_grid(f: &HeightField, w: usize, h: usize, dx: f64, dy: f64) -> R
     if w == f.width && h == f.height && dx == f.dx && dy == f.dy {
         return Ok(f.clone());
     }
-    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE || !(dx > 0.0 && dy > 0.0 && dx.is_finite() && dy.is_finite()) {
-        return Err(Error::usage(format!("cannot resample to {w}x{h} pixels of {dx:e} x {dy:e} m")));
+    if w == 0
+        || h == 0
+        || w > MAX_SIDE
+        || h > MAX_SIDE
+        || !(dx > 0.0 && dy > 0.0 && dx.is_finite() && dy.is_finite())
+    {
+        return Err(Error::usage(format!(
+            "cannot resample to {w}x{h} pixels of {dx:e} x {dy:e} m"
+        )));
     }
     let bad = f.count_nonfinite();
     if bad > 0 {
@@ -216,8 +238,16 @@ pub fn resample_grid(f: &HeightField, w: usize, h: usize, dx: f64, dy: f64) -> R
     }
     let same_x = w == f.width && dx == f.dx;
     let same_y = h == f.height && dy == f.dy;
-    let tmp = if same_x { f.data.clone() } else { apply_rows(&f.data, f.width, &axis(f.width, f.dx, w, dx), w) };
-    let data = if same_y { tmp } else { apply_cols(&tmp, w, &axis(f.height, f.dy, h, dy), h) };
+    let tmp = if same_x {
+        f.data.clone()
+    } else {
+        apply_rows(&f.data, f.width, &axis(f.width, f.dx, w, dx), w)
+    };
+    let data = if same_y {
+        tmp
+    } else {
+        apply_cols(&tmp, w, &axis(f.height, f.dy, h, dy), h)
+    };
     let mut out = HeightField::new(w, h, dx, dy, data)?;
     out.provenance = f.provenance.clone();
     Ok(out)
@@ -229,11 +259,22 @@ mod tests {
 
     #[test]
     fn identity_and_flat() {
-        let f = HeightField::new(5, 4, 2e-9, 2e-9, (0..20).map(|v| (v as f64).sin()).collect()).unwrap();
+        let f = HeightField::new(
+            5,
+            4,
+            2e-9,
+            2e-9,
+            (0..20).map(|v| (v as f64).sin()).collect(),
+        )
+        .unwrap();
         assert_eq!(resample(&f, Target::PixelSize(2e-9)).unwrap(), f);
         assert_eq!(resample(&f, Target::Size(5, 4)).unwrap(), f);
         let flat = HeightField::new(30, 20, 1e-9, 1e-9, vec![3.5; 600]).unwrap();
-        for t in [Target::PixelSize(1.7e-9), Target::PixelSize(0.3e-9), Target::Size(7, 11)] {
+        for t in [
+            Target::PixelSize(1.7e-9),
+            Target::PixelSize(0.3e-9),
+            Target::Size(7, 11),
+        ] {
             let g = resample(&flat, t).unwrap();
             assert!(g.data.iter().all(|v| (v - 3.5).abs() < 1e-12));
             assert_eq!(g.dx, g.dy);
@@ -244,7 +285,10 @@ mod tests {
     fn grids() {
         // 100 x 50 pixels of 2 x 4 nm = 200 x 200 nm.
         let f = HeightField::new(100, 50, 2e-9, 4e-9, vec![0.0; 5000]).unwrap();
-        assert_eq!(target_grid(&f, Target::PixelSize(2e-9)).unwrap(), (100, 100, 2e-9));
+        assert_eq!(
+            target_grid(&f, Target::PixelSize(2e-9)).unwrap(),
+            (100, 100, 2e-9)
+        );
         let (w, h, p) = target_grid(&f, Target::Size(64, 32)).unwrap();
         assert_eq!((w, h), (64, 32));
         assert!((p - 200e-9 / 64.0).abs() < 1e-20);
@@ -253,7 +297,14 @@ mod tests {
 
     #[test]
     fn non_finite_refused() {
-        let f = HeightField::new(3, 3, 1.0, 1.0, vec![0.0, 1.0, f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
+        let f = HeightField::new(
+            3,
+            3,
+            1.0,
+            1.0,
+            vec![0.0, 1.0, f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        )
+        .unwrap();
         assert!(resample(&f, Target::Size(5, 5)).is_err());
     }
 }

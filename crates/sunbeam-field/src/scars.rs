@@ -24,7 +24,12 @@ pub struct ScarParams {
 
 impl Default for ScarParams {
     fn default() -> Self {
-        Self { threshold_high: 0.666, threshold_low: 0.25, min_len: 16, max_width: 4 }
+        Self {
+            threshold_high: 0.666,
+            threshold_low: 0.25,
+            min_len: 16,
+            max_width: 4,
+        }
     }
 }
 
@@ -71,7 +76,7 @@ pub fn mark_scars(f: &HeightField, p: &ScarParams) -> Vec<bool> {
                             .map(|r| sign * (f.data[r * w + j] - bound))
                             .fold(f64::INFINITY, f64::min)
                     };
-                    if !(excess(j) > lo) {
+                    if excess(j).is_nan() || excess(j) <= lo {
                         j += 1;
                         continue;
                     }
@@ -79,7 +84,7 @@ pub fn mark_scars(f: &HeightField, p: &ScarParams) -> Vec<bool> {
                     let mut peak = 0.0f64;
                     while j < w {
                         let e = excess(j);
-                        if !(e > lo) {
+                        if e.is_nan() || e <= lo {
                             break;
                         }
                         peak = peak.max(e);
@@ -115,7 +120,9 @@ mod tests {
     #[test]
     fn removes_a_streak() {
         let (w, h) = (64, 32);
-        let truth: Vec<f64> = (0..w * h).map(|p| ((p % w) as f64 * 0.3).sin() + ((p / w) as f64 * 0.2).cos()).collect();
+        let truth: Vec<f64> = (0..w * h)
+            .map(|p| ((p % w) as f64 * 0.3).sin() + ((p / w) as f64 * 0.2).cos())
+            .collect();
         let mut data = truth.clone();
         for j in 10..40 {
             data[12 * w + j] += 5.0;
@@ -123,7 +130,9 @@ mod tests {
         let mut f = HeightField::new(w, h, 1.0, 1.0, data).unwrap();
         let n = remove_scars(&mut f, &ScarParams::default()).unwrap();
         assert!(n >= 30, "{n}");
-        let err = (10..40).map(|j| (f.data[12 * w + j] - truth[12 * w + j]).abs()).fold(0.0, f64::max);
+        let err = (10..40)
+            .map(|j| (f.data[12 * w + j] - truth[12 * w + j]).abs())
+            .fold(0.0, f64::max);
         assert!(err < 0.2, "{err}");
         // A clean field is untouched.
         let mut g = HeightField::new(w, h, 1.0, 1.0, truth.clone()).unwrap();

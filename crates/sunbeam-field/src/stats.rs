@@ -24,10 +24,29 @@ impl Stats {
             n += 1;
         }
         if n == 0 {
-            return Stats { min: f64::NAN, max: f64::NAN, mean: f64::NAN, rms: f64::NAN, finite: 0, nonfinite: f.data.len() };
+            return Stats {
+                min: f64::NAN,
+                max: f64::NAN,
+                mean: f64::NAN,
+                rms: f64::NAN,
+                finite: 0,
+                nonfinite: f.data.len(),
+            };
         }
         let mean = sum / n as f64;
-        let ss: f64 = f.data.iter().filter(|v| v.is_finite()).map(|v| (v - mean) * (v - mean)).sum();
-        Stats { min, max, mean, rms: (ss / n as f64).sqrt(), finite: n, nonfinite: f.data.len() - n }
+        let ss: f64 = f
+            .data
+            .iter()
+            .filter(|v| v.is_finite())
+            .map(|v| (v - mean) * (v - mean))
+            .sum();
+        Stats {
+            min,
+            max,
+            mean,
+            rms: (ss / n as f64).sqrt(),
+            finite: n,
+            nonfinite: f.data.len() - n,
+        }
     }
 }

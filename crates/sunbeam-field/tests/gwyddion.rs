@@ -18,14 +18,19 @@ const N: usize = 512;
 const XREAL: f64 = 1.76908e-06;
 
 fn data(name: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
 }
 
 fn raw_veeco() -> Option<HeightField> {
     let p = testdata::shared_file("afm/reference/nanoscopeAFM_Veeco_20160622.003.0.f64")?;
     let bytes = std::fs::read(p).unwrap();
     assert_eq!(bytes.len(), N * N * 8);
-    let v = bytes.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect();
+    let v = bytes
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect();
     Some(HeightField::new(N, N, XREAL / N as f64, XREAL / N as f64, v).unwrap())
 }
 
@@ -36,11 +41,14 @@ fn expected_median() -> Vec<f64> {
     let mut b = Vec::new();
     gz.read_to_end(&mut b).unwrap();
     assert_eq!(b.len(), N * N * 4);
-    b.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap()) as f64).collect()
+    b.chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()) as f64)
+        .collect()
 }
 
 fn range(v: &[f64]) -> f64 {
-    v.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - v.iter().cloned().fold(f64::INFINITY, f64::min)
+    v.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+        - v.iter().cloned().fold(f64::INFINITY, f64::min)
 }
 
 #[test]
@@ -50,9 +58,20 @@ fn plane_level_and_align_rows_median_match_gwyddion() {
     align_rows(&mut f, AlignRows::Median).unwrap();
     let want = expected_median();
     let zr = range(&want);
-    let err = f.data.iter().zip(&want).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-    eprintln!("max |ours - Gwyddion| = {err:e} m = {:.2e} of the z range {zr:e} m", err / zr);
-    assert!(err < 0.01 * zr, "differs from Gwyddion by {err:e} m, more than 1% of {zr:e}");
+    let err = f
+        .data
+        .iter()
+        .zip(&want)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "max |ours - Gwyddion| = {err:e} m = {:.2e} of the z range {zr:e} m",
+        err / zr
+    );
+    assert!(
+        err < 0.01 * zr,
+        "differs from Gwyddion by {err:e} m, more than 1% of {zr:e}"
+    );
     // What we actually achieve (Gwyddion's quickselect occasionally returns a
     // neighbouring rank for even row lengths): keep it that way.
     assert!(err < 1e-3 * zr, "regression: {err:e} m");
@@ -72,8 +91,15 @@ fn align_rows_shifts_match_gwyddion_median_and_median_diff() {
     assert_eq!(rows.len(), N);
     for (col, m) in [(0, AlignRows::Median), (1, AlignRows::MedianDiff)] {
         let ours = row_shifts(&f, m).unwrap();
-        let err = ours.iter().zip(&rows).map(|(a, r)| (a - r[col]).abs()).fold(0.0, f64::max);
-        eprintln!("{m:?}: max shift difference {err:e} m ({:.2e} of the z range)", err / zr);
+        let err = ours
+            .iter()
+            .zip(&rows)
+            .map(|(a, r)| (a - r[col]).abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "{m:?}: max shift difference {err:e} m ({:.2e} of the z range)",
+            err / zr
+        );
         assert!(err < 0.01 * zr && err < 1e-3 * zr, "{m:?}: {err:e}");
     }
 }

@@ -7,7 +7,9 @@ use sunbeam_field::{HeightField, Provenance};
 
 fn sample() -> HeightField {
     let (w, h) = (37, 23);
-    let data = (0..w * h).map(|p| ((p % w) as f64 * 0.37).sin() * 12e-9 + (p / w) as f64 * 0.5e-9).collect();
+    let data = (0..w * h)
+        .map(|p| ((p % w) as f64 * 0.37).sin() * 12e-9 + (p / w) as f64 * 0.5e-9)
+        .collect();
     let mut f = HeightField::new(w, h, 6.5e-9, 7.25e-9, data).unwrap();
     f.provenance = Provenance {
         source_file: "scan.spm".into(),
@@ -38,10 +40,20 @@ fn exr_round_trip_and_determinism() {
     io::write(&p, &f).unwrap();
     let g = io::read(&p).unwrap();
     assert_f32_equal(&f, &g);
-    assert_eq!((g.dx, g.dy), (f.dx, f.dy), "pixel size is stored as f64, exactly");
+    assert_eq!(
+        (g.dx, g.dy),
+        (f.dx, f.dy),
+        "pixel size is stored as f64, exactly"
+    );
     assert_eq!(g.provenance, f.provenance);
-    assert_eq!(io::encode(Kind::Exr, &f).unwrap(), std::fs::read(&p).unwrap());
-    assert_eq!(io::encode(Kind::Exr, &f).unwrap(), io::encode(Kind::Exr, &f.clone()).unwrap());
+    assert_eq!(
+        io::encode(Kind::Exr, &f).unwrap(),
+        std::fs::read(&p).unwrap()
+    );
+    assert_eq!(
+        io::encode(Kind::Exr, &f).unwrap(),
+        io::encode(Kind::Exr, &f.clone()).unwrap()
+    );
 }
 
 #[test]
@@ -63,15 +75,22 @@ fn gsf_round_trip_and_determinism() {
 #[test]
 fn reads_gwyddions_own_gsf() {
     // A GSF written by Gwyddion 2.62 from the Veeco scan, against Gwyddion's values.
-    let Some(p) = testdata::shared_file("afm/samples/derived_by_gwyddion/Veeco_20160622.003.height.gsf") else {
+    let Some(p) =
+        testdata::shared_file("afm/samples/derived_by_gwyddion/Veeco_20160622.003.height.gsf")
+    else {
         return;
     };
-    let Some(r) = testdata::shared_file("afm/reference/Veeco_20160622.003.height.gsf.0.f64") else { return };
+    let Some(r) = testdata::shared_file("afm/reference/Veeco_20160622.003.height.gsf.0.f64") else {
+        return;
+    };
     let f = io::read(&p).unwrap();
     assert_eq!((f.width, f.height), (512, 512));
     assert!((f.size_x() - 1.76908e-06).abs() < 1e-17);
-    let want: Vec<f64> =
-        std::fs::read(r).unwrap().chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect();
+    let want: Vec<f64> = std::fs::read(r)
+        .unwrap()
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect();
     for (a, b) in f.data.iter().zip(&want) {
         assert_eq!(*a as f32, *b as f32);
     }
@@ -88,7 +107,10 @@ fn bad_files_are_input_errors() {
         ("truncated exr", exr[..exr.len() / 2].to_vec()),
         ("exr header only", exr[..200].to_vec()),
         ("truncated gsf", gsf[..gsf.len() - 10].to_vec()),
-        ("gsf without NUL", b"Gwyddion Simple Field 1.0\nXRes = 2\nYRes = 2\n".to_vec()),
+        (
+            "gsf without NUL",
+            b"Gwyddion Simple Field 1.0\nXRes = 2\nYRes = 2\n".to_vec(),
+        ),
     ];
     let huge = b"Gwyddion Simple Field 1.0\nXRes = 30000\nYRes = 30000\n\0\0\0\0".to_vec();
     cases.push(("gsf size beyond the file", huge));
@@ -99,7 +121,15 @@ fn bad_files_are_input_errors() {
     cases.push(("negative XReal", neg));
     let mut big_exr = exr.clone();
     // dataWindow xMax -> 2^30: refused before decoding pixels.
-    let pos = big_exr.windows(10).position(|w| w == b"dataWindow").unwrap() + 10 + 1 + 6 + 4 + 8;
+    let pos = big_exr
+        .windows(10)
+        .position(|w| w == b"dataWindow")
+        .unwrap()
+        + 10
+        + 1
+        + 6
+        + 4
+        + 8;
     big_exr[pos..pos + 4].copy_from_slice(&(1i32 << 30).to_le_bytes());
     cases.push(("absurd exr size", big_exr));
     for (what, bytes) in cases {
@@ -120,25 +150,93 @@ fn oiiotool_reads_our_exr() {
     let f = sample();
     let p = tmp("oiio.exr");
     io::write(&p, &f).unwrap();
-    let out = std::process::Command::new("oiiotool").arg("--info").arg("-v").arg(&p).output().unwrap();
-    let text = String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    let out = std::process::Command::new("oiiotool")
+        .arg("--info")
+        .arg("-v")
+        .arg(&p)
+        .output()
+        .unwrap();
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "oiiotool failed: {text}");
     let words: Vec<&str> = text.split_whitespace().collect();
     assert!(words.windows(3).any(|w| w == ["37", "x", "23,"]), "{text}");
-    assert!(text.contains("sunbeam_dx_m") && text.contains("sunbeam_source_file"), "{text}");
+    assert!(
+        text.contains("sunbeam_dx_m") && text.contains("sunbeam_source_file"),
+        "{text}"
+    );
     assert!(text.contains("float") && text.contains('Z'), "{text}");
     // Values: oiiotool's statistics of the channel (in nm) against ours.
-    let out = std::process::Command::new("oiiotool").arg(&p).args(["--mulc", "1e9", "--printstats"]).output().unwrap();
+    let out = std::process::Command::new("oiiotool")
+        .arg(&p)
+        .args(["--mulc", "1e9", "--printstats"])
+        .output()
+        .unwrap();
     let text = String::from_utf8_lossy(&out.stdout).to_string();
     assert!(out.status.success(), "{text}");
     let st = sunbeam_field::stats::Stats::of(&f);
     let stat = |name: &str| -> f64 {
-        let line = text.lines().find(|l| l.trim_start().starts_with(name)).unwrap_or_else(|| panic!("{text}"));
-        line.split(':').nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap()
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with(name))
+            .unwrap_or_else(|| panic!("{text}"));
+        line.split(':')
+            .nth(1)
+            .unwrap()
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
     };
-    for (name, ours) in [("Stats Min:", st.min), ("Stats Max:", st.max), ("Stats Avg:", st.mean)] {
+    for (name, ours) in [
+        ("Stats Min:", st.min),
+        ("Stats Max:", st.max),
+        ("Stats Avg:", st.mean),
+    ] {
         let theirs = stat(name);
-        assert!((theirs - ours * 1e9).abs() < 1e-5, "oiiotool {name} {theirs} nm vs ours {} nm", ours * 1e9);
+        assert!(
+            (theirs - ours * 1e9).abs() < 1e-5,
+            "oiiotool {name} {theirs} nm vs ours {} nm",
+            ours * 1e9
+        );
     }
     std::fs::remove_file(&p).ok();
+}
+
+#[test]
+fn mutated_files_never_panic() {
+    // A small deterministic mutation fuzzer over both decoders.
+    let f = HeightField::new(9, 7, 1e-9, 2e-9, (0..63).map(|v| v as f64 * 1e-10).collect()).unwrap();
+    let mut seed = 0x1234_5678_9abc_def0u64;
+    let mut next = move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 33) as usize
+    };
+    for kind in [Kind::Exr, Kind::Gsf] {
+        let good = io::encode(kind, &f).unwrap();
+        for _ in 0..3000 {
+            let mut b = good.clone();
+            match next() % 4 {
+                0 => b.truncate(next() % good.len()),
+                1 => {
+                    for _ in 0..1 + next() % 4 {
+                        let i = next() % b.len();
+                        b[i] = next() as u8;
+                    }
+                }
+                2 => {
+                    let i = next() % (b.len() - 4);
+                    b[i..i + 4].copy_from_slice(&[0xff, 0xff, 0xff, 0x7f]);
+                }
+                _ => {
+                    let i = next() % b.len();
+                    b.insert(i, next() as u8);
+                }
+            }
+            if let Ok(g) = io::decode(&b) {
+                assert_eq!(g.data.len(), g.width * g.height);
+            }
+        }
+    }
 }

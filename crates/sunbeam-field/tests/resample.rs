@@ -11,7 +11,10 @@ use sunbeam_field::HeightField;
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
     }
 }
@@ -41,10 +44,24 @@ impl Surface {
         let kmax = self.terms.iter().map(|t| t.0).max().unwrap();
         let lmax = self.terms.iter().map(|t| t.1).max().unwrap();
         let cx: Vec<Vec<f64>> = (0..=kmax)
-            .map(|k| (0..w).map(|j| (std::f64::consts::PI * k as f64 * (x0 + (j as f64 + 0.5) * dx) / self.lx).cos()).collect())
+            .map(|k| {
+                (0..w)
+                    .map(|j| {
+                        (std::f64::consts::PI * k as f64 * (x0 + (j as f64 + 0.5) * dx) / self.lx)
+                            .cos()
+                    })
+                    .collect()
+            })
             .collect();
         let cy: Vec<Vec<f64>> = (0..=lmax)
-            .map(|l| (0..h).map(|i| (std::f64::consts::PI * l as f64 * (y0 + (i as f64 + 0.5) * dy) / self.ly).cos()).collect())
+            .map(|l| {
+                (0..h)
+                    .map(|i| {
+                        (std::f64::consts::PI * l as f64 * (y0 + (i as f64 + 0.5) * dy) / self.ly)
+                            .cos()
+                    })
+                    .collect()
+            })
             .collect();
         // Separable: first collapse k for each (l, j).
         let mut bl = vec![vec![0.0; w]; lmax + 1];
@@ -77,20 +94,39 @@ fn dct(f: &HeightField) -> Vec<Vec<f64>> {
         (0..n)
             .map(|k| {
                 let c = if k == 0 { 1.0 } else { 2.0 } / n as f64;
-                (0..n).map(|j| c * (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / n as f64).cos()).collect()
+                (0..n)
+                    .map(|j| {
+                        c * (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / n as f64).cos()
+                    })
+                    .collect()
             })
             .collect()
     };
     let (bx, by) = (basis(w), basis(h));
     // rows: r[i][k] = sum_j f[i][j] bx[k][j]
-    let r: Vec<Vec<f64>> =
-        (0..h).map(|i| (0..w).map(|k| (0..w).map(|j| f.data[i * w + j] * bx[k][j]).sum()).collect()).collect();
-    (0..w).map(|k| (0..h).map(|l| (0..h).map(|i| r[i][k] * by[l][i]).sum()).collect()).collect()
+    let r: Vec<Vec<f64>> = (0..h)
+        .map(|i| {
+            (0..w)
+                .map(|k| (0..w).map(|j| f.data[i * w + j] * bx[k][j]).sum())
+                .collect()
+        })
+        .collect();
+    (0..w)
+        .map(|k| {
+            (0..h)
+                .map(|l| (0..h).map(|i| r[i][k] * by[l][i]).sum())
+                .collect()
+        })
+        .collect()
 }
 
 fn max_diff(a: &HeightField, b: &HeightField) -> f64 {
     assert_eq!((a.width, a.height), (b.width, b.height));
-    a.data.iter().zip(&b.data).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.data
+        .iter()
+        .zip(&b.data)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 /// Root-mean-square amplitude of a field.
@@ -113,7 +149,10 @@ fn down_and_up_keeps_the_band_below_the_new_nyquist() {
     let amp = s.amplitude().max(rms(&fine));
 
     let down = resample(&fine, Target::PixelSize(coarse)).unwrap();
-    assert_eq!((down.width, down.height, down.dx, down.dy), (160, 120, coarse, coarse));
+    assert_eq!(
+        (down.width, down.height, down.dx, down.dy),
+        (160, 120, coarse, coarse)
+    );
     let e_down = max_diff(&down, &s.sample(160, 120, coarse, coarse)) / rms(&fine);
     let up = resample_grid(&down, w, h, d, d).unwrap();
     let e_up = max_diff(&up, &fine) / rms(&fine);
@@ -148,7 +187,11 @@ fn a_tone_above_the_new_nyquist_does_not_alias() {
     let (lx, ly) = (w as f64 * d, h as f64 * d);
     let coarse = 2e-9; // new Nyquist: 1/(4 nm); cos(pi k x/L) at k = 1.05 * L / 2 nm ...
     let k = (1.05 * lx / coarse).round() as usize;
-    let s = Surface { lx, ly, terms: vec![(k, 0, 1e-9)] };
+    let s = Surface {
+        lx,
+        ly,
+        terms: vec![(k, 0, 1e-9)],
+    };
     let fine = s.sample(w, h, d, d);
     let down = resample(&fine, Target::PixelSize(coarse)).unwrap();
     let leak = rms(&down) / rms(&fine);

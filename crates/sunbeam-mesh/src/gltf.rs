@@ -237,6 +237,7 @@ impl Document {
             views.push(json!({"buffer": 0, "byteOffset": off, "byteLength": len, "target": 34962}));
             views.len() - 1
         };
+        self.sync_len();
         let ty = ["SCALAR", "VEC2", "VEC3", "VEC4"][ncomp - 1];
         let mut acc = json!({"bufferView": bv, "componentType": FLOAT, "count": data.len() / ncomp, "type": ty});
         if with_bounds {
@@ -276,6 +277,7 @@ impl Document {
             }
         }
         let len = buf.len() - off;
+        self.sync_len();
         let views = self.json_array_mut("bufferViews");
         views.push(json!({"buffer": 0, "byteOffset": off, "byteLength": len, "target": 34963}));
         let bv = views.len() - 1;
@@ -296,9 +298,18 @@ impl Document {
         }
         let off = buf.len();
         buf.extend_from_slice(bytes);
+        self.sync_len();
         let views = self.json_array_mut("bufferViews");
         views.push(json!({"buffer": 0, "byteOffset": off, "byteLength": bytes.len()}));
         views.len() - 1
+    }
+
+    /// Keep `buffers[0].byteLength` equal to the bytes held.
+    fn sync_len(&mut self) {
+        let len = self.buffers.first().map_or(0, |b| b.len());
+        if let Some(b0) = self.json_array_mut("buffers").first_mut() {
+            b0["byteLength"] = json!(len);
+        }
     }
 
     pub fn json_array_mut(&mut self, key: &str) -> &mut Vec<Value> {

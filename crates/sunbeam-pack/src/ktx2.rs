@@ -138,6 +138,24 @@ fn lcm(a: usize, b: usize) -> usize {
     a / gcd(a, b) * b
 }
 
+/// Stream a pack as KTX2 into `out` (no second copy of the level data in memory).
+pub fn write_to(pack: &Pack, writer: &str, out: &mut impl std::io::Write) -> std::io::Result<u64> {
+    let (total, head) = encode_parts(&pack.manifest, writer);
+    out.write_all(&head)?;
+    let mut buf = Vec::with_capacity(1 << 16);
+    for chunk in pack.terms.chunks(1 << 14) {
+        buf.clear();
+        match pack.manifest.precision {
+            Precision::F32 => chunk.iter().for_each(|v| buf.extend_from_slice(&v.to_le_bytes())),
+            Precision::F16 => {
+                chunk.iter().for_each(|v| buf.extend_from_slice(&half::f16::from_f32(*v).to_le_bytes()))
+            }
+        }
+        out.write_all(&buf)?;
+    }
+    Ok(total as u64)
+}
+
 /// Encode a pack as KTX2 bytes (the terms are converted to the manifest's precision).
 pub fn encode(pack: &Pack, writer: &str) -> Vec<u8> {
     let (total, mut out) = encode_parts(&pack.manifest, writer);

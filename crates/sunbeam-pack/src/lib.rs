@@ -11,3 +11,5 @@ pub mod series;
 pub use build::{build, BuildOptions, FieldRef};
 pub use manifest::{Basis, Manifest, Model, Precision};
 pub use pack::Pack;
+pub mod io;
+pub mod scene;

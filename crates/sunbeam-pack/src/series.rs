@@ -239,7 +239,7 @@ mod tests {
 
     #[test]
     fn miller_matches_integral_f64_and_f32() {
-        for &t in &[1e-6, 1e-3, 0.1, 1.0, 5.0, 9.0, 16.5, 30.0, 60.0, -7.3] {
+        for &t in &[1e-6f64, 1e-3, 0.1, 1.0, 5.0, 9.0, 16.5, 30.0, 60.0, -7.3] {
             let n = (t.abs() as usize) + 30;
             let mut j = vec![0.0; n];
             bessel_j_f64(t, &mut j);

@@ -14,6 +14,7 @@
 //!
 //! `render(&Scene)` is what `sunbeam-eval render` calls.
 
+pub mod fixtures;
 pub mod image;
 pub mod raster;
 pub mod shade;

@@ -130,7 +130,6 @@ fn run(cli: Cli) -> Result<()> {
         (Some(m), false) => {
             let d = sunbeam_mesh::load_document(m)?;
             inputs.push(m.clone());
-            inputs.extend(d.extra_inputs.iter().cloned());
             (d, None)
         }
         (None, true) => {
@@ -173,6 +172,12 @@ fn run(cli: Cli) -> Result<()> {
         max_snap: cli.max_snap,
     };
     let mut baked = bake(doc, &opts)?;
+    // Files the document read (external buffers, images embedded while merging, MTL).
+    for f in &baked.doc.extra_inputs {
+        if !inputs.contains(f) {
+            inputs.push(f.clone());
+        }
+    }
     let mut tex_bytes = None;
     if let Some(t) = &cli.texture {
         let (bytes, rep) = texture::render(&baked.work, &TextureOptions { size: cli.texture_size, dilate: cli.texture_dilate, path: t.clone() })?;

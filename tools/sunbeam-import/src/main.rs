@@ -129,7 +129,9 @@ fn plan(cli: &Cli) -> Result<Plan> {
         steps.push(Step::Level(l.parse::<Level>().map_err(ctx("--level"))?));
     }
     if let Some(a) = &cli.align_rows {
-        steps.push(Step::AlignRows(a.parse::<AlignRows>().map_err(ctx("--align-rows"))?));
+        steps.push(Step::AlignRows(
+            a.parse::<AlignRows>().map_err(ctx("--align-rows"))?,
+        ));
     }
     if cli.remove_scars {
         steps.push(Step::RemoveScars);
@@ -147,34 +149,69 @@ fn plan(cli: &Cli) -> Result<Plan> {
         steps.push(Step::Flip(f.parse::<FlipAxis>().map_err(ctx("--flip"))?));
     }
     if let Some(r) = &cli.resample_to {
-        steps.push(Step::Resample(Target::PixelSize(parse_positive_length(r).map_err(ctx("--resample-to"))?)));
+        steps.push(Step::Resample(Target::PixelSize(
+            parse_positive_length(r).map_err(ctx("--resample-to"))?,
+        )));
     }
     if let Some(s) = &cli.size {
         let (w, h) = parse_size(s).map_err(ctx("--size"))?;
         steps.push(Step::Resample(Target::Size(w, h)));
     }
     steps.sort_by_key(Step::canonical_order);
-    let pixel_size = cli.pixel_size.as_deref().map(parse_pixel_size).transpose().map_err(ctx("--pixel-size"))?;
+    let pixel_size = cli
+        .pixel_size
+        .as_deref()
+        .map(parse_pixel_size)
+        .transpose()
+        .map_err(ctx("--pixel-size"))?;
     let format = cli
         .format
         .as_deref()
-        .map(|f| Format::from_name(f).ok_or_else(|| Error::usage(format!("--format {f}: unknown format"))))
+        .map(|f| {
+            Format::from_name(f)
+                .ok_or_else(|| Error::usage(format!("--format {f}: unknown format")))
+        })
         .transpose()?;
-    let z_range = cli.z_range.as_deref().map(parse_positive_length).transpose().map_err(ctx("--z-range"))?;
-    let z_scale = cli.z_scale.as_deref().map(parse_positive_length).transpose().map_err(ctx("--z-scale"))?;
+    let z_range = cli
+        .z_range
+        .as_deref()
+        .map(parse_positive_length)
+        .transpose()
+        .map_err(ctx("--z-range"))?;
+    let z_scale = cli
+        .z_scale
+        .as_deref()
+        .map(parse_positive_length)
+        .transpose()
+        .map_err(ctx("--z-scale"))?;
     if let Some(o) = &cli.output {
         Kind::from_path(o)?;
         if same_file(o, &cli.input) {
-            return Err(Error::usage(format!("{}: the output would overwrite the input", o.display())));
+            return Err(Error::usage(format!(
+                "{}: the output would overwrite the input",
+                o.display()
+            )));
         }
     }
     if let Some(p) = &cli.preview {
         let ok = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
         if !ok {
-            return Err(Error::usage(format!("--preview {}: the preview is a .png", p.display())));
+            return Err(Error::usage(format!(
+                "--preview {}: the preview is a .png",
+                p.display()
+            )));
         }
     }
-    Ok(Plan { steps, pixel_size, read: ReadOptions { format, pixel_size: None, z_range, z_scale } })
+    Ok(Plan {
+        steps,
+        pixel_size,
+        read: ReadOptions {
+            format,
+            pixel_size: None,
+            z_range,
+            z_scale,
+        },
+    })
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {
@@ -195,9 +232,20 @@ fn read_exr(bytes: &[u8], pixel_size: Option<(f64, f64)>) -> Result<(Vec<Channel
     let z_unit = raw.z_unit.clone().unwrap_or_else(|| "m".into());
     let mut field = HeightField::new(raw.width, raw.height, dx, dy, raw.data)?;
     field.provenance = raw.provenance;
-    let name = if field.provenance.channel.is_empty() { raw.channel_name } else { field.provenance.channel.clone() };
+    let name = if field.provenance.channel.is_empty() {
+        raw.channel_name
+    } else {
+        field.provenance.channel.clone()
+    };
     Ok((
-        vec![Channel { name, is_height: z_unit == "m", z_unit, field, xy_unit: xy_unit.into(), offset: (0.0, 0.0) }],
+        vec![Channel {
+            name,
+            is_height: z_unit == "m",
+            z_unit,
+            field,
+            xy_unit: xy_unit.into(),
+            offset: (0.0, 0.0),
+        }],
         calibrated_by_user,
     ))
 }
@@ -212,7 +260,10 @@ fn read_channels(bytes: &[u8], plan: &Plan) -> Result<(Vec<Channel>, Format, boo
     let fmt = format.unwrap_or(Format::Ascii);
     // XYZ points: the pixel size is the grid the points are sampled onto.
     if fmt == Format::Xyz && plan.pixel_size.is_some() {
-        let opts = ReadOptions { pixel_size: plan.pixel_size, ..plan.read.clone() };
+        let opts = ReadOptions {
+            pixel_size: plan.pixel_size,
+            ..plan.read.clone()
+        };
         return Ok((sunbeam_afm::read_bytes(bytes, &opts)?, fmt, true));
     }
     match sunbeam_afm::read_bytes(bytes, &plan.read) {
@@ -220,7 +271,10 @@ fn read_channels(bytes: &[u8], plan: &Plan) -> Result<(Vec<Channel>, Format, boo
         Err(e) => match plan.pixel_size {
             // Files without calibration refuse to load without a pixel size.
             Some(p) => {
-                let opts = ReadOptions { pixel_size: Some(p), ..plan.read.clone() };
+                let opts = ReadOptions {
+                    pixel_size: Some(p),
+                    ..plan.read.clone()
+                };
                 Ok((sunbeam_afm::read_bytes(bytes, &opts)?, fmt, true))
             }
             None => Err(e),
@@ -243,11 +297,21 @@ fn list(cli: &Cli, chans: &[Channel], fmt: Format) {
                 })
             })
             .collect();
-        println!("{}", serde_json::to_string_pretty(&serde_json::json!({ "file": cli.input, "channels": v })).unwrap_or_default());
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({ "file": cli.input, "channels": v }))
+                .unwrap_or_default()
+        );
     } else {
         println!("{} ({}):", cli.input.display(), fmt.name());
         for (i, c) in chans.iter().enumerate() {
-            let size = |v: f64| if c.xy_unit == "m" { format_length(v) } else { format!("{v} {}", c.xy_unit) };
+            let size = |v: f64| {
+                if c.xy_unit == "m" {
+                    format_length(v)
+                } else {
+                    format!("{v} {}", c.xy_unit)
+                }
+            };
             println!(
                 "  {i}: {:<24} {}x{} px, {} x {}, z unit {}{}",
                 format!("\"{}\"", c.name),
@@ -255,7 +319,11 @@ fn list(cli: &Cli, chans: &[Channel], fmt: Format) {
                 c.field.height,
                 size(c.field.size_x()),
                 size(c.field.size_y()),
-                if c.z_unit.is_empty() { "(none)" } else { &c.z_unit },
+                if c.z_unit.is_empty() {
+                    "(none)"
+                } else {
+                    &c.z_unit
+                },
                 if c.is_height { ", height" } else { "" }
             );
         }
@@ -265,7 +333,8 @@ fn list(cli: &Cli, chans: &[Channel], fmt: Format) {
 fn run(cli: Cli) -> Result<()> {
     let plan = plan(&cli)?;
     let input = &cli.input;
-    let bytes = std::fs::read(input).map_err(|e| Error::input_file(input, format!("cannot read: {e}")))?;
+    let bytes =
+        std::fs::read(input).map_err(|e| Error::input_file(input, format!("cannot read: {e}")))?;
     let in_file = |e: Error| e.context(input.display());
     let (chans, fmt, calibrated_by_user) = read_channels(&bytes, &plan).map_err(in_file)?;
     if cli.list {
@@ -320,11 +389,18 @@ fn run(cli: Cli) -> Result<()> {
         pixel_size_role = "none";
     }
     if pixel_size_role == "calibration" {
-        let d = format!("calibrate pixel size {} x {}", format_length(field.dx), format_length(field.dy));
+        let d = format!(
+            "calibrate pixel size {} x {}",
+            format_length(field.dx),
+            format_length(field.dy)
+        );
         field.provenance.processing.push(d.clone());
         processing.push(d);
     }
-    field.provenance.source_file = input.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    field.provenance.source_file = input
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     field.provenance.source_format = fmt.name().to_string();
     field.provenance.channel = ch.name.clone();
     if cli.verbose {
@@ -353,7 +429,10 @@ fn run(cli: Cli) -> Result<()> {
             field.count_nonfinite()
         );
     }
-    let output = cli.output.as_ref().ok_or_else(|| Error::usage("-o/--output is required"))?;
+    let output = cli
+        .output
+        .as_ref()
+        .ok_or_else(|| Error::usage("-o/--output is required"))?;
     io::write(output, &field)?;
     if let Some(p) = &cli.preview {
         sunbeam_field::preview::write_png(p, &field)?;
@@ -367,7 +446,13 @@ fn run(cli: Cli) -> Result<()> {
     }
     let st = Stats::of(&field);
     if cli.json {
-        let num = |v: f64| if v.is_finite() { serde_json::json!(v) } else { serde_json::Value::Null };
+        let num = |v: f64| {
+            if v.is_finite() {
+                serde_json::json!(v)
+            } else {
+                serde_json::Value::Null
+            }
+        };
         let report = serde_json::json!({
             "input": input, "output": output, "preview": cli.preview,
             "source_format": fmt.name(), "channel": ch.name,
@@ -377,7 +462,10 @@ fn run(cli: Cli) -> Result<()> {
             "nonfinite": st.nonfinite, "pixel_size_role": pixel_size_role,
             "processing": processing,
         });
-        println!("{}", serde_json::to_string_pretty(&report).unwrap_or_default());
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).unwrap_or_default()
+        );
     } else if !cli.quiet {
         eprintln!(
             "sunbeam-import: wrote {} ({}x{} px of {}, z {} .. {})",

@@ -1,6 +1,293 @@
-//! sunbeam-pack (placeholder until its issue lands).
+//! sunbeam-pack: height field -> diffraction term pack (KTX2 / EXR). See docs/PACK.md.
+
+use clap::{Parser, ValueEnum};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Instant;
+use sunbeam_common::{depfile, units, Error, Result};
+use sunbeam_pack::build::{self, BuildOptions, FieldRef};
+use sunbeam_pack::io::{read_height, write_pack, InputOptions, OutputKind};
+use sunbeam_pack::manifest::Source;
+use sunbeam_pack::{Basis, Model, Precision};
+
+const TOOL: &str = "sunbeam-pack";
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum BasisArg {
+    Chebyshev,
+    Taylor,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum ModelArg {
+    Window,
+    Tiled,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum PrecisionArg {
+    F32,
+    F16,
+}
+
+/// Build a diffraction term pack (KTX2 2D array or EXR) from a height field.
+#[derive(Parser, Debug)]
+#[command(name = "sunbeam-pack", version, about, long_about = None)]
+struct Cli {
+    /// Height field: EXR/GSF from sunbeam-import, or any AFM file / image sunbeam-import reads.
+    height: PathBuf,
+    /// Output pack: PACK.ktx2 or PACK.exr.
+    #[arg(short = 'o', long = "output")]
+    output: PathBuf,
+    /// Basis of the height expansion.
+    #[arg(long, value_enum, default_value = "chebyshev")]
+    basis: BasisArg,
+    /// Model of what lies beyond the patch (PHYSICS.md 2).
+    #[arg(long, value_enum, default_value = "window")]
+    model: ModelArg,
+    /// Spatial coherence length of the light.
+    #[arg(long, default_value = "65um")]
+    coherence: String,
+    /// Wavelength range.
+    #[arg(long, default_value = "380nm..780nm")]
+    lambda: String,
+    /// Bound on max |dR| that picks the term count.
+    #[arg(long, conflicts_with = "terms")]
+    max_error: Option<f64>,
+    /// Fixed term count (the error bound is reported).
+    #[arg(long)]
+    terms: Option<usize>,
+    /// Storage precision.
+    #[arg(long, value_enum, default_value = "f32")]
+    precision: PrecisionArg,
+    /// Largest |w| = cos(theta_i) + cos(theta_r) to cover (2: all directions).
+    #[arg(long, default_value_t = 2.0)]
+    max_w: f64,
+    /// Derive wavelength range, largest |w| and reachable frequencies from a scene (sunbeam-scene JSON).
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// EXR: one file per term (PACK.nNN.exr) with plain R/G channels.
+    #[arg(long)]
+    split: bool,
+    /// EXR: all terms in one grid atlas with plain R/G channels.
+    #[arg(long)]
+    atlas: bool,
+    /// Also write the manifest as JSON here.
+    #[arg(long)]
+    manifest: Option<PathBuf>,
+    /// Kaiser-Bessel taps per axis (window model; even).
+    #[arg(long, default_value_t = 6)]
+    taps: usize,
+    /// Pixel size for files without calibration (e.g. 65nm or 65nm,70nm).
+    #[arg(long)]
+    pixel_size: Option<String>,
+    /// Height of the full grey range for uncalibrated images (e.g. 375nm).
+    #[arg(long)]
+    z_range: Option<String>,
+    /// Channel to use (name or index) in multi-channel AFM files.
+    #[arg(long)]
+    channel: Option<String>,
+    /// Worker threads (the output does not depend on it).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write a Make-style depfile.
+    #[arg(long)]
+    depfile: Option<PathBuf>,
+    /// Quiet: no warnings or progress.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Verbose: print the plan.
+    #[arg(short, long)]
+    verbose: bool,
+}
+
+fn parse_pixel_size(s: &str) -> Result<(f64, f64)> {
+    match s.split_once(',') {
+        Some((a, b)) => Ok((units::parse_positive_length(a)?, units::parse_positive_length(b)?)),
+        None => {
+            let v = units::parse_positive_length(s)?;
+            Ok((v, v))
+        }
+    }
+}
+
 fn main() {
-    sunbeam_common::error::run_main("sunbeam-pack", || {
-        Err(sunbeam_common::Error::internal("sunbeam-pack is not implemented yet"))
+    sunbeam_common::error::run_main(TOOL, || {
+        let cli = match Cli::try_parse() {
+            Ok(c) => c,
+            Err(e) => {
+                use clap::error::ErrorKind;
+                if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                    print!("{e}");
+                    return Ok(());
+                }
+                return Err(Error::usage(e.to_string().trim_end().to_string()));
+            }
+        };
+        run(cli)
     })
+}
+
+fn run(cli: Cli) -> Result<()> {
+    let t0 = Instant::now();
+    let kind = OutputKind::from_path(&cli.output, cli.split, cli.atlas)?;
+    let coherence = units::parse_positive_length(&cli.coherence)?;
+    let (mut lmin, mut lmax) = units::parse_length_range(&cli.lambda)?;
+    let pixel_size = cli.pixel_size.as_deref().map(parse_pixel_size).transpose()?;
+    let z_range = cli.z_range.as_deref().map(units::parse_positive_length).transpose()?;
+    let mut warnings: Vec<String> = vec![];
+    let mut notes: Vec<String> = vec![];
+
+    let field = read_height(&cli.height, &InputOptions { pixel_size, z_range, channel: cli.channel.clone() })?;
+    let fr = FieldRef { width: field.width, height: field.height, dx: field.dx, dy: field.dy, data: &field.data };
+
+    let mut max_w = cli.max_w;
+    let mut freq_limit = None;
+    let mut inputs = vec![cli.height.clone()];
+    if let Some(sp) = &cli.scene {
+        let b = sunbeam_pack::scene::bound_scene(sp, max_w)?;
+        inputs.extend(b.inputs.iter().cloned());
+        if let Some((a, z)) = b.lambda {
+            lmin = lmin.max(a);
+            lmax = lmax.min(z);
+        }
+        max_w = max_w.min(b.max_w);
+        freq_limit = Some(b.freq_limit(lmin));
+        notes.extend(b.notes.iter().cloned());
+    }
+
+    let model = match cli.model {
+        ModelArg::Window => Model::Window,
+        ModelArg::Tiled => Model::Tiled,
+    };
+    let basis = match cli.basis {
+        BasisArg::Chebyshev => Basis::Chebyshev,
+        BasisArg::Taylor => Basis::Taylor,
+    };
+    let precision = match cli.precision {
+        PrecisionArg::F32 => Precision::F32,
+        PrecisionArg::F16 => Precision::F16,
+    };
+    let p = &field.provenance;
+    let mut o = BuildOptions {
+        basis,
+        model,
+        coherence_m: coherence,
+        lambda_min_m: lmin,
+        lambda_max_m: lmax,
+        max_error: cli.max_error.unwrap_or(1e-4),
+        terms: cli.terms,
+        precision,
+        max_w,
+        freq_limit_per_m: freq_limit,
+        taps: cli.taps,
+        generator: format!("{TOOL} {}", env!("CARGO_PKG_VERSION")),
+        source: Source {
+            file: p.source_file.clone(),
+            format: p.source_format.clone(),
+            channel: p.channel.clone(),
+            processing: p.processing.clone(),
+        },
+        notes,
+        ..BuildOptions::default()
+    };
+    if let Some(t) = cli.threads {
+        o.threads = t.max(1);
+    }
+    warnings.extend(build::check_field(fr, lmin));
+    let plan = build::plan(fr, &o)?;
+    let m = &plan.manifest;
+    if basis == Basis::Taylor && m.error.f32_rounding_estimate > 1e-3 {
+        warnings.push(format!(
+            "Taylor basis at |t| up to {:.1}: float32 evaluation loses about {:.1e} to cancellation \
+             (PHYSICS.md 3); use --basis chebyshev",
+            m.t_max, m.error.f32_rounding_estimate
+        ));
+    }
+    if let Some(tol) = m.error.tolerance {
+        let _ = tol;
+    } else if m.error.series_bound > 1e-3 {
+        warnings.push(format!(
+            "--terms {}: the series bound on |dR| is {:.2e} at |t| = {:.1}",
+            m.terms, m.error.series_bound, m.t_max
+        ));
+    }
+    if m.crop.width > 8192 || m.crop.height > 8192 {
+        warnings.push(format!(
+            "the crop is {}x{} texels: many GPUs limit textures to 8192",
+            m.crop.width, m.crop.height
+        ));
+    }
+    if !cli.quiet {
+        for w in &warnings {
+            eprintln!("{TOOL}: warning: {w}");
+        }
+        for n in &m.notes {
+            eprintln!("{TOOL}: note: {n}");
+        }
+    }
+    if cli.verbose && !cli.quiet {
+        eprintln!(
+            "{TOOL}: {}x{} px, {:?} basis, {:?} model, {} terms (|t| <= {:.2}, bound {:.2e}), crop {}x{}",
+            field.width, field.height, basis, model, m.terms, m.t_max, m.error.series_bound, m.crop.width, m.crop.height
+        );
+    }
+    let progress_on = !cli.quiet && std::io::stderr().is_terminal();
+    let mut progress = |done: usize, total: usize| {
+        if progress_on {
+            let w = 30;
+            let f = done * w / total.max(1);
+            eprint!("\r{TOOL}: [{}{}] {done}/{total} terms", "#".repeat(f), " ".repeat(w - f));
+            if done == total {
+                eprintln!();
+            }
+        }
+    };
+    let pack = build::run(fr, &plan, o.threads, &mut progress)?;
+    let files = write_pack(&pack, &cli.output, kind)?;
+    let mut bytes: u64 = files.iter().map(|f| f.1).sum();
+    if let Some(mp) = &cli.manifest {
+        let s = pack.manifest.to_json_pretty();
+        sunbeam_common::output::write_atomic(mp, s.as_bytes())?;
+        bytes += s.len() as u64;
+    }
+    if let Some(d) = &cli.depfile {
+        let outs: Vec<&std::path::Path> = files.iter().map(|f| f.0.as_path()).collect();
+        let ins: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+        depfile::write(d, &outs, &ins)?;
+    }
+    let secs = t0.elapsed().as_secs_f64();
+    if cli.json {
+        let m = &pack.manifest;
+        let report = serde_json::json!({
+            "tool": TOOL,
+            "version": env!("CARGO_PKG_VERSION"),
+            "input": cli.height.display().to_string(),
+            "outputs": files.iter().map(|f| f.0.display().to_string()).collect::<Vec<_>>(),
+            "terms": m.terms,
+            "basis": m.basis,
+            "model": m.model,
+            "precision": m.precision,
+            "crop": [m.crop.width, m.crop.height],
+            "padding": m.padding,
+            "grid": m.grid,
+            "t_max": m.t_max,
+            "error_bound": m.error.series_bound,
+            "tolerance": m.error.tolerance,
+            "f32_rounding_estimate": m.error.f32_rounding_estimate,
+            "lambda_m": [m.lambda_min_m, m.lambda_max_m],
+            "max_w": m.max_w,
+            "bytes_written": bytes,
+            "time_s": secs,
+            "warnings": warnings,
+            "notes": m.notes,
+        });
+        println!("{}", serde_json::to_string_pretty(&report).expect("json"));
+    } else if !cli.quiet && cli.verbose {
+        eprintln!("{TOOL}: wrote {} ({} bytes) in {:.2} s", cli.output.display(), bytes, secs);
+    }
+    Ok(())
 }

@@ -55,12 +55,15 @@ fn clean(s: &str) -> String {
 pub fn encode(field: &HeightField) -> Result<Vec<u8>> {
     let (w, h) = (field.width, field.height);
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE || field.data.len() != w * h {
-        return Err(Error::internal(format!("cannot write a {w}x{h} field with {} values", field.data.len())));
+        return Err(Error::internal(format!(
+            "cannot write a {w}x{h} field with {} values",
+            field.data.len()
+        )));
     }
     let mut out = Vec::with_capacity(w * h * 4 + h * 16 + 1024);
     out.extend_from_slice(&MAGIC);
     out.extend_from_slice(&2u32.to_le_bytes()); // version 2, single-part scanline
-    // Standard attributes, in alphabetical order as OpenEXR writes them.
+                                                // Standard attributes, in alphabetical order as OpenEXR writes them.
     let mut ch = Vec::new();
     ch.extend_from_slice(CHANNEL.as_bytes());
     ch.push(0);
@@ -74,7 +77,12 @@ pub fn encode(field: &HeightField) -> Result<Vec<u8>> {
     attr(&mut out, "dataWindow", "box2i", &box2i(w, h));
     attr(&mut out, "displayWindow", "box2i", &box2i(w, h));
     attr(&mut out, "lineOrder", "lineOrder", &[0]); // INCREASING_Y
-    attr(&mut out, "pixelAspectRatio", "float", &((field.dx / field.dy) as f32).to_le_bytes());
+    attr(
+        &mut out,
+        "pixelAspectRatio",
+        "float",
+        &((field.dx / field.dy) as f32).to_le_bytes(),
+    );
     let mut v2f = Vec::new();
     v2f.extend_from_slice(&0f32.to_le_bytes());
     v2f.extend_from_slice(&0f32.to_le_bytes());
@@ -85,12 +93,32 @@ pub fn encode(field: &HeightField) -> Result<Vec<u8>> {
     attr(&mut out, ATTR_DY, "double", &field.dy.to_le_bytes());
     attr(&mut out, ATTR_Z_UNIT, "string", b"m");
     let p = &field.provenance;
-    attr(&mut out, ATTR_SOURCE_FILE, "string", clean(&p.source_file).as_bytes());
-    attr(&mut out, ATTR_SOURCE_FORMAT, "string", clean(&p.source_format).as_bytes());
-    attr(&mut out, ATTR_CHANNEL, "string", clean(&p.channel).as_bytes());
-    attr(&mut out, ATTR_PROCESSING, "string", clean(&p.processing.join("; ")).as_bytes());
+    attr(
+        &mut out,
+        ATTR_SOURCE_FILE,
+        "string",
+        clean(&p.source_file).as_bytes(),
+    );
+    attr(
+        &mut out,
+        ATTR_SOURCE_FORMAT,
+        "string",
+        clean(&p.source_format).as_bytes(),
+    );
+    attr(
+        &mut out,
+        ATTR_CHANNEL,
+        "string",
+        clean(&p.channel).as_bytes(),
+    );
+    attr(
+        &mut out,
+        ATTR_PROCESSING,
+        "string",
+        clean(&p.processing.join("; ")).as_bytes(),
+    );
     out.push(0); // end of header
-    // Offset table: one chunk per scanline.
+                 // Offset table: one chunk per scanline.
     let line_bytes = w * 4;
     let chunk_bytes = 8 + line_bytes;
     let first = out.len() + h * 8;
@@ -143,7 +171,9 @@ pub fn decode_raw(bytes: &[u8]) -> Result<RawExr> {
     }
     let (w, h) = (header.layer_size.x(), header.layer_size.y());
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        return Err(Error::input(format!("OpenEXR data window {w}x{h} is outside 1..{MAX_SIDE} per side")));
+        return Err(Error::input(format!(
+            "OpenEXR data window {w}x{h} is outside 1..{MAX_SIDE} per side"
+        )));
     }
     let nch = header.channels.list.len().max(1);
     // Uncompressed size bound: compressed data can expand at most ~1000x (zlib);
@@ -185,11 +215,18 @@ pub fn decode_raw(bytes: &[u8]) -> Result<RawExr> {
     };
     let (w, h) = (layer.size.x(), layer.size.y());
     if data.len() != w * h {
-        return Err(Error::input(format!("OpenEXR channel has {} samples for {w}x{h} pixels", data.len())));
+        return Err(Error::input(format!(
+            "OpenEXR channel has {} samples for {w}x{h} pixels",
+            data.len()
+        )));
     }
     let get_f64 = |name: &str| -> Option<f64> {
         let key = Text::from(name);
-        let v = layer.attributes.other.get(&key).or_else(|| image.attributes.other.get(&key))?;
+        let v = layer
+            .attributes
+            .other
+            .get(&key)
+            .or_else(|| image.attributes.other.get(&key))?;
         match v {
             AttributeValue::F64(x) => Some(*x),
             AttributeValue::F32(x) => Some(*x as f64),
@@ -200,14 +237,23 @@ pub fn decode_raw(bytes: &[u8]) -> Result<RawExr> {
     let dy = get_f64(ATTR_DY);
     let get_text = |name: &str| -> Option<String> {
         let key = Text::from(name);
-        let v = layer.attributes.other.get(&key).or_else(|| image.attributes.other.get(&key))?;
+        let v = layer
+            .attributes
+            .other
+            .get(&key)
+            .or_else(|| image.attributes.other.get(&key))?;
         match v {
             AttributeValue::Text(t) => Some(t.to_string()),
             _ => None,
         }
     };
     let processing = get_text(ATTR_PROCESSING)
-        .map(|s| s.split("; ").filter(|x| !x.is_empty()).map(str::to_string).collect())
+        .map(|s| {
+            s.split("; ")
+                .filter(|x| !x.is_empty())
+                .map(str::to_string)
+                .collect()
+        })
         .unwrap_or_default();
     let provenance = Provenance {
         source_file: get_text(ATTR_SOURCE_FILE).unwrap_or_default(),

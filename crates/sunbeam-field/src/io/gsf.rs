@@ -11,21 +11,40 @@ use sunbeam_common::{Error, Result};
 pub const MAGIC: &str = "Gwyddion Simple Field 1.0\n";
 
 fn one_line(s: &str) -> String {
-    s.chars().map(|c| if c == '\n' || c == '\r' || c == '\0' { ' ' } else { c }).collect()
+    s.chars()
+        .map(|c| {
+            if c == '\n' || c == '\r' || c == '\0' {
+                ' '
+            } else {
+                c
+            }
+        })
+        .collect()
 }
 
 /// Encode `field` as GSF (heights in metres, lateral units metres).
 pub fn encode(field: &HeightField) -> Result<Vec<u8>> {
     let (w, h) = (field.width, field.height);
     if w == 0 || h == 0 || field.data.len() != w * h {
-        return Err(Error::internal(format!("cannot write a {w}x{h} field with {} values", field.data.len())));
+        return Err(Error::internal(format!(
+            "cannot write a {w}x{h} field with {} values",
+            field.data.len()
+        )));
     }
     let p = &field.provenance;
     let mut s = String::from(MAGIC);
     s += &format!("XRes = {w}\nYRes = {h}\n");
-    s += &format!("XReal = {:e}\nYReal = {:e}\n", field.size_x(), field.size_y());
+    s += &format!(
+        "XReal = {:e}\nYReal = {:e}\n",
+        field.size_x(),
+        field.size_y()
+    );
     s += "XYUnits = m\nZUnits = m\n";
-    let title = if p.channel.is_empty() { "Height".to_string() } else { one_line(&p.channel) };
+    let title = if p.channel.is_empty() {
+        "Height".to_string()
+    } else {
+        one_line(&p.channel)
+    };
     s += &format!("Title = {title}\n");
     if !p.source_file.is_empty() {
         s += &format!("SunbeamSource = {}\n", one_line(&p.source_file));
@@ -34,7 +53,10 @@ pub fn encode(field: &HeightField) -> Result<Vec<u8>> {
         s += &format!("SunbeamFormat = {}\n", one_line(&p.source_format));
     }
     if !p.processing.is_empty() {
-        s += &format!("SunbeamProcessing = {}\n", one_line(&p.processing.join("; ")));
+        s += &format!(
+            "SunbeamProcessing = {}\n",
+            one_line(&p.processing.join("; "))
+        );
     }
     let mut out = s.into_bytes();
     let pad = 4 - out.len() % 4;
@@ -63,15 +85,18 @@ pub struct RawGsf {
 /// Decode a GSF file, checking the header against the file length.
 pub fn decode_raw(bytes: &[u8]) -> Result<RawGsf> {
     if !bytes.starts_with(MAGIC.as_bytes()) {
-        return Err(Error::input("not a Gwyddion Simple Field file (first line is not 'Gwyddion Simple Field 1.0')"));
+        return Err(Error::input(
+            "not a Gwyddion Simple Field file (first line is not 'Gwyddion Simple Field 1.0')",
+        ));
     }
-    let nul = bytes
-        .iter()
-        .position(|&b| b == 0)
-        .ok_or_else(|| Error::input("GSF header is not terminated by a NUL byte (truncated file?)"))?;
+    let nul = bytes.iter().position(|&b| b == 0).ok_or_else(|| {
+        Error::input("GSF header is not terminated by a NUL byte (truncated file?)")
+    })?;
     let data_start = (nul / 4 + 1) * 4;
     if data_start > bytes.len() || bytes[nul..data_start].iter().any(|&b| b != 0) {
-        return Err(Error::input("GSF header padding is not NUL bytes up to a multiple of 4"));
+        return Err(Error::input(
+            "GSF header padding is not NUL bytes up to a multiple of 4",
+        ));
     }
     let text = std::str::from_utf8(&bytes[MAGIC.len()..nul])
         .map_err(|_| Error::input("GSF header is not UTF-8 text"))?;
@@ -81,17 +106,21 @@ pub fn decode_raw(bytes: &[u8]) -> Result<RawGsf> {
         if line.is_empty() {
             continue;
         }
-        let (k, v) = line
-            .split_once('=')
-            .ok_or_else(|| Error::input(format!("GSF header line '{line}' is not 'Key = Value'")))?;
+        let (k, v) = line.split_once('=').ok_or_else(|| {
+            Error::input(format!("GSF header line '{line}' is not 'Key = Value'"))
+        })?;
         keys.push((k.trim().to_string(), v.trim().to_string()));
     }
     let get = |k: &str| keys.iter().find(|(kk, _)| kk == k).map(|(_, v)| v.as_str());
     let res = |k: &str| -> Result<usize> {
         let v = get(k).ok_or_else(|| Error::input(format!("GSF header has no {k}")))?;
-        let n: usize = v.parse().map_err(|_| Error::input(format!("GSF {k} = '{v}' is not a positive integer")))?;
+        let n: usize = v
+            .parse()
+            .map_err(|_| Error::input(format!("GSF {k} = '{v}' is not a positive integer")))?;
         if n == 0 || n > MAX_SIDE {
-            return Err(Error::input(format!("GSF {k} = {n} is outside 1..{MAX_SIDE}")));
+            return Err(Error::input(format!(
+                "GSF {k} = {n} is outside 1..{MAX_SIDE}"
+            )));
         }
         Ok(n)
     };
@@ -100,9 +129,13 @@ pub fn decode_raw(bytes: &[u8]) -> Result<RawGsf> {
         match get(k) {
             None => Ok(1.0),
             Some(v) => {
-                let x: f64 = v.parse().map_err(|_| Error::input(format!("GSF {k} = '{v}' is not a number")))?;
+                let x: f64 = v
+                    .parse()
+                    .map_err(|_| Error::input(format!("GSF {k} = '{v}' is not a number")))?;
                 if !(x.is_finite() && x > 0.0) {
-                    return Err(Error::input(format!("GSF {k} = {v} must be finite and positive")));
+                    return Err(Error::input(format!(
+                        "GSF {k} = {v} must be finite and positive"
+                    )));
                 }
                 Ok(x)
             }
@@ -125,7 +158,12 @@ pub fn decode_raw(bytes: &[u8]) -> Result<RawGsf> {
         source_format: get("SunbeamFormat").unwrap_or("").to_string(),
         channel: get("Title").unwrap_or("").to_string(),
         processing: get("SunbeamProcessing")
-            .map(|s| s.split("; ").filter(|x| !x.is_empty()).map(str::to_string).collect())
+            .map(|s| {
+                s.split("; ")
+                    .filter(|x| !x.is_empty())
+                    .map(str::to_string)
+                    .collect()
+            })
             .unwrap_or_default(),
     };
     Ok(RawGsf {
@@ -147,10 +185,18 @@ pub fn decode(bytes: &[u8]) -> Result<HeightField> {
     let r = decode_raw(bytes)?;
     for (what, u) in [("XYUnits", &r.xy_unit), ("ZUnits", &r.z_unit)] {
         if !(u.is_empty() || u == "m") {
-            return Err(Error::input(format!("GSF {what} = '{u}': only metres can be read as a height field")));
+            return Err(Error::input(format!(
+                "GSF {what} = '{u}': only metres can be read as a height field"
+            )));
         }
     }
-    let mut f = HeightField::new(r.width, r.height, r.xreal / r.width as f64, r.yreal / r.height as f64, r.data)?;
+    let mut f = HeightField::new(
+        r.width,
+        r.height,
+        r.xreal / r.width as f64,
+        r.yreal / r.height as f64,
+        r.data,
+    )?;
     f.provenance = r.provenance;
     Ok(f)
 }

@@ -5,9 +5,9 @@ pub mod exr;
 pub mod gsf;
 
 use crate::HeightField;
+use std::path::Path;
 use sunbeam_common::output::write_atomic;
 use sunbeam_common::{Error, Result};
-use std::path::Path;
 
 /// The file kinds this module writes, chosen from the output file's extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -66,7 +66,9 @@ pub fn decode(bytes: &[u8]) -> Result<HeightField> {
     match Kind::sniff(bytes) {
         Some(Kind::Exr) => exr::decode(bytes),
         Some(Kind::Gsf) => gsf::decode(bytes),
-        None => Err(Error::input("not an OpenEXR or Gwyddion Simple Field file (unknown magic bytes)")),
+        None => Err(Error::input(
+            "not an OpenEXR or Gwyddion Simple Field file (unknown magic bytes)",
+        )),
     }
 }
 

@@ -1,0 +1,116 @@
+//! The CPU reference against independent truths: closed forms for geometry and
+//! Lambert shading, and sunbeam-optics' ground truth (shares no code with the
+//! packs) for the diffraction colour of rendered pixels.
+
+use std::sync::Arc;
+use sunbeam_optics::colour;
+use sunbeam_optics::truth::{Params, Truth};
+use sunbeam_raster::{fixtures, raster, shade, Mesh, Options};
+
+#[test]
+fn lambert_quad_centre_and_coverage() {
+    let (mut scene, mesh) = fixtures::quad_scene([64, 64]);
+    scene.meshes[0].pack = None;
+    scene.meshes[0].base_color = [0.5, 0.25, 0.125];
+    let p = fixtures::prepared(scene.clone(), mesh, None);
+    let img = sunbeam_raster::render_prepared(&p, &Options::default());
+    // Centre pixel: base * cos(theta_i) with the light at 30 degrees from the normal.
+    let l = scene.lights[0].direction;
+    let cos_i = l[2] / (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+    let want = [0.5 * cos_i, 0.25 * cos_i, 0.125 * cos_i].map(colour::srgb_oetf);
+    let got = img.pixel(32, 32);
+    for k in 0..3 {
+        assert!((got[k] as f64 - want[k]).abs() < 1e-6, "{got:?} vs {want:?}");
+    }
+    // Coverage: the quad's projected area in pixels (square, centred) within one pixel row/column.
+    let g = raster::rasterise(&p, 64, 64);
+    let covered = g.iter().filter(|f| f.mesh.is_some()).count() as f64;
+    let d = (scene.camera.eye[2] - 0.0).abs();
+    let half = 0.5 / d / (scene.camera.fov_y_deg.to_radians() / 2.0).tan() * 32.0; // half side in pixels
+    let side = 2.0 * half;
+    assert!((covered - side * side).abs() <= 2.0 * side + 2.0, "{covered} px vs {}", side * side);
+    // Symmetric about the centre lines.
+    for j in 0..64 {
+        for i in 0..64 {
+            assert_eq!(g[j * 64 + i].mesh.is_some(), g[j * 64 + 63 - i].mesh.is_some());
+            assert_eq!(g[j * 64 + i].mesh.is_some(), g[(63 - j) * 64 + i].mesh.is_some());
+        }
+    }
+}
+
+#[test]
+fn sphere_back_faces_are_hidden_and_depth_is_front_most() {
+    let (scene, mesh) = fixtures::sphere_scene([48, 48]);
+    let p = fixtures::prepared(scene.clone(), mesh, None);
+    let g = raster::rasterise(&p, 48, 48);
+    let eye = scene.camera.eye;
+    for f in g.iter().filter(|f| f.mesh.is_some()) {
+        // every visible point faces the camera (front hemisphere)
+        let v = [eye[0] - f.pos[0], eye[1] - f.pos[1], eye[2] - f.pos[2]];
+        assert!(v[0] * f.pos[0] + v[1] * f.pos[1] + v[2] * f.pos[2] > -1e-3, "{:?}", f.pos);
+        let r = (f.pos[0].powi(2) + f.pos[1].powi(2) + f.pos[2].powi(2)).sqrt();
+        assert!((r - 0.5).abs() < 2e-3);
+    }
+}
+
+/// Diffraction colour of rendered pixels against the ground truth of PHYSICS.md 2
+/// (float64 direct sum, 1 nm, no pack code): the frame, the sign of (u, v, w) and
+/// the gain must all agree for this to hold.
+#[test]
+fn blazed_quad_pixels_match_ground_truth() {
+    let Some(dir) = sunbeam_common::testdata::shared_file("snake/BlazingBump.bmp") else { return };
+    let dir = dir.parent().unwrap().to_path_buf();
+    let opts = sunbeam_pack::build::BuildOptions::default();
+    let pack = Arc::new(fixtures::pack(&fixtures::BLAZED, &dir, &opts).unwrap());
+    let (scene, mesh) = fixtures::quad_scene([40, 40]);
+    let p = fixtures::prepared(scene.clone(), mesh, Some(pack));
+    let g = raster::rasterise(&p, 40, 40);
+    let sh = shade::Shader::new(&p, &Options::default());
+    let (w, h, data) = fixtures::heights(&fixtures::BLAZED, &dir).unwrap();
+    let field = sunbeam_field::HeightField::new(w, h, 25e-9, 25e-9, data).unwrap();
+    let truth = Truth::new(&field, &Params::default()).unwrap();
+    let mut worst: f64 = 0.0;
+    let mut bright = 0;
+    for &(i, j) in &[(20usize, 20usize), (5, 20), (35, 20), (12, 19), (28, 21), (20, 8), (8, 30)] {
+        let f = &g[j * 40 + i];
+        assert!(f.mesh.is_some());
+        let (t, b, n) = shade::frame(f.normal, f.tangent).unwrap();
+        let e = scene.camera.eye;
+        let wr = norm([e[0] - f.pos[0], e[1] - f.pos[1], e[2] - f.pos[2]]);
+        let wi = norm(scene.lights[0].direction);
+        let loc = |d: [f64; 3]| [dot(d, t), dot(d, b), dot(d, n)];
+        let ours = sh.diffraction_xyz(0, loc(wi), loc(wr));
+        let want = truth.colour_xyz(loc(wi), loc(wr));
+        if want[1] > 0.01 {
+            bright += 1;
+        }
+        let de = colour::ciede2000_xyz(ours, want);
+        worst = worst.max(de);
+        assert!(de < 1.0 || want[1] < 1e-4, "pixel ({i},{j}): {ours:?} vs truth {want:?}, dE {de}");
+    }
+    assert!(bright >= 3, "the test scene should show the grating's orders");
+    eprintln!("worst CIEDE2000 against the ground truth: {worst:.3}");
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn norm(a: [f64; 3]) -> [f64; 3] {
+    let l = dot(a, a).sqrt();
+    a.map(|v| v / l)
+}
+
+#[test]
+fn images_round_trip_png_and_compare() {
+    let mut a = sunbeam_raster::Image::new(4, 3);
+    a.rgb[5] = [0.2, 0.5, 0.9];
+    let dir = std::env::temp_dir().join(format!("sb-raster-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("a.png");
+    a.write_png(&f).unwrap();
+    let b = sunbeam_raster::Image::read_png(&f).unwrap();
+    let d = sunbeam_raster::compare(&a, &b).unwrap();
+    assert!(d.max < 0.3, "{d}");
+    let _ = Mesh::quad();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
