@@ -9,8 +9,11 @@
 //   (tiled model), exactly as sunbeam_pack::Pack::reflectance;
 // XYZ = G * sum_l R_l weight_l; linear sRGB; diffuse blend; exposure; tone curve; sRGB OETF.
 //
-// Modes: 0 = default (above), 1 = thesis (fixed term count, 5 nm samples, nearest
-// texel, no interpolation), 2 = Lambert (base colour only).
+// Modes: 0 = default: the same sum precomputed per pack as a response table
+// T(u, v, w) (XYZ without G, crates/sunbeam-render/src/table.rs) read with 8
+// loads and trilinear interpolation; 3 = direct (the sum above per fragment);
+// 1 = thesis (fixed term count, 5 nm samples, nearest texel, no interpolation);
+// 2 = Lambert (base colour only).
 
 const MAX_TERMS: u32 = 64u;
 const MAX_TAPS: u32 = 16u;
@@ -57,6 +60,20 @@ struct Material {
     sigma_bins: vec2<f32>,
     kb_norm: f32,      // beta / (W sinh beta)
     table_dt: f32,     // |t| step of term_table
+    // response table: cells (nu, nv, nw), 1 when present
+    tab_nu: u32,
+    tab_nv: u32,
+    tab_nw: u32,
+    tab_on: u32,
+    // u, v of cell 0 (= -2), their steps; w of cell 0 (= -2), its step
+    tab_u0: f32,
+    tab_du: f32,
+    tab_dv: f32,
+    tab_w0: f32,
+    tab_dw: f32,
+    _q0: f32,
+    _q1: f32,
+    _q2: f32,
 };
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -68,6 +85,8 @@ struct Material {
 @group(1) @binding(1) var<storage, read> terms: array<vec2<f32>>;
 // term_table[i] = terms needed for |t| <= (i + 1) * table_dt
 @group(1) @binding(2) var<storage, read> term_table: array<u32>;
+// response table, (iw * nv + iv) * nu + iu, xyz
+@group(1) @binding(3) var<storage, read> response: array<vec4<f32>>;
 
 struct VsIn {
     @location(0) pos: vec3<f32>,
@@ -325,6 +344,29 @@ fn diffraction_xyz(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     return xyz;
 }
 
+fn response_xyz(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    let uvw = -wi - wr;
+    let nmax = vec3<f32>(f32(mat.tab_nu - 1u), f32(mat.tab_nv - 1u), f32(mat.tab_nw - 1u));
+    let p = clamp(
+        (uvw - vec3<f32>(mat.tab_u0, mat.tab_u0, mat.tab_w0)) / vec3<f32>(mat.tab_du, mat.tab_dv, mat.tab_dw),
+        vec3<f32>(0.0),
+        nmax
+    );
+    let i = min(vec3<u32>(floor(p)), vec3<u32>(nmax) - vec3<u32>(1u));
+    let f = p - vec3<f32>(i);
+    let nu = mat.tab_nu;
+    let nv = mat.tab_nv;
+    let b00 = (i.z * nv + i.y) * nu + i.x;
+    let b01 = b00 + nu;
+    let b10 = b00 + nv * nu;
+    let b11 = b10 + nu;
+    let c00 = mix(response[b00].xyz, response[b00 + 1u].xyz, f.x);
+    let c01 = mix(response[b01].xyz, response[b01 + 1u].xyz, f.x);
+    let c10 = mix(response[b10].xyz, response[b10 + 1u].xyz, f.x);
+    let c11 = mix(response[b11].xyz, response[b11 + 1u].xyz, f.x);
+    return mix(mix(c00, c01, f.y), mix(c10, c11, f.y), f.z);
+}
+
 // ---------------------------------------------------------------- colour
 fn schlick(c: f32) -> f32 {
     let m = 1.0 - clamp(c, 0.0, 1.0);
@@ -420,7 +462,13 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         let cos_i = max(wi_l.z, 0.0);
         var diff = vec3<f32>(0.0);
         if (diffract && dw < 1.0 && wi_l.z > 0.0 && wr_l.z > 0.0) {
-            diff = xyz_to_rgb(diffraction_xyz(wi_l, wr_l) * gain(wi_l, wr_l));
+            var xyz: vec3<f32>;
+            if (g.mode == 0u && mat.tab_on == 1u) {
+                xyz = response_xyz(wi_l, wr_l);
+            } else {
+                xyz = diffraction_xyz(wi_l, wr_l);
+            }
+            diff = xyz_to_rgb(xyz * gain(wi_l, wr_l));
         }
         rgb = rgb + g.lights[i].w * (dw * base * cos_i + (1.0 - dw) * diff);
     }

@@ -6,7 +6,11 @@ use std::path::Path;
 use sunbeam_afm::{detect, read_file, ReadOptions};
 
 fn main() {
-    let opts = ReadOptions { pixel_size: Some((1e-9, 1e-9)), z_range: Some(1e-6), ..Default::default() };
+    let opts = ReadOptions {
+        pixel_size: Some((1e-9, 1e-9)),
+        z_range: Some(1e-6),
+        ..Default::default()
+    };
     for a in std::env::args().skip(1) {
         let fmt = std::fs::read(&a).ok().and_then(|b| detect(&b));
         match read_file(Path::new(&a), &opts) {
@@ -29,7 +33,11 @@ fn main() {
                     );
                 }
             }
-            Err(e) => println!("{a} [{:?}] error ({:?}): {e}", fmt.map(|f| f.name()), e.code),
+            Err(e) => println!(
+                "{a} [{:?}] error ({:?}): {e}",
+                fmt.map(|f| f.name()),
+                e.code
+            ),
         }
     }
 }

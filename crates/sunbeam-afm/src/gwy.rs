@@ -193,6 +193,18 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
         }
     }
     fields.sort_by_key(|f| f.0);
+    let mut titles = std::collections::HashMap::new();
+    for (name, v) in &top.comps {
+        let Some(id) = name
+            .strip_prefix('/')
+            .and_then(|r| r.strip_suffix("/data/title"))
+        else {
+            continue;
+        };
+        if let (Ok(id), Val::Str(t)) = (id.parse::<u64>(), v) {
+            titles.entry(id).or_insert_with(|| t.clone());
+        }
+    }
     let mut out = Vec::new();
     for (id, f) in fields {
         let ctx = format!("Gwyddion data field /{id}/data");
@@ -211,10 +223,10 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
             );
         }
         let data = decode(raw, 0, xres * yres, Sample::F64, Endian::Little, &ctx)?;
-        let title = match top.get(&format!("/{id}/data/title")) {
-            Some(Val::Str(s)) => s.clone(),
-            _ => format!("Channel {id}"),
-        };
+        let title = titles
+            .get(&id)
+            .cloned()
+            .unwrap_or_else(|| format!("Channel {id}"));
         let mut ch = channel(
             Format::Gwy,
             &title,

@@ -27,6 +27,8 @@ pub struct Tiff<'a> {
 }
 
 const MAX_IFDS: usize = 1024;
+/// Entries over all directories (directories may overlap in a hostile file).
+const MAX_ENTRIES: usize = 1 << 18;
 
 fn type_size(t: u16) -> usize {
     match t {
@@ -50,12 +52,17 @@ impl<'a> Tiff<'a> {
         let mut off = u32_at(b, 4, e, "TIFF first IFD offset")? as usize;
         let mut ifds = Vec::new();
         let mut seen = std::collections::HashSet::new();
+        let mut total = 0usize;
         while off != 0 {
             if !seen.insert(off) || ifds.len() >= MAX_IFDS {
                 bail!("TIFF IFD chain loops or is longer than {MAX_IFDS}");
             }
             let n = u16_at(b, off, e, "TIFF IFD entry count")? as usize;
             slice(b, off + 2, n * 12 + 4, "TIFF IFD entries")?;
+            total += n;
+            if total > MAX_ENTRIES {
+                bail!("TIFF directories hold more than {MAX_ENTRIES} entries");
+            }
             let mut entries = Vec::with_capacity(n);
             for i in 0..n {
                 let p = off + 2 + 12 * i;

@@ -289,7 +289,10 @@ fn nanoscope_v43_header_closed_form() {
     }
     assert_eq!(detect(&b), Some(Format::Nanoscope));
     let c = &read_bytes(&b, &ReadOptions::default()).unwrap()[0];
-    assert_eq!((c.name.as_str(), c.field.width, c.field.height), ("Height", 4, 2));
+    assert_eq!(
+        (c.name.as_str(), c.field.width, c.field.height),
+        ("Height", 4, 2)
+    );
     assert!(c.is_height && c.z_unit == "m");
     assert!((c.field.size_x() - 1769.08e-9).abs() < 1e-15);
     // 2 lines of 4 samples: the slow axis is half as long (square pixels).

@@ -105,6 +105,8 @@ struct Axis {
     taps: usize,
     idx: Vec<usize>,
     w: Vec<f64>,
+    /// First input index of output k's taps when they are contiguous (no mirroring).
+    contiguous: Vec<Option<usize>>,
 }
 
 fn mirror(j: i64, n: usize) -> usize {
@@ -130,9 +132,11 @@ fn axis(n_in: usize, d_in: f64, n_out: usize, d_out: f64) -> Axis {
     let i0b = bessel_i0(KAISER_BETA);
     let mut idx = Vec::with_capacity(n_out * taps);
     let mut w = Vec::with_capacity(n_out * taps);
+    let mut contiguous = Vec::with_capacity(n_out);
     for k in 0..n_out {
         let t = (x0 + (k as f64 + 0.5) * d_out) / d_in - 0.5;
         let first = (t - radius).ceil() as i64;
+        contiguous.push((first >= 0 && first as usize + taps <= n_in).then_some(first as usize));
         let mut sum = 0.0;
         let start = w.len();
         for m in 0..taps as i64 {
@@ -152,7 +156,23 @@ fn axis(n_in: usize, d_in: f64, n_out: usize, d_out: f64) -> Axis {
             *v /= sum;
         }
     }
-    Axis { taps, idx, w }
+    Axis { taps, idx, w, contiguous }
+}
+
+/// Dot product with four accumulators (vectorises; fixed order, so the result
+/// does not depend on the thread count).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let (mut s0, mut s1, mut s2, mut s3) = (0.0, 0.0, 0.0, 0.0);
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        s0 += x[0] * y[0];
+        s1 += x[1] * y[1];
+        s2 += x[2] * y[2];
+        s3 += x[3] * y[3];
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    (s0 + s1) + (s2 + s3) + tail
 }
 
 fn threads() -> usize {

@@ -29,7 +29,9 @@ fn main() {
     std::fs::create_dir_all(&out).unwrap();
     let p = SnakeParams::with_detail(detail);
     let doc = snake::generate(&p);
-    let prim = sunbeam_mesh::scene::read_primitive(&doc, 0, 0, 0).unwrap().unwrap();
+    let prim = sunbeam_mesh::scene::read_primitive(&doc, 0, 0, 0)
+        .unwrap()
+        .unwrap();
     let uv = prim.uvs.unwrap();
     eprintln!("mesh: {} vertices", uv.len());
     let mut s = 0x2545F4914F6CDD1Du64;
@@ -50,7 +52,10 @@ fn main() {
         csv += &format!("{:.17e},{:.17e},{:.17e}\n", q[0], q[1], a.to_degrees());
     }
     std::fs::write(out.join("samples.csv"), csv).unwrap();
-    write_f64(&out.join("uv.f64"), &uv.iter().flatten().copied().collect::<Vec<_>>());
+    write_f64(
+        &out.join("uv.f64"),
+        &uv.iter().flatten().copied().collect::<Vec<_>>(),
+    );
     let mut rep = serde_json::Map::new();
     rep.insert("vertices".into(), uv.len().into());
     rep.insert("samples".into(), nsamp.into());
@@ -66,7 +71,10 @@ fn main() {
             res = uv
                 .iter()
                 .map(|q| match e.eval(*q) {
-                    AxialValue::Angle { angle, extrapolated: false } => angle,
+                    AxialValue::Angle {
+                        angle,
+                        extrapolated: false,
+                    } => angle,
                     _ => f64::NAN,
                 })
                 .collect::<Vec<f64>>();
@@ -94,7 +102,11 @@ fn main() {
         );
         eprintln!("{name}: build {best_build:.3} s, eval {best_eval:.3} s, rms err {rms:.2e} rad");
     }
-    std::fs::write(out.join("rust.json"), serde_json::to_string_pretty(&rep).unwrap()).unwrap();
+    std::fs::write(
+        out.join("rust.json"),
+        serde_json::to_string_pretty(&rep).unwrap(),
+    )
+    .unwrap();
     // The 1M-vertex mesh itself, for the end-to-end CLI timing.
     let mut d = doc;
     std::fs::write(out.join("snake1m.glb"), d.to_glb()).unwrap();

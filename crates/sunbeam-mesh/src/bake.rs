@@ -41,7 +41,13 @@ pub struct BakeOptions {
 
 impl BakeOptions {
     pub fn new(source: Source) -> Self {
-        BakeOptions { source, rotate_deg: 0.0, uv_set: 0, interp: Interp::Natural, max_snap: None }
+        BakeOptions {
+            source,
+            rotate_deg: 0.0,
+            uv_set: 0,
+            interp: Interp::Natural,
+            max_snap: None,
+        }
     }
 }
 
@@ -160,10 +166,15 @@ pub fn prepare(doc: &Document, uv_set: usize, report: &mut Report) -> Result<Vec
                 Xform::new(Mat4::IDENTITY).expect("identity is invertible")
             }
         };
-        let nprim = doc.array("meshes")[m].get("primitives").and_then(|p| p.as_array()).map_or(0, |a| a.len());
+        let nprim = doc.array("meshes")[m]
+            .get("primitives")
+            .and_then(|p| p.as_array())
+            .map_or(0, |a| a.len());
         for k in 0..nprim {
             let Some(p) = scene::read_primitive(doc, m, k, uv_set)? else {
-                report.skipped_primitives.push(format!("meshes[{m}].primitives[{k}]: not triangles (points/lines), left as is"));
+                report.skipped_primitives.push(format!(
+                    "meshes[{m}].primitives[{k}]: not triangles (points/lines), left as is"
+                ));
                 continue;
             };
             let normals_rewrite = match &p.normals {
@@ -173,11 +184,19 @@ pub fn prepare(doc: &Document, uv_set: usize, report: &mut Report) -> Result<Vec
             let n_local = crate::local_normals(&p);
             let nv = p.positions.len();
             let p_world: Vec<V3> = p.positions.iter().map(|&q| xf.point(q)).collect();
-            let n_world: Vec<V3> = n_local.iter().map(|&n| xf.normal(n).unwrap_or([0.0, 0.0, 1.0])).collect();
+            let n_world: Vec<V3> = n_local
+                .iter()
+                .map(|&n| xf.normal(n).unwrap_or([0.0, 0.0, 1.0]))
+                .collect();
             let (u_world, v_world) = match &p.uvs {
                 Some(uv) => {
                     let (du, dv) = crate::geom::uv_derivatives(&p.positions, uv, &p.triangles);
-                    let f = |d: &Vec<V3>| -> Vec<Option<V3>> { d.iter().zip(&n_world).map(|(d, n)| normalize(project(xf.tangent(*d), *n))).collect() };
+                    let f = |d: &Vec<V3>| -> Vec<Option<V3>> {
+                        d.iter()
+                            .zip(&n_world)
+                            .map(|(d, n)| normalize(project(xf.tangent(*d), *n)))
+                            .collect()
+                    };
                     (Some(f(&du)), Some(f(&dv)))
                 }
                 None => (None, None),
@@ -188,8 +207,15 @@ pub fn prepare(doc: &Document, uv_set: usize, report: &mut Report) -> Result<Vec
                 .triangles
                 .iter()
                 .filter(|t| {
-                    let q = [p.positions[t[0] as usize], p.positions[t[1] as usize], p.positions[t[2] as usize]];
-                    crate::geom::norm(cross(crate::geom::sub(q[1], q[0]), crate::geom::sub(q[2], q[0]))) <= 0.0
+                    let q = [
+                        p.positions[t[0] as usize],
+                        p.positions[t[1] as usize],
+                        p.positions[t[2] as usize],
+                    ];
+                    crate::geom::norm(cross(
+                        crate::geom::sub(q[1], q[0]),
+                        crate::geom::sub(q[2], q[0]),
+                    )) <= 0.0
                 })
                 .count();
             out.push(Work {
@@ -233,10 +259,18 @@ fn from_angle(u: V3, n: V3, a: f64) -> V3 {
 
 /// Compute the field (no output written).
 pub fn compute(doc: &Document, opts: &BakeOptions) -> Result<(Vec<Work>, Report)> {
-    let mut report = Report { input: doc.source.display().to_string(), source: opts.source.describe(), rotate_deg: opts.rotate_deg, ..Default::default() };
+    let mut report = Report {
+        input: doc.source.display().to_string(),
+        source: opts.source.describe(),
+        rotate_deg: opts.rotate_deg,
+        ..Default::default()
+    };
     let mut work = prepare(doc, opts.uv_set, &mut report)?;
     if work.is_empty() {
-        return Err(Error::input_file(&doc.source, "no triangle primitives to bake"));
+        return Err(Error::input_file(
+            &doc.source,
+            "no triangle primitives to bake",
+        ));
     }
     match &opts.source {
         Source::Axis(a) => {
@@ -257,7 +291,11 @@ pub fn compute(doc: &Document, opts: &BakeOptions) -> Result<(Vec<Work>, Report)
         Source::UvDirection(ax) => {
             need_uvs(doc, &work, opts.uv_set, "--uv-direction")?;
             for w in &mut work {
-                let src = if *ax == UvAxis::U { w.u_world.clone() } else { w.v_world.clone() };
+                let src = if *ax == UvAxis::U {
+                    w.u_world.clone()
+                } else {
+                    w.v_world.clone()
+                };
                 let src = src.unwrap_or_default();
                 for i in 0..w.dir.len() {
                     w.set(i, src[i], "degenerate UVs around the vertex");
@@ -287,7 +325,11 @@ pub fn compute(doc: &Document, opts: &BakeOptions) -> Result<(Vec<Work>, Report)
     Ok((work, report))
 }
 
-fn samples(work: &mut [Work], s: &crate::orient::Samples, opts: &BakeOptions) -> Result<SampleReport> {
+fn samples(
+    work: &mut [Work],
+    s: &crate::orient::Samples,
+    opts: &BakeOptions,
+) -> Result<SampleReport> {
     let mut rep = SampleReport {
         rows: s.items.len(),
         interpolation: match opts.interp {
@@ -308,7 +350,11 @@ fn samples(work: &mut [Work], s: &crate::orient::Samples, opts: &BakeOptions) ->
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for (wi, w) in work.iter().enumerate() {
             for (ti, t) in w.local.triangles.iter().enumerate() {
-                tris.push([w.p_world[t[0] as usize], w.p_world[t[1] as usize], w.p_world[t[2] as usize]]);
+                tris.push([
+                    w.p_world[t[0] as usize],
+                    w.p_world[t[1] as usize],
+                    w.p_world[t[2] as usize],
+                ]);
                 owner.push((wi, ti));
             }
             for p in &w.p_world {
@@ -325,37 +371,65 @@ fn samples(work: &mut [Work], s: &crate::orient::Samples, opts: &BakeOptions) ->
         let mut max_snapped: f64 = 0.0;
         for smp in &s.items {
             let SampleAt::Xyz { p, d } = smp.at else {
-                rep.rejected.push(RejectedSample { row: smp.line, reason: "u,v sample mixed with x,y,z samples: the file must use one kind".into() });
+                rep.rejected.push(RejectedSample {
+                    row: smp.line,
+                    reason: "u,v sample mixed with x,y,z samples: the file must use one kind"
+                        .into(),
+                });
                 continue;
             };
             let Some(hit) = bvh.closest(p) else { continue };
             let dist = hit.dist2.sqrt();
             if dist > max_snap {
-                rep.rejected.push(RejectedSample { row: smp.line, reason: format!("{dist:.4e} from the surface (more than --max-snap {max_snap:.4e})") });
+                rep.rejected.push(RejectedSample {
+                    row: smp.line,
+                    reason: format!(
+                        "{dist:.4e} from the surface (more than --max-snap {max_snap:.4e})"
+                    ),
+                });
                 continue;
             }
             let (wi, ti) = owner[hit.tri];
             let w = &work[wi];
             let t = w.local.triangles[ti];
             let b = hit.bary;
-            let mix3 = |v: &dyn Fn(usize) -> V3| -> V3 { add(add(scale(v(t[0] as usize), b[0]), scale(v(t[1] as usize), b[1])), scale(v(t[2] as usize), b[2])) };
+            let mix3 = |v: &dyn Fn(usize) -> V3| -> V3 {
+                add(
+                    add(scale(v(t[0] as usize), b[0]), scale(v(t[1] as usize), b[1])),
+                    scale(v(t[2] as usize), b[2]),
+                )
+            };
             let Some(n) = normalize(mix3(&|i| w.n_world[i])) else {
-                rep.rejected.push(RejectedSample { row: smp.line, reason: "the surface normal at the snapped point is undefined".into() });
+                rep.rejected.push(RejectedSample {
+                    row: smp.line,
+                    reason: "the surface normal at the snapped point is undefined".into(),
+                });
                 continue;
             };
             let uw = w.u_world.as_ref().expect("checked by need_uvs");
-            let Some(u) = (|| normalize(project(mix3(&|i| uw[i].unwrap_or([0.0; 3])), n)))() else {
-                rep.rejected.push(RejectedSample { row: smp.line, reason: "degenerate UVs at the snapped point".into() });
+            let Some(u) = normalize(project(mix3(&|i| uw[i].unwrap_or([0.0; 3])), n)) else {
+                rep.rejected.push(RejectedSample {
+                    row: smp.line,
+                    reason: "degenerate UVs at the snapped point".into(),
+                });
                 continue;
             };
-            let Some(dp) = normalize(project(d, n)).filter(|_| crate::geom::norm(project(d, n)) > 1e-6 * crate::geom::norm(d)) else {
-                rep.rejected.push(RejectedSample { row: smp.line, reason: "direction is parallel to the surface normal (or zero)".into() });
+            let Some(dp) = normalize(project(d, n))
+                .filter(|_| crate::geom::norm(project(d, n)) > 1e-6 * crate::geom::norm(d))
+            else {
+                rep.rejected.push(RejectedSample {
+                    row: smp.line,
+                    reason: "direction is parallel to the surface normal (or zero)".into(),
+                });
                 continue;
             };
             let ang = dot(dp, cross(n, u)).atan2(dot(dp, u));
             let uv = w.local.uvs.as_ref().expect("checked by need_uvs");
             let (a, bb, c) = (uv[t[0] as usize], uv[t[1] as usize], uv[t[2] as usize]);
-            let suv = [a[0] * b[0] + bb[0] * b[1] + c[0] * b[2], a[1] * b[0] + bb[1] * b[1] + c[1] * b[2]];
+            let suv = [
+                a[0] * b[0] + bb[0] * b[1] + c[0] * b[2],
+                a[1] * b[0] + bb[1] * b[1] + c[1] * b[2],
+            ];
             max_snapped = max_snapped.max(dist);
             dom[wi].push((smp.line, suv, ang));
             snapped.push((hit.point, dp));
@@ -369,19 +443,36 @@ fn samples(work: &mut [Work], s: &crate::orient::Samples, opts: &BakeOptions) ->
         }
     }
     if dom.iter().all(|d| d.is_empty()) {
-        return Err(Error::input_file(&s.path, "no usable samples (see the reasons with --json); nothing to interpolate"));
+        return Err(Error::input_file(
+            &s.path,
+            "no usable samples (see the reasons with --json); nothing to interpolate",
+        ));
     }
     for (di, samples) in dom.iter().enumerate() {
-        let targets: Vec<usize> = if all_uv { (0..work.len()).collect() } else { vec![di] };
+        let targets: Vec<usize> = if all_uv {
+            (0..work.len()).collect()
+        } else {
+            vec![di]
+        };
         match AxialField::new(samples, opts.interp) {
             Some(f) => {
                 rep.used += f.used;
                 rep.merged_duplicates += f.merged_duplicates;
                 for (row, why) in &f.dropped {
-                    rep.rejected.push(RejectedSample { row: *row, reason: why.clone() });
+                    rep.rejected.push(RejectedSample {
+                        row: *row,
+                        reason: why.clone(),
+                    });
                 }
                 if let Some(note) = f.degenerate_layout() {
-                    rep.layout_notes.push(if all_uv { note.to_string() } else { format!("meshes[{}].primitives[{}]: {note}", work[di].mesh, work[di].prim) });
+                    rep.layout_notes.push(if all_uv {
+                        note.to_string()
+                    } else {
+                        format!(
+                            "meshes[{}].primitives[{}]: {note}",
+                            work[di].mesh, work[di].prim
+                        )
+                    });
                 }
                 for &wi in &targets {
                     let w = &mut work[wi];
@@ -390,12 +481,22 @@ fn samples(work: &mut [Work], s: &crate::orient::Samples, opts: &BakeOptions) ->
                     let results = eval_parallel(&f, &uv);
                     for (i, r) in results.into_iter().enumerate() {
                         match (r, uw[i]) {
-                            (AxialValue::Angle { angle, extrapolated }, Some(u)) => {
+                            (
+                                AxialValue::Angle {
+                                    angle,
+                                    extrapolated,
+                                },
+                                Some(u),
+                            ) => {
                                 if extrapolated {
                                     rep.extrapolated_vertices += 1;
                                 }
                                 let n = w.n_world[i];
-                                w.set(i, Some(from_angle(u, n, angle)), "degenerate UVs around the vertex");
+                                w.set(
+                                    i,
+                                    Some(from_angle(u, n, angle)),
+                                    "degenerate UVs around the vertex",
+                                );
                             }
                             (AxialValue::Cancelled, _) => {
                                 w.dir[i] = None;
@@ -433,7 +534,9 @@ fn samples(work: &mut [Work], s: &crate::orient::Samples, opts: &BakeOptions) ->
 
 /// Evaluate a field at many UVs on all cores (results do not depend on the thread count).
 fn eval_parallel(f: &AxialField, uv: &[[f64; 2]]) -> Vec<AxialValue> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 16);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, 16);
     if threads == 1 || uv.len() < 4096 {
         let mut e = f.evaluator();
         return uv.iter().map(|p| e.eval(*p)).collect();
@@ -449,7 +552,9 @@ fn eval_parallel(f: &AxialField, uv: &[[f64; 2]]) -> Vec<AxialValue> {
                 })
             })
             .collect();
-        hs.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+        hs.into_iter()
+            .flat_map(|h| h.join().unwrap_or_default())
+            .collect()
     })
 }
 
@@ -461,7 +566,14 @@ fn fill_missing(w: &mut Work, report: &mut Report) {
         return;
     }
     for &i in &missing {
-        *report.without_direction.entry(w.reason[i].unwrap_or("vertex used by no triangle").to_string()).or_insert(0) += 1;
+        *report
+            .without_direction
+            .entry(
+                w.reason[i]
+                    .unwrap_or("vertex used by no triangle")
+                    .to_string(),
+            )
+            .or_insert(0) += 1;
     }
     // Adjacency: triangle edges plus vertices welded by position.
     let mut adj: Vec<Vec<u32>> = vec![Vec::new(); nv];
@@ -474,7 +586,10 @@ fn fill_missing(w: &mut Work, report: &mut Report) {
     }
     let mut by_pos: HashMap<[u64; 3], Vec<u32>> = HashMap::new();
     for (i, p) in w.local.positions.iter().enumerate() {
-        by_pos.entry(p.map(|x| (x + 0.0).to_bits())).or_default().push(i as u32);
+        by_pos
+            .entry(p.map(|x| (x + 0.0).to_bits()))
+            .or_default()
+            .push(i as u32);
     }
     for g in by_pos.values().filter(|g| g.len() > 1) {
         for &a in g {
@@ -522,11 +637,18 @@ fn fill_missing(w: &mut Work, report: &mut Report) {
 /// World directions to local unit vectors orthogonal to the local normal, and tangent signs.
 fn finish_local(w: &mut Work) {
     let nv = w.dir.len();
-    let dv_local = w.local.uvs.as_ref().map(|uv| crate::geom::uv_derivatives(&w.local.positions, uv, &w.local.triangles));
+    let dv_local = w
+        .local
+        .uvs
+        .as_ref()
+        .map(|uv| crate::geom::uv_derivatives(&w.local.positions, uv, &w.local.triangles));
     w.t_local = (0..nv)
         .map(|i| {
             let n = w.n_local[i];
-            w.dir[i].and_then(|d| normalize(project(w.xf.tangent_to_local(d), n))).map(|t| normalize(project(t, n)).unwrap_or(t)).unwrap_or_else(|| any_perpendicular(n))
+            w.dir[i]
+                .and_then(|d| normalize(project(w.xf.tangent_to_local(d), n)))
+                .map(|t| normalize(project(t, n)).unwrap_or(t))
+                .unwrap_or_else(|| any_perpendicular(n))
         })
         .collect();
     w.w_sign = (0..nv)
@@ -549,7 +671,12 @@ pub fn bake(mut doc: Document, opts: &BakeOptions) -> Result<Baked> {
             attrs.push(("NORMAL", doc.push_f32_accessor(&n, 3, false)));
             report.normals_written += 1;
         }
-        let t: Vec<f32> = w.t_local.iter().zip(&w.w_sign).flat_map(|(v, s)| [v[0] as f32, v[1] as f32, v[2] as f32, *s as f32]).collect();
+        let t: Vec<f32> = w
+            .t_local
+            .iter()
+            .zip(&w.w_sign)
+            .flat_map(|(v, s)| [v[0] as f32, v[1] as f32, v[2] as f32, *s as f32])
+            .collect();
         attrs.push(("TANGENT", doc.push_f32_accessor(&t, 4, false)));
         let o: Vec<f32> = w.t_local.iter().flat_map(|v| v.map(|x| x as f32)).collect();
         attrs.push(("_ORIENTATION", doc.push_f32_accessor(&o, 3, false)));

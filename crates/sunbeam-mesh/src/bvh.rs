@@ -34,9 +34,17 @@ pub struct Hit {
 
 impl Bvh {
     pub fn new(tris: Vec<[V3; 3]>) -> Bvh {
-        let mut b = Bvh { order: (0..tris.len() as u32).collect(), tris, nodes: Vec::new() };
+        let mut b = Bvh {
+            order: (0..tris.len() as u32).collect(),
+            tris,
+            nodes: Vec::new(),
+        };
         if !b.tris.is_empty() {
-            let cent: Vec<V3> = b.tris.iter().map(|t| scale(add(add(t[0], t[1]), t[2]), 1.0 / 3.0)).collect();
+            let cent: Vec<V3> = b
+                .tris
+                .iter()
+                .map(|t| scale(add(add(t[0], t[1]), t[2]), 1.0 / 3.0))
+                .collect();
             b.build(0, b.tris.len(), &cent);
         }
         b
@@ -59,14 +67,29 @@ impl Bvh {
     fn build(&mut self, s: usize, e: usize, cent: &[V3]) -> u32 {
         let (lo, hi) = self.bounds(s, e);
         let id = self.nodes.len() as u32;
-        self.nodes.push(Node { lo, hi, start: s as u32, count: (e - s) as u32, left: 0, right: 0 });
+        self.nodes.push(Node {
+            lo,
+            hi,
+            start: s as u32,
+            count: (e - s) as u32,
+            left: 0,
+            right: 0,
+        });
         if e - s <= 4 {
             return id;
         }
         let ext = sub(hi, lo);
-        let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] { 0 } else if ext[1] >= ext[2] { 1 } else { 2 };
+        let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] {
+            0
+        } else if ext[1] >= ext[2] {
+            1
+        } else {
+            2
+        };
         let mid = (s + e) / 2;
-        self.order[s..e].select_nth_unstable_by(mid - s, |a, b| cent[*a as usize][axis].total_cmp(&cent[*b as usize][axis]));
+        self.order[s..e].select_nth_unstable_by(mid - s, |a, b| {
+            cent[*a as usize][axis].total_cmp(&cent[*b as usize][axis])
+        });
         let l = self.build(s, mid, cent);
         let r = self.build(mid, e, cent);
         let n = &mut self.nodes[id as usize];
@@ -103,13 +126,22 @@ impl Bvh {
                     let (q, bary) = closest_on_triangle(p, &self.tris[ti as usize]);
                     let d = sub(q, p);
                     let d2 = dot(d, d);
-                    if best.is_none_or(|b| d2 < b.dist2 || (d2 == b.dist2 && (ti as usize) < b.tri)) {
-                        best = Some(Hit { tri: ti as usize, point: q, bary, dist2: d2 });
+                    if best.is_none_or(|b| d2 < b.dist2 || (d2 == b.dist2 && (ti as usize) < b.tri))
+                    {
+                        best = Some(Hit {
+                            tri: ti as usize,
+                            point: q,
+                            bary,
+                            dist2: d2,
+                        });
                     }
                 }
             } else {
                 let (l, r) = (n.left, n.right);
-                let (dl, dr) = (Self::box_dist2(&self.nodes[l as usize], p), Self::box_dist2(&self.nodes[r as usize], p));
+                let (dl, dr) = (
+                    Self::box_dist2(&self.nodes[l as usize], p),
+                    Self::box_dist2(&self.nodes[r as usize], p),
+                );
                 if dl < dr {
                     stack.push(r);
                     stack.push(l);

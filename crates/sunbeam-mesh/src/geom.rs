@@ -23,7 +23,11 @@ pub fn dot(a: V3, b: V3) -> f64 {
 }
 #[inline]
 pub fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 #[inline]
 pub fn norm(a: V3) -> f64 {
@@ -46,7 +50,11 @@ pub fn project(a: V3, n: V3) -> V3 {
 }
 /// Some unit vector orthogonal to the unit `n` (deterministic).
 pub fn any_perpendicular(n: V3) -> V3 {
-    let a = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let a = if n[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
     normalize(project(a, n)).unwrap_or([1.0, 0.0, 0.0])
 }
 
@@ -55,7 +63,9 @@ pub fn any_perpendicular(n: V3) -> V3 {
 pub struct Mat4(pub [f64; 16]);
 
 impl Mat4 {
-    pub const IDENTITY: Mat4 = Mat4([1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.]);
+    pub const IDENTITY: Mat4 = Mat4([
+        1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.,
+    ]);
     pub fn mul(&self, o: &Mat4) -> Mat4 {
         let mut r = [0.0; 16];
         for c in 0..4 {
@@ -68,9 +78,21 @@ impl Mat4 {
     pub fn from_trs(t: V3, q: [f64; 4], s: V3) -> Mat4 {
         let [x, y, z, w] = q;
         let r = [
-            [1. - 2. * (y * y + z * z), 2. * (x * y + z * w), 2. * (x * z - y * w)],
-            [2. * (x * y - z * w), 1. - 2. * (x * x + z * z), 2. * (y * z + x * w)],
-            [2. * (x * z + y * w), 2. * (y * z - x * w), 1. - 2. * (x * x + y * y)],
+            [
+                1. - 2. * (y * y + z * z),
+                2. * (x * y + z * w),
+                2. * (x * z - y * w),
+            ],
+            [
+                2. * (x * y - z * w),
+                1. - 2. * (x * x + z * z),
+                2. * (y * z + x * w),
+            ],
+            [
+                2. * (x * z + y * w),
+                2. * (y * z - x * w),
+                1. - 2. * (x * x + y * y),
+            ],
         ];
         let mut m = [0.0; 16];
         for c in 0..3 {
@@ -107,7 +129,8 @@ impl Mat4 {
     }
     pub fn det3(&self) -> f64 {
         let a = self.lin();
-        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
             + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
     }
     /// Inverse of the upper 3x3 (rows), None when singular.
@@ -151,7 +174,11 @@ pub struct Xform {
 
 impl Xform {
     pub fn new(m: Mat4) -> Option<Xform> {
-        Some(Xform { m, inv: m.inv3()?, det: m.det3() })
+        Some(Xform {
+            m,
+            inv: m.inv3()?,
+            det: m.det3(),
+        })
     }
     pub fn point(&self, p: V3) -> V3 {
         self.m.point(p)
@@ -177,10 +204,14 @@ pub fn angle_weighted_normals(pos: &[V3], tris: &[[u32; 3]]) -> (Vec<V3>, usize)
     let mut acc = vec![[0.0; 3]; pos.len()];
     for t in tris {
         let p = [pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]];
-        let Some(fnrm) = normalize(cross(sub(p[1], p[0]), sub(p[2], p[0]))) else { continue };
+        let Some(fnrm) = normalize(cross(sub(p[1], p[0]), sub(p[2], p[0]))) else {
+            continue;
+        };
         for k in 0..3 {
             let (a, b) = (sub(p[(k + 1) % 3], p[k]), sub(p[(k + 2) % 3], p[k]));
-            let (Some(a), Some(b)) = (normalize(a), normalize(b)) else { continue };
+            let (Some(a), Some(b)) = (normalize(a), normalize(b)) else {
+                continue;
+            };
             let ang = dot(a, b).clamp(-1.0, 1.0).acos();
             let i = t[k] as usize;
             acc[i] = add(acc[i], scale(fnrm, ang));
@@ -209,7 +240,11 @@ pub fn angle_weighted_normals(pos: &[V3], tris: &[[u32; 3]]) -> (Vec<V3>, usize)
 
 fn key(p: V3) -> [u64; 3] {
     // +0.0 and -0.0 weld together.
-    [(p[0] + 0.0).to_bits(), (p[1] + 0.0).to_bits(), (p[2] + 0.0).to_bits()]
+    [
+        (p[0] + 0.0).to_bits(),
+        (p[1] + 0.0).to_bits(),
+        (p[2] + 0.0).to_bits(),
+    ]
 }
 
 /// Per-vertex direction of increasing u (and of v), from the triangles' UV
@@ -232,7 +267,9 @@ pub fn uv_derivatives(pos: &[V3], uv: &[[f64; 2]], tris: &[[u32; 3]]) -> (Vec<V3
         let pu = scale(sub(scale(e1, t2), scale(e2, t1)), 1.0 / det);
         let pv = scale(sub(scale(e2, s1), scale(e1, s2)), 1.0 / det);
         let area = norm(cross(e1, e2));
-        let (Some(pu), Some(pv)) = (normalize(pu), normalize(pv)) else { continue };
+        let (Some(pu), Some(pv)) = (normalize(pu), normalize(pv)) else {
+            continue;
+        };
         for &i in &[i0, i1, i2] {
             du[i] = add(du[i], scale(pu, area));
             dv[i] = add(dv[i], scale(pv, area));

@@ -19,7 +19,11 @@ pub const UNSIGNED_INT: u64 = 5125;
 pub const FLOAT: u64 = 5126;
 
 /// Extensions whose data we cannot decode: refused with a clear message.
-const UNSUPPORTED_REQUIRED: &[&str] = &["KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression"];
+const UNSUPPORTED_REQUIRED: &[&str] = &[
+    "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
+];
 
 /// A loaded glTF document.
 #[derive(Debug, Clone)]
@@ -49,19 +53,32 @@ impl Document {
 
     /// Parse bytes that came from `path` (used to resolve relative URIs and name errors).
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Document> {
-        let base_dir = path.parent().map(|p| if p.as_os_str().is_empty() { PathBuf::from(".") } else { p.to_path_buf() });
+        let base_dir = path.parent().map(|p| {
+            if p.as_os_str().is_empty() {
+                PathBuf::from(".")
+            } else {
+                p.to_path_buf()
+            }
+        });
         let (json_bytes, bin) = if bytes.len() >= 4 && &bytes[0..4] == b"glTF" {
             parse_glb(bytes, path)?
         } else {
             (bytes, None)
         };
-        let json: Value = serde_json::from_slice(json_bytes).map_err(|e| bad(path, format!("not valid glTF JSON: {e}")))?;
+        let json: Value = serde_json::from_slice(json_bytes)
+            .map_err(|e| bad(path, format!("not valid glTF JSON: {e}")))?;
         if !json.is_object() {
             return Err(bad(path, "glTF JSON is not an object"));
         }
-        let version = json.pointer("/asset/version").and_then(Value::as_str).unwrap_or("");
+        let version = json
+            .pointer("/asset/version")
+            .and_then(Value::as_str)
+            .unwrap_or("");
         if !version.starts_with("2.") {
-            return Err(bad(path, format!("asset.version is {version:?}; only glTF 2.x is supported")));
+            return Err(bad(
+                path,
+                format!("asset.version is {version:?}; only glTF 2.x is supported"),
+            ));
         }
         if let Some(req) = json.get("extensionsRequired").and_then(Value::as_array) {
             for e in req.iter().filter_map(Value::as_str) {
@@ -73,22 +90,50 @@ impl Document {
                 }
             }
         }
-        let mut doc = Document { json, buffers: Vec::new(), base_dir, source: path.to_path_buf(), extra_inputs: Vec::new() };
-        let bufs = doc.json.get("buffers").and_then(Value::as_array).cloned().unwrap_or_default();
+        let mut doc = Document {
+            json,
+            buffers: Vec::new(),
+            base_dir,
+            source: path.to_path_buf(),
+            extra_inputs: Vec::new(),
+        };
+        let bufs = doc
+            .json
+            .get("buffers")
+            .and_then(Value::as_array)
+            .cloned()
+            .unwrap_or_default();
         let mut bin = bin;
         for (i, b) in bufs.iter().enumerate() {
-            let len = b.get("byteLength").and_then(Value::as_u64).ok_or_else(|| bad(path, format!("buffers[{i}].byteLength missing")))? as usize;
+            let len = b
+                .get("byteLength")
+                .and_then(Value::as_u64)
+                .ok_or_else(|| bad(path, format!("buffers[{i}].byteLength missing")))?
+                as usize;
             let data = match b.get("uri").and_then(Value::as_str) {
                 None => {
                     if i != 0 {
-                        return Err(bad(path, format!("buffers[{i}] has no uri (only buffer 0 of a GLB may)")));
+                        return Err(bad(
+                            path,
+                            format!("buffers[{i}] has no uri (only buffer 0 of a GLB may)"),
+                        ));
                     }
-                    bin.take().ok_or_else(|| bad(path, "buffers[0] has no uri and there is no GLB BIN chunk"))?.to_vec()
+                    bin.take()
+                        .ok_or_else(|| {
+                            bad(path, "buffers[0] has no uri and there is no GLB BIN chunk")
+                        })?
+                        .to_vec()
                 }
                 Some(uri) => doc.read_uri(uri, &format!("buffers[{i}]"))?.0,
             };
             if data.len() < len {
-                return Err(bad(path, format!("buffers[{i}] holds {} bytes, byteLength says {len}", data.len())));
+                return Err(bad(
+                    path,
+                    format!(
+                        "buffers[{i}] holds {} bytes, byteLength says {len}",
+                        data.len()
+                    ),
+                ));
             }
             let mut data = data;
             data.truncate(len);
@@ -100,8 +145,14 @@ impl Document {
     /// Read a URI (data: or a relative file). Returns the bytes and a MIME type if the URI had one.
     pub fn read_uri(&mut self, uri: &str, what: &str) -> Result<(Vec<u8>, Option<String>)> {
         if let Some(rest) = uri.strip_prefix("data:") {
-            let (meta, data) = rest.split_once(',').ok_or_else(|| bad(&self.source, format!("{what}: malformed data URI")))?;
-            let mime = meta.split(';').next().filter(|m| !m.is_empty()).map(str::to_string);
+            let (meta, data) = rest
+                .split_once(',')
+                .ok_or_else(|| bad(&self.source, format!("{what}: malformed data URI")))?;
+            let mime = meta
+                .split(';')
+                .next()
+                .filter(|m| !m.is_empty())
+                .map(str::to_string);
             if !meta.ends_with(";base64") {
                 return Err(bad(&self.source, format!("{what}: data URI is not base64")));
             }
@@ -112,17 +163,29 @@ impl Document {
         }
         let rel = percent_decode(uri);
         if rel.contains("://") {
-            return Err(bad(&self.source, format!("{what}: URI {uri:?} is not a relative file")));
+            return Err(bad(
+                &self.source,
+                format!("{what}: URI {uri:?} is not a relative file"),
+            ));
         }
         let base = self.base_dir.clone().unwrap_or_else(|| PathBuf::from("."));
         let p = base.join(&rel);
-        let bytes = std::fs::read(&p).map_err(|e| bad(&self.source, format!("{what}: cannot read {}: {e}", p.display())))?;
+        let bytes = std::fs::read(&p).map_err(|e| {
+            bad(
+                &self.source,
+                format!("{what}: cannot read {}: {e}", p.display()),
+            )
+        })?;
         self.extra_inputs.push(p);
         Ok((bytes, None))
     }
 
     pub fn array(&self, key: &str) -> &[Value] {
-        self.json.get(key).and_then(Value::as_array).map(|v| v.as_slice()).unwrap_or(&[])
+        self.json
+            .get(key)
+            .and_then(Value::as_array)
+            .map(|v| v.as_slice())
+            .unwrap_or(&[])
     }
 
     fn err(&self, msg: impl std::fmt::Display) -> Error {
@@ -132,10 +195,19 @@ impl Document {
     /// Read accessor `idx` as f64 elements (normalized integers are mapped to
     /// [0,1] / [-1,1]); returns (flat values, component count).
     pub fn read_accessor(&self, idx: usize) -> Result<(Vec<f64>, usize)> {
-        let acc = self.array("accessors").get(idx).ok_or_else(|| self.err(format!("accessors[{idx}] does not exist")))?;
+        let acc = self
+            .array("accessors")
+            .get(idx)
+            .ok_or_else(|| self.err(format!("accessors[{idx}] does not exist")))?;
         let what = format!("accessors[{idx}]");
-        let count = acc.get("count").and_then(Value::as_u64).ok_or_else(|| self.err(format!("{what}.count missing")))? as usize;
-        let ctype = acc.get("componentType").and_then(Value::as_u64).ok_or_else(|| self.err(format!("{what}.componentType missing")))?;
+        let count = acc
+            .get("count")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| self.err(format!("{what}.count missing")))? as usize;
+        let ctype = acc
+            .get("componentType")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| self.err(format!("{what}.componentType missing")))?;
         let ncomp = match acc.get("type").and_then(Value::as_str) {
             Some("SCALAR") => 1,
             Some("VEC2") => 2,
@@ -146,9 +218,15 @@ impl Document {
             Some("MAT4") => 16,
             t => return Err(self.err(format!("{what}.type {t:?} is not valid"))),
         };
-        let csize = comp_size(ctype).ok_or_else(|| self.err(format!("{what}.componentType {ctype} is not valid")))?;
-        let normalized = acc.get("normalized").and_then(Value::as_bool).unwrap_or(false);
-        let total = count.checked_mul(ncomp).ok_or_else(|| self.err(format!("{what}.count too large")))?;
+        let csize = comp_size(ctype)
+            .ok_or_else(|| self.err(format!("{what}.componentType {ctype} is not valid")))?;
+        let normalized = acc
+            .get("normalized")
+            .and_then(Value::as_bool)
+            .unwrap_or(false);
+        let total = count
+            .checked_mul(ncomp)
+            .ok_or_else(|| self.err(format!("{what}.count too large")))?;
         let mut out = vec![0.0f64; total];
         if let Some(bv) = acc.get("bufferView").and_then(Value::as_u64) {
             let off = acc.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
@@ -157,11 +235,18 @@ impl Document {
             let stride = stride.unwrap_or(elem);
             if count > 0 {
                 let need = off
-                    .checked_add((count - 1).checked_mul(stride).ok_or_else(|| self.err(format!("{what} too large")))?)
+                    .checked_add(
+                        (count - 1)
+                            .checked_mul(stride)
+                            .ok_or_else(|| self.err(format!("{what} too large")))?,
+                    )
                     .and_then(|x| x.checked_add(elem))
                     .ok_or_else(|| self.err(format!("{what} too large")))?;
                 if need > data.len() {
-                    return Err(self.err(format!("{what} needs {need} bytes of bufferView {bv}, which has {}", data.len())));
+                    return Err(self.err(format!(
+                        "{what} needs {need} bytes of bufferView {bv}, which has {}",
+                        data.len()
+                    )));
                 }
             }
             for i in 0..count {
@@ -173,16 +258,30 @@ impl Document {
         }
         if let Some(sp) = acc.get("sparse") {
             let n = sp.get("count").and_then(Value::as_u64).unwrap_or(0) as usize;
-            let ind = sp.get("indices").ok_or_else(|| self.err(format!("{what}.sparse.indices missing")))?;
-            let val = sp.get("values").ok_or_else(|| self.err(format!("{what}.sparse.values missing")))?;
-            let ibv = ind.get("bufferView").and_then(Value::as_u64).ok_or_else(|| self.err(format!("{what}.sparse.indices.bufferView missing")))?;
-            let ict = ind.get("componentType").and_then(Value::as_u64).unwrap_or(UNSIGNED_INT);
+            let ind = sp
+                .get("indices")
+                .ok_or_else(|| self.err(format!("{what}.sparse.indices missing")))?;
+            let val = sp
+                .get("values")
+                .ok_or_else(|| self.err(format!("{what}.sparse.values missing")))?;
+            let ibv = ind
+                .get("bufferView")
+                .and_then(Value::as_u64)
+                .ok_or_else(|| self.err(format!("{what}.sparse.indices.bufferView missing")))?;
+            let ict = ind
+                .get("componentType")
+                .and_then(Value::as_u64)
+                .unwrap_or(UNSIGNED_INT);
             let ioff = ind.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
-            let vbv = val.get("bufferView").and_then(Value::as_u64).ok_or_else(|| self.err(format!("{what}.sparse.values.bufferView missing")))?;
+            let vbv = val
+                .get("bufferView")
+                .and_then(Value::as_u64)
+                .ok_or_else(|| self.err(format!("{what}.sparse.values.bufferView missing")))?;
             let voff = val.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
             let (idata, _) = self.view_bytes(ibv as usize, &what)?;
             let (vdata, _) = self.view_bytes(vbv as usize, &what)?;
-            let isz = comp_size(ict).ok_or_else(|| self.err(format!("{what}.sparse.indices.componentType invalid")))?;
+            let isz = comp_size(ict)
+                .ok_or_else(|| self.err(format!("{what}.sparse.indices.componentType invalid")))?;
             if ioff + n * isz > idata.len() || voff + n * ncomp * csize > vdata.len() {
                 return Err(self.err(format!("{what}.sparse runs past its buffer views")));
             }
@@ -192,7 +291,8 @@ impl Document {
                     return Err(self.err(format!("{what}.sparse index {i} >= count {count}")));
                 }
                 for c in 0..ncomp {
-                    out[i * ncomp + c] = read_comp(&vdata[voff + (k * ncomp + c) * csize..], ctype, normalized);
+                    out[i * ncomp + c] =
+                        read_comp(&vdata[voff + (k * ncomp + c) * csize..], ctype, normalized);
                 }
             }
         }
@@ -204,13 +304,38 @@ impl Document {
 
     /// The bytes of a buffer view and its stride.
     fn view_bytes(&self, bv: usize, what: &str) -> Result<(&[u8], Option<usize>)> {
-        let v = self.array("bufferViews").get(bv).ok_or_else(|| self.err(format!("{what}: bufferViews[{bv}] does not exist")))?;
-        let b = v.get("buffer").and_then(Value::as_u64).ok_or_else(|| self.err(format!("bufferViews[{bv}].buffer missing")))? as usize;
+        let v = self
+            .array("bufferViews")
+            .get(bv)
+            .ok_or_else(|| self.err(format!("{what}: bufferViews[{bv}] does not exist")))?;
+        let b = v
+            .get("buffer")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| self.err(format!("bufferViews[{bv}].buffer missing")))?
+            as usize;
         let off = v.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
-        let len = v.get("byteLength").and_then(Value::as_u64).ok_or_else(|| self.err(format!("bufferViews[{bv}].byteLength missing")))? as usize;
-        let buf = self.buffers.get(b).ok_or_else(|| self.err(format!("bufferViews[{bv}].buffer {b} does not exist")))?;
-        let end = off.checked_add(len).filter(|&e| e <= buf.len()).ok_or_else(|| self.err(format!("bufferViews[{bv}] runs past the end of buffers[{b}]")))?;
-        let stride = v.get("byteStride").and_then(Value::as_u64).map(|s| s as usize).filter(|&s| s > 0);
+        let len = v
+            .get("byteLength")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| self.err(format!("bufferViews[{bv}].byteLength missing")))?
+            as usize;
+        let buf = self
+            .buffers
+            .get(b)
+            .ok_or_else(|| self.err(format!("bufferViews[{bv}].buffer {b} does not exist")))?;
+        let end = off
+            .checked_add(len)
+            .filter(|&e| e <= buf.len())
+            .ok_or_else(|| {
+                self.err(format!(
+                    "bufferViews[{bv}] runs past the end of buffers[{b}]"
+                ))
+            })?;
+        let stride = v
+            .get("byteStride")
+            .and_then(Value::as_u64)
+            .map(|s| s as usize)
+            .filter(|&s| s > 0);
         Ok((&buf[off..end], stride))
     }
 
@@ -224,9 +349,7 @@ impl Document {
             arr.push(json!({"byteLength": 0}));
         }
         let buf = &mut self.buffers[0];
-        while buf.len() % 4 != 0 {
-            buf.push(0);
-        }
+        buf.resize(buf.len().next_multiple_of(4), 0);
         let off = buf.len();
         for x in data {
             buf.extend_from_slice(&x.to_le_bytes());
@@ -261,13 +384,12 @@ impl Document {
     pub fn push_index_accessor(&mut self, idx: &[u32]) -> usize {
         if self.buffers.is_empty() {
             self.buffers.push(Vec::new());
-            self.json_array_mut("buffers").push(json!({"byteLength": 0}));
+            self.json_array_mut("buffers")
+                .push(json!({"byteLength": 0}));
         }
         let small = idx.iter().all(|&i| i < 65535);
         let buf = &mut self.buffers[0];
-        while buf.len() % 4 != 0 {
-            buf.push(0);
-        }
+        buf.resize(buf.len().next_multiple_of(4), 0);
         let off = buf.len();
         for &i in idx {
             if small {
@@ -290,12 +412,11 @@ impl Document {
     pub fn push_bytes_view(&mut self, bytes: &[u8]) -> usize {
         if self.buffers.is_empty() {
             self.buffers.push(Vec::new());
-            self.json_array_mut("buffers").push(json!({"byteLength": 0}));
+            self.json_array_mut("buffers")
+                .push(json!({"byteLength": 0}));
         }
         let buf = &mut self.buffers[0];
-        while buf.len() % 4 != 0 {
-            buf.push(0);
-        }
+        buf.resize(buf.len().next_multiple_of(4), 0);
         let off = buf.len();
         buf.extend_from_slice(bytes);
         self.sync_len();
@@ -313,8 +434,13 @@ impl Document {
     }
 
     pub fn json_array_mut(&mut self, key: &str) -> &mut Vec<Value> {
-        let obj = self.json.as_object_mut().expect("glTF root is an object (checked on load)");
-        let e = obj.entry(key.to_string()).or_insert_with(|| Value::Array(Vec::new()));
+        let obj = self
+            .json
+            .as_object_mut()
+            .expect("glTF root is an object (checked on load)");
+        let e = obj
+            .entry(key.to_string())
+            .or_insert_with(|| Value::Array(Vec::new()));
         if !e.is_array() {
             *e = Value::Array(Vec::new());
         }
@@ -327,9 +453,7 @@ impl Document {
         let mut merged: Vec<u8> = Vec::new();
         let mut bases = Vec::with_capacity(self.buffers.len());
         for b in &self.buffers {
-            while merged.len() % 16 != 0 {
-                merged.push(0);
-            }
+            merged.resize(merged.len().next_multiple_of(16), 0);
             bases.push(merged.len());
             merged.extend_from_slice(b);
         }
@@ -338,14 +462,21 @@ impl Document {
         for (i, v) in views.iter_mut().enumerate() {
             let b = v.get("buffer").and_then(Value::as_u64).unwrap_or(u64::MAX) as usize;
             if b >= nbuf {
-                return Err(Error::input_file(&self.source, format!("bufferViews[{i}].buffer {b} does not exist")));
+                return Err(Error::input_file(
+                    &self.source,
+                    format!("bufferViews[{i}].buffer {b} does not exist"),
+                ));
             }
             let off = v.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize + bases[b];
             v["buffer"] = json!(0);
             v["byteOffset"] = json!(off);
         }
         // Buffer 0 keeps its name/extras, loses its uri.
-        let mut b0 = self.array("buffers").first().cloned().unwrap_or_else(|| json!({}));
+        let mut b0 = self
+            .array("buffers")
+            .first()
+            .cloned()
+            .unwrap_or_else(|| json!({}));
         if let Some(o) = b0.as_object_mut() {
             o.remove("uri");
         }
@@ -362,7 +493,12 @@ impl Document {
                     .map(str::to_string)
                     .or(mime)
                     .or_else(|| sniff_mime(&bytes).map(str::to_string))
-                    .ok_or_else(|| Error::input_file(&self.source, format!("images[{i}]: cannot tell the image type of {uri:?}")))?;
+                    .ok_or_else(|| {
+                        Error::input_file(
+                            &self.source,
+                            format!("images[{i}]: cannot tell the image type of {uri:?}"),
+                        )
+                    })?;
                 let bv = self.push_bytes_view(&bytes);
                 let im = &mut self.json_array_mut("images")[i];
                 if let Some(o) = im.as_object_mut() {
@@ -386,20 +522,27 @@ impl Document {
         }
         // Empty top-level arrays are invalid glTF ("must have at least 1 item").
         if let Some(o) = self.json.as_object_mut() {
-            let empty: Vec<String> = o.iter().filter(|(_, v)| v.as_array().is_some_and(|a| a.is_empty())).map(|(k, _)| k.clone()).collect();
+            let empty: Vec<String> = o
+                .iter()
+                .filter(|(_, v)| v.as_array().is_some_and(|a| a.is_empty()))
+                .map(|(k, _)| k.clone())
+                .collect();
             for k in empty {
                 o.remove(&k);
             }
         }
         let mut js = serde_json::to_vec(&self.json).expect("a JSON value always serialises");
-        while js.len() % 4 != 0 {
-            js.push(b' ');
-        }
+        js.resize(js.len().next_multiple_of(4), b' ');
         let mut bin = self.buffers.first().cloned().unwrap_or_default();
-        while bin.len() % 4 != 0 {
-            bin.push(0);
-        }
-        let total = 12 + 8 + js.len() + if self.buffers.is_empty() { 0 } else { 8 + bin.len() };
+        bin.resize(bin.len().next_multiple_of(4), 0);
+        let total = 12
+            + 8
+            + js.len()
+            + if self.buffers.is_empty() {
+                0
+            } else {
+                8 + bin.len()
+            };
         let mut out = Vec::with_capacity(total);
         out.extend_from_slice(b"glTF");
         out.extend_from_slice(&2u32.to_le_bytes());
@@ -419,23 +562,48 @@ impl Document {
     pub fn new_empty(source: &Path) -> Document {
         let mut asset = Map::new();
         asset.insert("version".into(), json!("2.0"));
-        asset.insert("generator".into(), json!(concat!("sunbeam-mesh ", env!("CARGO_PKG_VERSION"))));
-        Document { json: json!({ "asset": Value::Object(asset) }), buffers: Vec::new(), base_dir: None, source: source.to_path_buf(), extra_inputs: Vec::new() }
+        asset.insert(
+            "generator".into(),
+            json!(concat!("sunbeam-mesh ", env!("CARGO_PKG_VERSION"))),
+        );
+        Document {
+            json: json!({ "asset": Value::Object(asset) }),
+            buffers: Vec::new(),
+            base_dir: None,
+            source: source.to_path_buf(),
+            extra_inputs: Vec::new(),
+        }
     }
 }
 
 fn parse_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<(&'a [u8], Option<&'a [u8]>)> {
-    let u32at = |o: usize| -> Option<u32> { bytes.get(o..o + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) };
+    let u32at = |o: usize| -> Option<u32> {
+        bytes
+            .get(o..o + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
     if bytes.len() < 20 {
-        return Err(bad(path, "GLB shorter than its 12-byte header and first chunk header"));
+        return Err(bad(
+            path,
+            "GLB shorter than its 12-byte header and first chunk header",
+        ));
     }
     let version = u32at(4).unwrap_or(0);
     if version != 2 {
-        return Err(bad(path, format!("GLB version {version}; only 2 is supported")));
+        return Err(bad(
+            path,
+            format!("GLB version {version}; only 2 is supported"),
+        ));
     }
     let total = u32at(8).unwrap_or(0) as usize;
     if total > bytes.len() {
-        return Err(bad(path, format!("GLB header says {total} bytes, the file has {} (truncated?)", bytes.len())));
+        return Err(bad(
+            path,
+            format!(
+                "GLB header says {total} bytes, the file has {} (truncated?)",
+                bytes.len()
+            ),
+        ));
     }
     let mut off = 12;
     let mut json = None;
@@ -444,7 +612,15 @@ fn parse_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<(&'a [u8], Option<&'a [
         let len = u32at(off).unwrap_or(0) as usize;
         let ty = u32at(off + 4).unwrap_or(0);
         let start = off + 8;
-        let end = start.checked_add(len).filter(|&e| e <= total).ok_or_else(|| bad(path, format!("GLB chunk at byte {off} runs past the end of the file")))?;
+        let end = start
+            .checked_add(len)
+            .filter(|&e| e <= total)
+            .ok_or_else(|| {
+                bad(
+                    path,
+                    format!("GLB chunk at byte {off} runs past the end of the file"),
+                )
+            })?;
         match ty {
             0x4E4F534A if json.is_none() => json = Some(&bytes[start..end]),
             0x004E4942 if bin.is_none() => bin = Some(&bytes[start..end]),
@@ -510,7 +686,10 @@ fn percent_decode(s: &str) -> String {
     let mut i = 0;
     while i < b.len() {
         if b[i] == b'%' && i + 2 < b.len() {
-            if let Some(v) = std::str::from_utf8(&b[i + 1..i + 3]).ok().and_then(|h| u8::from_str_radix(h, 16).ok()) {
+            if let Some(v) = std::str::from_utf8(&b[i + 1..i + 3])
+                .ok()
+                .and_then(|h| u8::from_str_radix(h, 16).ok())
+            {
                 out.push(v);
                 i += 3;
                 continue;

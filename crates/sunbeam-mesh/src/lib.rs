@@ -36,6 +36,8 @@
 //! [`bake::bake`] computes the field from an [`orient::Source`] and writes a GLB
 //! through [`gltf::Document`]; [`snake::generate`] makes the demo snake.
 
+#![allow(clippy::needless_range_loop)] // index loops over parallel per-vertex arrays read best
+
 pub mod bake;
 pub mod bvh;
 pub mod geom;
@@ -113,8 +115,10 @@ pub fn load_document(path: &Path) -> Result<Document> {
     let mut head = [0u8; 64];
     let n = {
         use std::io::Read;
-        let mut f = std::fs::File::open(path).map_err(|e| Error::input_file(path, format!("cannot open: {e}")))?;
-        f.read(&mut head).map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?
+        let mut f = std::fs::File::open(path)
+            .map_err(|e| Error::input_file(path, format!("cannot open: {e}")))?;
+        f.read(&mut head)
+            .map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?
     };
     let h = &head[..n];
     let text = String::from_utf8_lossy(h);
@@ -166,18 +170,30 @@ pub fn load_scene_mesh(path: &Path) -> Result<TriMesh> {
 
 /// [`load_scene_mesh`] on an already loaded document.
 pub fn scene_mesh(doc: &Document) -> Result<TriMesh> {
-    let mut out = TriMesh { has_uvs: true, ..Default::default() };
-    let mut cache: std::collections::HashMap<(usize, usize), Option<scene::Prim>> = Default::default();
+    let mut out = TriMesh {
+        has_uvs: true,
+        ..Default::default()
+    };
+    let mut cache: std::collections::HashMap<(usize, usize), Option<scene::Prim>> =
+        Default::default();
     for inst in scene::instances(doc) {
-        let nprim = doc.array("meshes").get(inst.mesh).and_then(|m| m.get("primitives")).and_then(|p| p.as_array()).map_or(0, |a| a.len());
-        let Some(x) = Xform::new(inst.world) else { continue }; // a zero scale hides the node
+        let nprim = doc
+            .array("meshes")
+            .get(inst.mesh)
+            .and_then(|m| m.get("primitives"))
+            .and_then(|p| p.as_array())
+            .map_or(0, |a| a.len());
+        let Some(x) = Xform::new(inst.world) else {
+            continue;
+        }; // a zero scale hides the node
         let mirror = if x.det < 0.0 { -1.0 } else { 1.0 };
         for k in 0..nprim {
-            if !cache.contains_key(&(inst.mesh, k)) {
-                let p = scene::read_primitive(doc, inst.mesh, k, 0)?;
-                cache.insert((inst.mesh, k), p);
+            if let std::collections::hash_map::Entry::Vacant(e) = cache.entry((inst.mesh, k)) {
+                e.insert(scene::read_primitive(doc, inst.mesh, k, 0)?);
             }
-            let Some(p) = cache[&(inst.mesh, k)].as_ref() else { continue };
+            let Some(p) = cache[&(inst.mesh, k)].as_ref() else {
+                continue;
+            };
             let nl = local_normals(p);
             let base = out.positions.len() as u32;
             let src = if p.orientation.is_some() {
@@ -189,7 +205,10 @@ pub fn scene_mesh(doc: &Document) -> Result<TriMesh> {
             };
             out.orientation_source = Some(out.orientation_source.map_or(src, |s| s.max(src)));
             out.has_uvs &= p.uvs.is_some();
-            let dpdu = p.uvs.as_ref().map(|uv| geom::uv_derivatives(&p.positions, uv, &p.triangles).0);
+            let dpdu = p
+                .uvs
+                .as_ref()
+                .map(|uv| geom::uv_derivatives(&p.positions, uv, &p.triangles).0);
             for i in 0..p.positions.len() {
                 let pw = x.point(p.positions[i]);
                 let nw = x.normal(nl[i]).unwrap_or([0.0, 0.0, 1.0]);
@@ -199,10 +218,13 @@ pub fn scene_mesh(doc: &Document) -> Result<TriMesh> {
                     .map(|o| o[i])
                     .or_else(|| p.tangents.as_ref().map(|t| [t[i][0], t[i][1], t[i][2]]))
                     .or_else(|| dpdu.as_ref().map(|d| d[i]));
-                let ow = local_dir.and_then(|d| normalize(project(x.tangent(d), nw))).unwrap_or_else(|| any_perpendicular(nw));
+                let ow = local_dir
+                    .and_then(|d| normalize(project(x.tangent(d), nw)))
+                    .unwrap_or_else(|| any_perpendicular(nw));
                 let tw = match &p.tangents {
                     Some(t) => {
-                        let tt = normalize(project(x.tangent([t[i][0], t[i][1], t[i][2]]), nw)).unwrap_or(ow);
+                        let tt = normalize(project(x.tangent([t[i][0], t[i][1], t[i][2]]), nw))
+                            .unwrap_or(ow);
                         let w = if t[i][3] < 0.0 { -1.0 } else { 1.0 } * mirror;
                         [tt[0], tt[1], tt[2], w]
                     }
@@ -210,7 +232,11 @@ pub fn scene_mesh(doc: &Document) -> Result<TriMesh> {
                 };
                 out.positions.push(pw.map(|v| v as f32));
                 out.normals.push(nw.map(|v| v as f32));
-                out.uvs.push(p.uvs.as_ref().map_or([0.0; 2], |u| [u[i][0] as f32, u[i][1] as f32]));
+                out.uvs.push(
+                    p.uvs
+                        .as_ref()
+                        .map_or([0.0; 2], |u| [u[i][0] as f32, u[i][1] as f32]),
+                );
                 out.orientation.push(ow.map(|v| v as f32));
                 out.tangents.push(tw.map(|v| v as f32));
             }

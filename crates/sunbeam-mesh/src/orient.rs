@@ -8,7 +8,10 @@
 
 use crate::geom::{normalize, sub, V3};
 use serde_json::Value;
-use spade::{Barycentric, DelaunayTriangulation, FloatTriangulation, HasPosition, NaturalNeighbor, Point2, Triangulation};
+use spade::{
+    Barycentric, DelaunayTriangulation, FloatTriangulation, HasPosition, NaturalNeighbor, Point2,
+    Triangulation,
+};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use sunbeam_common::{Error, Result};
@@ -61,12 +64,19 @@ impl Source {
 pub fn parse_axis(s: &str) -> Result<V3> {
     let v: Vec<f64> = s
         .split(',')
-        .map(|t| t.trim().parse::<f64>().map_err(|_| Error::usage(format!("--axis {s:?}: {t:?} is not a number"))))
+        .map(|t| {
+            t.trim()
+                .parse::<f64>()
+                .map_err(|_| Error::usage(format!("--axis {s:?}: {t:?} is not a number")))
+        })
         .collect::<Result<_>>()?;
     if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
-        return Err(Error::usage(format!("--axis {s:?}: need three finite numbers X,Y,Z")));
+        return Err(Error::usage(format!(
+            "--axis {s:?}: need three finite numbers X,Y,Z"
+        )));
     }
-    normalize([v[0], v[1], v[2]]).ok_or_else(|| Error::usage(format!("--axis {s:?} is the zero vector")))
+    normalize([v[0], v[1], v[2]])
+        .ok_or_else(|| Error::usage(format!("--axis {s:?} is the zero vector")))
 }
 
 // ---------------------------------------------------------------- curve
@@ -78,19 +88,34 @@ pub struct Curve {
     pub points: Vec<V3>,
     /// Unit tangent at each point (average of the adjacent segments).
     tangents: Vec<V3>,
+    /// Segments as degenerate triangles `[a, b, b]` for nearest-point queries.
+    bvh: crate::bvh::Bvh,
 }
 
 impl Curve {
     /// Read `{"points": [[x,y,z], ...]}` or a bare `[[x,y,z], ...]`.
     pub fn load(path: &Path) -> Result<Curve> {
-        let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
-        let v: Value = serde_json::from_slice(&bytes).map_err(|e| Error::input_file(path, format!("not valid JSON: {e}")))?;
-        let arr = v.get("points").unwrap_or(&v).as_array().ok_or_else(|| Error::input_file(path, "expected {\"points\": [[x,y,z], ...]} or [[x,y,z], ...]"))?;
+        let bytes = std::fs::read(path)
+            .map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
+        let v: Value = serde_json::from_slice(&bytes)
+            .map_err(|e| Error::input_file(path, format!("not valid JSON: {e}")))?;
+        let arr = v.get("points").unwrap_or(&v).as_array().ok_or_else(|| {
+            Error::input_file(
+                path,
+                "expected {\"points\": [[x,y,z], ...]} or [[x,y,z], ...]",
+            )
+        })?;
         let mut pts = Vec::with_capacity(arr.len());
         for (i, p) in arr.iter().enumerate() {
-            let c: Vec<f64> = p.as_array().map(|a| a.iter().filter_map(Value::as_f64).collect()).unwrap_or_default();
+            let c: Vec<f64> = p
+                .as_array()
+                .map(|a| a.iter().filter_map(Value::as_f64).collect())
+                .unwrap_or_default();
             if c.len() != 3 || c.iter().any(|x| !x.is_finite()) {
-                return Err(Error::input_file(path, format!("points[{i}] is not three finite numbers")));
+                return Err(Error::input_file(
+                    path,
+                    format!("points[{i}] is not three finite numbers"),
+                ));
             }
             pts.push([c[0], c[1], c[2]]);
         }
@@ -106,9 +131,15 @@ impl Curve {
             }
         }
         if points.len() < 2 {
-            return Err(Error::input_file(path, "a curve needs at least two distinct points"));
+            return Err(Error::input_file(
+                path,
+                "a curve needs at least two distinct points",
+            ));
         }
-        let seg: Vec<V3> = points.windows(2).map(|w| normalize(sub(w[1], w[0])).unwrap_or([1.0, 0.0, 0.0])).collect();
+        let seg: Vec<V3> = points
+            .windows(2)
+            .map(|w| normalize(sub(w[1], w[0])).unwrap_or([1.0, 0.0, 0.0]))
+            .collect();
         let n = points.len();
         let tangents = (0..n)
             .map(|i| {
@@ -118,18 +149,42 @@ impl Curve {
                 normalize(crate::geom::add(a, b)).unwrap_or(a)
             })
             .collect();
-        Ok(Curve { path: path.to_path_buf(), points, tangents })
+        let bvh = crate::bvh::Bvh::new(points.windows(2).map(|w| [w[0], w[1], w[1]]).collect());
+        Ok(Curve {
+            path: path.to_path_buf(),
+            points,
+            tangents,
+            bvh,
+        })
     }
 
     /// Tangent at the nearest point of the polyline to `p`, blended linearly
     /// between the point tangents so the field is continuous along the spine.
     pub fn tangent_at(&self, p: V3) -> V3 {
+        let (i, s) = match self.bvh.closest(p) {
+            // Barycentrics of [a, b, b]: the parameter along the segment is b1 + b2.
+            Some(h) => (h.tri, (h.bary[1] + h.bary[2]).clamp(0.0, 1.0)),
+            None => (0, 0.0),
+        };
+        let t = crate::geom::add(
+            crate::geom::scale(self.tangents[i], 1.0 - s),
+            crate::geom::scale(self.tangents[i + 1], s),
+        );
+        normalize(t).unwrap_or(self.tangents[i])
+    }
+
+    /// The same by brute force over all segments (a check for the BVH path).
+    pub fn tangent_at_brute_force(&self, p: V3) -> V3 {
         let mut best = (f64::INFINITY, 0usize, 0.0f64);
         for i in 0..self.points.len() - 1 {
             let (a, b) = (self.points[i], self.points[i + 1]);
             let ab = sub(b, a);
             let l2 = crate::geom::dot(ab, ab);
-            let s = if l2 > 0.0 { (crate::geom::dot(sub(p, a), ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+            let s = if l2 > 0.0 {
+                (crate::geom::dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             let q = crate::geom::add(a, crate::geom::scale(ab, s));
             let d = sub(p, q);
             let d2 = crate::geom::dot(d, d);
@@ -138,7 +193,10 @@ impl Curve {
             }
         }
         let (_, i, s) = best;
-        let t = crate::geom::add(crate::geom::scale(self.tangents[i], 1.0 - s), crate::geom::scale(self.tangents[i + 1], s));
+        let t = crate::geom::add(
+            crate::geom::scale(self.tangents[i], 1.0 - s),
+            crate::geom::scale(self.tangents[i + 1], s),
+        );
         normalize(t).unwrap_or(self.tangents[i])
     }
 }
@@ -175,44 +233,82 @@ impl Samples {
     /// extra columns ignored) or JSON (`[{...}]` or `{"samples": [{...}]}` with
     /// the same field names). NaN or infinite numbers are an error naming the row.
     pub fn load(path: &Path) -> Result<Samples> {
-        let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
+        let bytes = std::fs::read(path)
+            .map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
         let text = String::from_utf8_lossy(&bytes);
         let t = text.trim_start_matches('\u{feff}').trim_start();
-        let items = if t.starts_with('[') || t.starts_with('{') { Self::parse_json(path, t)? } else { Self::parse_csv(path, t)? };
+        let items = if t.starts_with('[') || t.starts_with('{') {
+            Self::parse_json(path, t)?
+        } else {
+            Self::parse_csv(path, t)?
+        };
         if items.is_empty() {
             return Err(Error::input_file(path, "no samples"));
         }
-        Ok(Samples { path: path.to_path_buf(), items })
+        Ok(Samples {
+            path: path.to_path_buf(),
+            items,
+        })
     }
 
-    fn make(path: &Path, line: usize, get: &dyn Fn(&str) -> Option<f64>, xyz: bool) -> Result<Sample> {
+    fn make(
+        path: &Path,
+        line: usize,
+        get: &dyn Fn(&str) -> Option<f64>,
+        xyz: bool,
+    ) -> Result<Sample> {
         let names: &[&str] = if xyz { &XYZ } else { &UVA };
         let mut v = [0.0; 6];
         for (i, n) in names.iter().enumerate() {
-            let x = get(n).ok_or_else(|| Error::input_file(path, format!("row {line}: field {n} missing or not a number")))?;
+            let x = get(n).ok_or_else(|| {
+                Error::input_file(
+                    path,
+                    format!("row {line}: field {n} missing or not a number"),
+                )
+            })?;
             if !x.is_finite() {
-                return Err(Error::input_file(path, format!("row {line}: {n} is {x} (NaN or infinite)")));
+                return Err(Error::input_file(
+                    path,
+                    format!("row {line}: {n} is {x} (NaN or infinite)"),
+                ));
             }
             v[i] = x;
         }
         Ok(Sample {
             line,
             at: if xyz {
-                SampleAt::Xyz { p: [v[0], v[1], v[2]], d: [v[3], v[4], v[5]] }
+                SampleAt::Xyz {
+                    p: [v[0], v[1], v[2]],
+                    d: [v[3], v[4], v[5]],
+                }
             } else {
-                SampleAt::Uv { uv: [v[0], v[1]], angle: v[2].to_radians() }
+                SampleAt::Uv {
+                    uv: [v[0], v[1]],
+                    angle: v[2].to_radians(),
+                }
             },
         })
     }
 
     fn parse_csv(path: &Path, t: &str) -> Result<Vec<Sample>> {
-        let mut lines = t.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-        let (_, header) = lines.next().ok_or_else(|| Error::input_file(path, "empty CSV"))?;
-        let cols: Vec<String> = header.split(',').map(|c| c.trim().trim_matches('"').to_ascii_lowercase()).collect();
+        let mut lines = t
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+        let (_, header) = lines
+            .next()
+            .ok_or_else(|| Error::input_file(path, "empty CSV"))?;
+        let cols: Vec<String> = header
+            .split(',')
+            .map(|c| c.trim().trim_matches('"').to_ascii_lowercase())
+            .collect();
         let has = |n: &str| cols.iter().any(|c| c == n);
         let xyz = XYZ.iter().all(|n| has(n));
         if !xyz && !UVA.iter().all(|n| has(n)) {
-            return Err(Error::input_file(path, format!("CSV header {header:?} must name x,y,z,dx,dy,dz or u,v,angle_deg")));
+            return Err(Error::input_file(
+                path,
+                format!("CSV header {header:?} must name x,y,z,dx,dy,dz or u,v,angle_deg"),
+            ));
         }
         let mut out = Vec::new();
         for (i, l) in lines {
@@ -231,8 +327,12 @@ impl Samples {
     }
 
     fn parse_json(path: &Path, t: &str) -> Result<Vec<Sample>> {
-        let v: Value = serde_json::from_str(t).map_err(|e| Error::input_file(path, format!("not valid JSON: {e}")))?;
-        let arr = v.get("samples").unwrap_or(&v).as_array().ok_or_else(|| Error::input_file(path, "expected [{...}] or {\"samples\": [{...}]}"))?;
+        let v: Value = serde_json::from_str(t)
+            .map_err(|e| Error::input_file(path, format!("not valid JSON: {e}")))?;
+        let arr =
+            v.get("samples").unwrap_or(&v).as_array().ok_or_else(|| {
+                Error::input_file(path, "expected [{...}] or {\"samples\": [{...}]}")
+            })?;
         let mut out = Vec::new();
         for (i, s) in arr.iter().enumerate() {
             let xyz = s.get("x").is_some();
@@ -279,7 +379,11 @@ enum Layout {
     /// One sample (or all at one point): a constant.
     Constant(f64, f64),
     /// All samples on a line: piecewise linear along it, clamped at the ends.
-    Line { origin: [f64; 2], dir: [f64; 2], pts: Vec<(f64, f64, f64)> },
+    Line {
+        origin: [f64; 2],
+        dir: [f64; 2],
+        pts: Vec<(f64, f64, f64)>,
+    },
     Tri(DelaunayTriangulation<Node>),
 }
 
@@ -304,8 +408,14 @@ impl AxialField {
         let mut merged_duplicates = 0;
         let mut dropped = Vec::new();
         for &(tag, p, a) in samples {
-            if spade::validate_coordinate(p[0]).is_err() || spade::validate_coordinate(p[1]).is_err() || !a.is_finite() {
-                dropped.push((tag, "coordinate out of the range spade accepts (or not finite)".to_string()));
+            if spade::validate_coordinate(p[0]).is_err()
+                || spade::validate_coordinate(p[1]).is_err()
+                || !a.is_finite()
+            {
+                dropped.push((
+                    tag,
+                    "coordinate out of the range spade accepts (or not finite)".to_string(),
+                ));
                 continue;
             }
             let k = [(p[0] + 0.0).to_bits(), (p[1] + 0.0).to_bits()];
@@ -326,10 +436,18 @@ impl AxialField {
         for (tag, p, c, s) in merged {
             let r = c.hypot(s);
             if r < 1e-9 {
-                dropped.push((tag, "duplicates at one position whose directions cancel (e.g. perpendicular)".to_string()));
+                dropped.push((
+                    tag,
+                    "duplicates at one position whose directions cancel (e.g. perpendicular)"
+                        .to_string(),
+                ));
                 continue;
             }
-            nodes.push(Node { p: Point2::new(p[0], p[1]), c: c / r, s: s / r });
+            nodes.push(Node {
+                p: Point2::new(p[0], p[1]),
+                c: c / r,
+                s: s / r,
+            });
         }
         let used = nodes.len();
         let layout = match nodes.len() {
@@ -338,7 +456,9 @@ impl AxialField {
             _ => {
                 let tri = DelaunayTriangulation::<Node>::bulk_load_stable(nodes.clone()).ok();
                 match tri {
-                    Some(t) if !t.all_vertices_on_line() && t.num_inner_faces() > 0 => Layout::Tri(t),
+                    Some(t) if !t.all_vertices_on_line() && t.num_inner_faces() > 0 => {
+                        Layout::Tri(t)
+                    }
                     _ => {
                         let o = [nodes[0].p.x, nodes[0].p.y];
                         let far = nodes
@@ -347,15 +467,32 @@ impl AxialField {
                             .max_by(|a, b| a[0].hypot(a[1]).total_cmp(&b[0].hypot(b[1])))
                             .unwrap_or([1.0, 0.0]);
                         let l = far[0].hypot(far[1]);
-                        let dir = if l > 0.0 { [far[0] / l, far[1] / l] } else { [1.0, 0.0] };
-                        let mut pts: Vec<(f64, f64, f64)> = nodes.iter().map(|n| ((n.p.x - o[0]) * dir[0] + (n.p.y - o[1]) * dir[1], n.c, n.s)).collect();
+                        let dir = if l > 0.0 {
+                            [far[0] / l, far[1] / l]
+                        } else {
+                            [1.0, 0.0]
+                        };
+                        let mut pts: Vec<(f64, f64, f64)> = nodes
+                            .iter()
+                            .map(|n| ((n.p.x - o[0]) * dir[0] + (n.p.y - o[1]) * dir[1], n.c, n.s))
+                            .collect();
                         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-                        Layout::Line { origin: o, dir, pts }
+                        Layout::Line {
+                            origin: o,
+                            dir,
+                            pts,
+                        }
                     }
                 }
             }
         };
-        Some(AxialField { layout, interp, merged_duplicates, dropped, used })
+        Some(AxialField {
+            layout,
+            interp,
+            merged_duplicates,
+            dropped,
+            used,
+        })
     }
 
     /// A reusable evaluator (holds spade's scratch buffers; one per thread).
@@ -365,14 +502,21 @@ impl AxialField {
             (Layout::Tri(t), Interp::Linear) => (None, Some(t.barycentric())),
             _ => (None, None),
         };
-        Evaluator { f: self, w: Vec::new(), nn, bc }
+        Evaluator {
+            f: self,
+            w: Vec::new(),
+            nn,
+            bc,
+        }
     }
 
     /// Whether the samples lie on one line (or one point).
     pub fn degenerate_layout(&self) -> Option<&'static str> {
         match self.layout {
             Layout::Constant(..) => Some("a single sample position: constant field"),
-            Layout::Line { .. } => Some("collinear samples: linear along the line, constant across it"),
+            Layout::Line { .. } => {
+                Some("collinear samples: linear along the line, constant across it")
+            }
             Layout::Tri(_) => None,
         }
     }
@@ -389,7 +533,10 @@ fn finish(c: f64, s: f64, extrapolated: bool) -> AxialValue {
     if c.hypot(s) < 1e-12 {
         AxialValue::Cancelled
     } else {
-        AxialValue::Angle { angle: 0.5 * s.atan2(c), extrapolated }
+        AxialValue::Angle {
+            angle: 0.5 * s.atan2(c),
+            extrapolated,
+        }
     }
 }
 
@@ -406,7 +553,11 @@ impl Evaluator<'_> {
                     finish(pts[k - 1].1, pts[k - 1].2, x > pts[k - 1].0)
                 } else {
                     let (a, b) = (pts[k - 1], pts[k]);
-                    let t = if b.0 > a.0 { (x - a.0) / (b.0 - a.0) } else { 0.0 };
+                    let t = if b.0 > a.0 {
+                        (x - a.0) / (b.0 - a.0)
+                    } else {
+                        0.0
+                    };
                     finish(a.1 + t * (b.1 - a.1), a.2 + t * (b.2 - a.2), false)
                 }
             }

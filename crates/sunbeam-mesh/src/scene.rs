@@ -21,16 +21,28 @@ pub struct Prim {
 }
 
 fn attr(p: &Value, name: &str) -> Option<usize> {
-    p.get("attributes").and_then(|a| a.get(name)).and_then(Value::as_u64).map(|x| x as usize)
+    p.get("attributes")
+        .and_then(|a| a.get(name))
+        .and_then(Value::as_u64)
+        .map(|x| x as usize)
 }
 
 fn to_v3(doc: &Document, acc: usize, what: &str, n: usize) -> Result<Vec<V3>> {
     let (d, c) = doc.read_accessor(acc)?;
     if c != 3 {
-        return Err(crate::gltf::bad(&doc.source, format!("{what} accessor {acc} is not VEC3")));
+        return Err(crate::gltf::bad(
+            &doc.source,
+            format!("{what} accessor {acc} is not VEC3"),
+        ));
     }
     if d.len() / 3 != n {
-        return Err(crate::gltf::bad(&doc.source, format!("{what} accessor {acc} has {} elements, POSITION has {n}", d.len() / 3)));
+        return Err(crate::gltf::bad(
+            &doc.source,
+            format!(
+                "{what} accessor {acc} has {} elements, POSITION has {n}",
+                d.len() / 3
+            ),
+        ));
     }
     Ok(d.chunks(3).map(|c| [c[0], c[1], c[2]]).collect())
 }
@@ -54,22 +66,33 @@ pub fn read_primitive(doc: &Document, m: usize, k: usize, uv_set: usize) -> Resu
     if !(4..=6).contains(&mode) {
         return Ok(None);
     }
-    let pacc = attr(p, "POSITION").ok_or_else(|| crate::gltf::bad(&doc.source, format!("{what} has no POSITION")))?;
+    let pacc = attr(p, "POSITION")
+        .ok_or_else(|| crate::gltf::bad(&doc.source, format!("{what} has no POSITION")))?;
     let positions: Vec<V3> = {
         let (d, c) = doc.read_accessor(pacc)?;
         if c != 3 {
-            return Err(crate::gltf::bad(&doc.source, format!("{what}.POSITION is not VEC3")));
+            return Err(crate::gltf::bad(
+                &doc.source,
+                format!("{what}.POSITION is not VEC3"),
+            ));
         }
         d.chunks(3).map(|c| [c[0], c[1], c[2]]).collect()
     };
     let n = positions.len();
-    let normals = attr(p, "NORMAL").map(|a| to_v3(doc, a, &format!("{what}.NORMAL"), n)).transpose()?;
-    let orientation = attr(p, "_ORIENTATION").map(|a| to_v3(doc, a, &format!("{what}._ORIENTATION"), n)).transpose()?;
+    let normals = attr(p, "NORMAL")
+        .map(|a| to_v3(doc, a, &format!("{what}.NORMAL"), n))
+        .transpose()?;
+    let orientation = attr(p, "_ORIENTATION")
+        .map(|a| to_v3(doc, a, &format!("{what}._ORIENTATION"), n))
+        .transpose()?;
     let uvs = match attr(p, &format!("TEXCOORD_{uv_set}")) {
         Some(a) => {
             let (d, c) = doc.read_accessor(a)?;
             if c != 2 || d.len() / 2 != n {
-                return Err(crate::gltf::bad(&doc.source, format!("{what}.TEXCOORD_{uv_set} is not VEC2 with one element per vertex")));
+                return Err(crate::gltf::bad(
+                    &doc.source,
+                    format!("{what}.TEXCOORD_{uv_set} is not VEC2 with one element per vertex"),
+                ));
             }
             Some(d.chunks(2).map(|c| [c[0], c[1]]).collect())
         }
@@ -79,7 +102,10 @@ pub fn read_primitive(doc: &Document, m: usize, k: usize, uv_set: usize) -> Resu
         Some(a) => {
             let (d, c) = doc.read_accessor(a)?;
             if c != 4 || d.len() / 4 != n {
-                return Err(crate::gltf::bad(&doc.source, format!("{what}.TANGENT is not VEC4 with one element per vertex")));
+                return Err(crate::gltf::bad(
+                    &doc.source,
+                    format!("{what}.TANGENT is not VEC4 with one element per vertex"),
+                ));
             }
             Some(d.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
         }
@@ -89,14 +115,20 @@ pub fn read_primitive(doc: &Document, m: usize, k: usize, uv_set: usize) -> Resu
         Some(a) => {
             let (d, c) = doc.read_accessor(a as usize)?;
             if c != 1 {
-                return Err(crate::gltf::bad(&doc.source, format!("{what}.indices is not SCALAR")));
+                return Err(crate::gltf::bad(
+                    &doc.source,
+                    format!("{what}.indices is not SCALAR"),
+                ));
             }
             d.into_iter().map(|x| x as u32).collect()
         }
         None => (0..n as u32).collect(),
     };
     if let Some(bad_i) = idx.iter().find(|&&i| i as usize >= n) {
-        return Err(crate::gltf::bad(&doc.source, format!("{what}: index {bad_i} >= vertex count {n}")));
+        return Err(crate::gltf::bad(
+            &doc.source,
+            format!("{what}: index {bad_i} >= vertex count {n}"),
+        ));
     }
     let mut triangles = Vec::new();
     match mode {
@@ -116,8 +148,21 @@ pub fn read_primitive(doc: &Document, m: usize, k: usize, uv_set: usize) -> Resu
             }
         }
     }
-    let material = p.get("material").and_then(Value::as_u64).map(|x| x as usize);
-    Ok(Some(Prim { mesh: m, prim: k, positions, normals, uvs, tangents, orientation, triangles, material }))
+    let material = p
+        .get("material")
+        .and_then(Value::as_u64)
+        .map(|x| x as usize);
+    Ok(Some(Prim {
+        mesh: m,
+        prim: k,
+        positions,
+        normals,
+        uvs,
+        tangents,
+        orientation,
+        triangles,
+        material,
+    }))
 }
 
 /// One placement of a mesh in the scene.
@@ -141,14 +186,22 @@ fn node_local(n: &Value) -> Mat4 {
     let f = |key: &str, def: &[f64]| -> Vec<f64> {
         n.get(key)
             .and_then(Value::as_array)
-            .map(|a| a.iter().map(|x| x.as_f64().unwrap_or(0.0)).collect::<Vec<_>>())
+            .map(|a| {
+                a.iter()
+                    .map(|x| x.as_f64().unwrap_or(0.0))
+                    .collect::<Vec<_>>()
+            })
             .filter(|a| a.len() == def.len())
             .unwrap_or_else(|| def.to_vec())
     };
     let t = f("translation", &[0., 0., 0.]);
     let r = f("rotation", &[0., 0., 0., 1.]);
     let s = f("scale", &[1., 1., 1.]);
-    Mat4::from_trs([t[0], t[1], t[2]], [r[0], r[1], r[2], r[3]], [s[0], s[1], s[2]])
+    Mat4::from_trs(
+        [t[0], t[1], t[2]],
+        [r[0], r[1], r[2], r[3]],
+        [s[0], s[1], s[2]],
+    )
 }
 
 /// Every mesh instance of the default scene (`scene`, else scene 0, else every
@@ -157,13 +210,32 @@ pub fn instances(doc: &Document) -> Vec<Instance> {
     let nodes = doc.array("nodes");
     let roots: Vec<usize> = {
         let scenes = doc.array("scenes");
-        let si = doc.json.get("scene").and_then(Value::as_u64).map(|x| x as usize).unwrap_or(0);
-        match scenes.get(si).and_then(|s| s.get("nodes")).and_then(Value::as_array) {
-            Some(a) => a.iter().filter_map(Value::as_u64).map(|x| x as usize).collect(),
+        let si = doc
+            .json
+            .get("scene")
+            .and_then(Value::as_u64)
+            .map(|x| x as usize)
+            .unwrap_or(0);
+        match scenes
+            .get(si)
+            .and_then(|s| s.get("nodes"))
+            .and_then(Value::as_array)
+        {
+            Some(a) => a
+                .iter()
+                .filter_map(Value::as_u64)
+                .map(|x| x as usize)
+                .collect(),
             None => {
                 let mut is_child = vec![false; nodes.len()];
                 for n in nodes {
-                    for c in n.get("children").and_then(Value::as_array).into_iter().flatten().filter_map(Value::as_u64) {
+                    for c in n
+                        .get("children")
+                        .and_then(Value::as_array)
+                        .into_iter()
+                        .flatten()
+                        .filter_map(Value::as_u64)
+                    {
                         if let Some(x) = is_child.get_mut(c as usize) {
                             *x = true;
                         }
@@ -175,7 +247,11 @@ pub fn instances(doc: &Document) -> Vec<Instance> {
     };
     let mut out = Vec::new();
     let mut visited = vec![false; nodes.len()];
-    let mut stack: Vec<(usize, Mat4)> = roots.into_iter().rev().map(|r| (r, Mat4::IDENTITY)).collect();
+    let mut stack: Vec<(usize, Mat4)> = roots
+        .into_iter()
+        .rev()
+        .map(|r| (r, Mat4::IDENTITY))
+        .collect();
     while let Some((i, parent)) = stack.pop() {
         let Some(n) = nodes.get(i) else { continue };
         if std::mem::replace(&mut visited[i], true) {
@@ -183,9 +259,20 @@ pub fn instances(doc: &Document) -> Vec<Instance> {
         }
         let world = parent.mul(&node_local(n));
         if let Some(m) = n.get("mesh").and_then(Value::as_u64) {
-            out.push(Instance { node: i, mesh: m as usize, world });
+            out.push(Instance {
+                node: i,
+                mesh: m as usize,
+                world,
+            });
         }
-        let children: Vec<usize> = n.get("children").and_then(Value::as_array).into_iter().flatten().filter_map(Value::as_u64).map(|x| x as usize).collect();
+        let children: Vec<usize> = n
+            .get("children")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .filter_map(Value::as_u64)
+            .map(|x| x as usize)
+            .collect();
         for c in children.into_iter().rev() {
             stack.push((c, world));
         }

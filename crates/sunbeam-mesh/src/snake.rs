@@ -28,7 +28,12 @@ pub struct SnakeParams {
 impl Default for SnakeParams {
     /// About 29k vertices.
     fn default() -> Self {
-        SnakeParams { rings: 600, segments: 48, length: 1.0, radius: 0.03 }
+        SnakeParams {
+            rings: 600,
+            segments: 48,
+            length: 1.0,
+            radius: 0.03,
+        }
     }
 }
 
@@ -37,7 +42,11 @@ impl SnakeParams {
     pub fn with_detail(detail: f64) -> Self {
         let d = SnakeParams::default();
         let k = detail.clamp(0.1, 100.0);
-        SnakeParams { rings: ((d.rings as f64 * k).round() as usize).max(8), segments: ((d.segments as f64 * k).round() as usize).max(3), ..d }
+        SnakeParams {
+            rings: ((d.rings as f64 * k).round() as usize).max(8),
+            segments: ((d.segments as f64 * k).round() as usize).max(3),
+            ..d
+        }
     }
     pub fn vertex_count(&self) -> usize {
         self.rings * (self.segments + 1) + 2
@@ -50,7 +59,11 @@ fn controls(len: f64) -> Vec<V3> {
     (0..n)
         .map(|i| {
             let s = i as f64 / (n - 1) as f64;
-            [(s - 0.5) * 0.85 * len, 0.12 * len * (std::f64::consts::TAU * 1.25 * s).sin(), 0.01 * len * (std::f64::consts::TAU * 2.0 * s).sin()]
+            [
+                (s - 0.5) * 0.85 * len,
+                0.12 * len * (std::f64::consts::TAU * 1.25 * s).sin(),
+                0.01 * len * (std::f64::consts::TAU * 2.0 * s).sin(),
+            ]
         })
         .collect()
 }
@@ -70,16 +83,28 @@ fn spline(c: &[V3], s: f64) -> V3 {
         }
     };
     let (p0, p1, p2, p3) = (
-        if i == 0 { sub(scale(c[0], 2.0), c[1]) } else { p(i as isize - 1) },
+        if i == 0 {
+            sub(scale(c[0], 2.0), c[1])
+        } else {
+            p(i as isize - 1)
+        },
         p(i as isize),
         p(i as isize + 1),
-        if i + 2 > segs { sub(scale(c[segs], 2.0), c[segs - 1]) } else { p(i as isize + 2) },
+        if i + 2 > segs {
+            sub(scale(c[segs], 2.0), c[segs - 1])
+        } else {
+            p(i as isize + 2)
+        },
     );
     let t2 = t * t;
     let t3 = t2 * t;
     let mut out = [0.0; 3];
     for k in 0..3 {
-        out[k] = 0.5 * (2.0 * p1[k] + (-p0[k] + p2[k]) * t + (2.0 * p0[k] - 5.0 * p1[k] + 4.0 * p2[k] - p3[k]) * t2 + (-p0[k] + 3.0 * p1[k] - 3.0 * p2[k] + p3[k]) * t3);
+        out[k] = 0.5
+            * (2.0 * p1[k]
+                + (-p0[k] + p2[k]) * t
+                + (2.0 * p0[k] - 5.0 * p1[k] + 4.0 * p2[k] - p3[k]) * t2
+                + (-p0[k] + 3.0 * p1[k] - 3.0 * p2[k] + p3[k]) * t3);
     }
     out
 }
@@ -91,8 +116,13 @@ fn radius(s: f64, r: f64) -> f64 {
         t * t * (3.0 - 2.0 * t)
     };
     let tail = sm(0.0, 0.45, s).powf(0.8);
-    let head = if s > 0.93 { (1.0 - ((s - 0.93) / 0.07).powi(2)).max(0.0).sqrt() } else { 1.0 };
-    let neck = 1.0 - 0.12 * (-((s - 0.9) / 0.025).powi(2)).exp() + 0.1 * (-((s - 0.955) / 0.025).powi(2)).exp();
+    let head = if s > 0.93 {
+        (1.0 - ((s - 0.93) / 0.07).powi(2)).max(0.0).sqrt()
+    } else {
+        1.0
+    };
+    let neck = 1.0 - 0.12 * (-((s - 0.9) / 0.025).powi(2)).exp()
+        + 0.1 * (-((s - 0.955) / 0.025).powi(2)).exp();
     r * tail * head * neck
 }
 
@@ -137,7 +167,11 @@ pub fn generate(p: &SnakeParams) -> Document {
             let tn = tangent(i);
             let v2 = sub(tn, tl);
             let c2 = dot(v2, v2);
-            up = if c2 > 0.0 { sub(rl, scale(v2, 2.0 / c2 * dot(v2, rl))) } else { rl };
+            up = if c2 > 0.0 {
+                sub(rl, scale(v2, 2.0 / c2 * dot(v2, rl)))
+            } else {
+                rl
+            };
             up = normalize(sub(up, scale(tn, dot(up, tn)))).unwrap_or(up);
         }
         ups.push(up);
@@ -187,9 +221,20 @@ pub fn generate(p: &SnakeParams) -> Document {
     let tris: Vec<[u32; 3]> = idx.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
     let mid = (rings / 2) as u32 * row + (seg as u32 / 2);
     let outward = sub(pos[mid as usize], centres[rings / 2]);
-    let t = tris.iter().find(|t| t[0] == mid).copied().unwrap_or(tris[0]);
-    let fnrm = cross(sub(pos[t[1] as usize], pos[t[0] as usize]), sub(pos[t[2] as usize], pos[t[0] as usize]));
-    let tris: Vec<[u32; 3]> = if dot(fnrm, outward) < 0.0 { tris.iter().map(|t| [t[0], t[2], t[1]]).collect() } else { tris };
+    let t = tris
+        .iter()
+        .find(|t| t[0] == mid)
+        .copied()
+        .unwrap_or(tris[0]);
+    let fnrm = cross(
+        sub(pos[t[1] as usize], pos[t[0] as usize]),
+        sub(pos[t[2] as usize], pos[t[0] as usize]),
+    );
+    let tris: Vec<[u32; 3]> = if dot(fnrm, outward) < 0.0 {
+        tris.iter().map(|t| [t[0], t[2], t[1]]).collect()
+    } else {
+        tris
+    };
     let (nrm, _) = crate::geom::angle_weighted_normals(&pos, &tris);
     let idx: Vec<u32> = tris.iter().flatten().copied().collect();
 
@@ -209,7 +254,8 @@ pub fn generate(p: &SnakeParams) -> Document {
         "name": "snake",
         "primitives": [{"attributes": {"POSITION": pa, "NORMAL": na, "TEXCOORD_0": ua}, "indices": ia, "material": 0, "mode": 4}]
     }));
-    doc.json_array_mut("nodes").push(json!({"name": "snake", "mesh": 0}));
+    doc.json_array_mut("nodes")
+        .push(json!({"name": "snake", "mesh": 0}));
     doc.json_array_mut("scenes").push(json!({"nodes": [0]}));
     doc.json["scene"] = json!(0);
     doc.json["asset"]["extras"] = json!({"sunbeam": {"snake": {"rings": rings, "segments": seg, "length_m": p.length, "radius_m": p.radius}}});

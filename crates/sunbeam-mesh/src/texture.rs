@@ -32,7 +32,9 @@ pub fn rasterize(work: &[Work], size: u32, dilate: u32) -> Vec<[f32; 3]> {
     let n = size as usize;
     let mut img = vec![[0.0f32; 3]; n * n];
     for w in work {
-        let (Some(uv), Some(uw)) = (&w.local.uvs, &w.u_world) else { continue };
+        let (Some(uv), Some(uw)) = (&w.local.uvs, &w.u_world) else {
+            continue;
+        };
         let ang: Vec<Option<(f64, f64)>> = (0..w.dir.len())
             .map(|i| {
                 let (d, u) = (w.dir[i]?, uw[i]?);
@@ -43,20 +45,48 @@ pub fn rasterize(work: &[Work], size: u32, dilate: u32) -> Vec<[f32; 3]> {
             .collect();
         for t in &w.local.triangles {
             let ids = [t[0] as usize, t[1] as usize, t[2] as usize];
-            let (Some(a0), Some(a1), Some(a2)) = (ang[ids[0]], ang[ids[1]], ang[ids[2]]) else { continue };
-            let p: Vec<[f64; 2]> = ids.iter().map(|&i| [uv[i][0] * n as f64, uv[i][1] * n as f64]).collect();
-            let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+            let (Some(a0), Some(a1), Some(a2)) = (ang[ids[0]], ang[ids[1]], ang[ids[2]]) else {
+                continue;
+            };
+            let p: Vec<[f64; 2]> = ids
+                .iter()
+                .map(|&i| [uv[i][0] * n as f64, uv[i][1] * n as f64])
+                .collect();
+            let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
             if area.abs() < 1e-18 || !area.is_finite() {
                 continue;
             }
-            let x0 = p.iter().map(|q| q[0]).fold(f64::INFINITY, f64::min).floor().max(0.0) as usize;
-            let x1 = (p.iter().map(|q| q[0]).fold(f64::NEG_INFINITY, f64::max).ceil().min(n as f64)) as usize;
-            let y0 = p.iter().map(|q| q[1]).fold(f64::INFINITY, f64::min).floor().max(0.0) as usize;
-            let y1 = (p.iter().map(|q| q[1]).fold(f64::NEG_INFINITY, f64::max).ceil().min(n as f64)) as usize;
+            let x0 = p
+                .iter()
+                .map(|q| q[0])
+                .fold(f64::INFINITY, f64::min)
+                .floor()
+                .max(0.0) as usize;
+            let x1 = (p
+                .iter()
+                .map(|q| q[0])
+                .fold(f64::NEG_INFINITY, f64::max)
+                .ceil()
+                .min(n as f64)) as usize;
+            let y0 = p
+                .iter()
+                .map(|q| q[1])
+                .fold(f64::INFINITY, f64::min)
+                .floor()
+                .max(0.0) as usize;
+            let y1 = (p
+                .iter()
+                .map(|q| q[1])
+                .fold(f64::NEG_INFINITY, f64::max)
+                .ceil()
+                .min(n as f64)) as usize;
             for y in y0..y1 {
                 for x in x0..x1 {
                     let c = [x as f64 + 0.5, y as f64 + 0.5];
-                    let e = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+                    let e = |a: [f64; 2], b: [f64; 2]| {
+                        (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+                    };
                     let l0 = e(p[1], p[2]) / area;
                     let l1 = e(p[2], p[0]) / area;
                     let l2 = 1.0 - l0 - l1;
@@ -87,7 +117,12 @@ pub fn rasterize(work: &[Work], size: u32, dilate: u32) -> Vec<[f32; 3]> {
                 for dy in -1i64..=1 {
                     for dx in -1i64..=1 {
                         let (xx, yy) = (x as i64 + dx, y as i64 + dy);
-                        if (dx, dy) == (0, 0) || xx < 0 || yy < 0 || xx >= n as i64 || yy >= n as i64 {
+                        if (dx, dy) == (0, 0)
+                            || xx < 0
+                            || yy < 0
+                            || xx >= n as i64
+                            || yy >= n as i64
+                        {
                             continue;
                         }
                         let q = prev[yy as usize * n + xx as usize];
@@ -113,12 +148,21 @@ pub fn rasterize(work: &[Work], size: u32, dilate: u32) -> Vec<[f32; 3]> {
 
 /// Render the map and encode it by the extension of `opts.path` (.png or .exr).
 pub fn render(work: &[Work], opts: &TextureOptions) -> Result<(Vec<u8>, serde_json::Value)> {
-    let ext = opts.path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    let ext = opts
+        .path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
     if ext != "png" && ext != "exr" {
-        return Err(Error::usage(format!("--texture {}: the name must end in .png or .exr", opts.path.display())));
+        return Err(Error::usage(format!(
+            "--texture {}: the name must end in .png or .exr",
+            opts.path.display()
+        )));
     }
     if work.iter().all(|w| w.local.uvs.is_none()) {
-        return Err(Error::input("--texture needs UVs (TEXCOORD), and the mesh has none"));
+        return Err(Error::input(
+            "--texture needs UVs (TEXCOORD), and the mesh has none",
+        ));
     }
     let n = opts.size as usize;
     let img = rasterize(work, opts.size, opts.dilate);
@@ -137,7 +181,9 @@ pub fn render(work: &[Work], opts: &TextureOptions) -> Result<(Vec<u8>, serde_js
         for p in &img {
             let (c, s) = half(p);
             for v in [0.5 + 0.5 * c, 0.5 + 0.5 * s, p[2]] {
-                data.extend_from_slice(&((v.clamp(0.0, 1.0) * 65535.0).round() as u16).to_be_bytes());
+                data.extend_from_slice(
+                    &((v.clamp(0.0, 1.0) * 65535.0).round() as u16).to_be_bytes(),
+                );
             }
         }
         let mut out = Vec::new();
@@ -145,8 +191,11 @@ pub fn render(work: &[Work], opts: &TextureOptions) -> Result<(Vec<u8>, serde_js
             let mut enc = png::Encoder::new(&mut out, opts.size, opts.size);
             enc.set_color(png::ColorType::Rgb);
             enc.set_depth(png::BitDepth::Sixteen);
-            let mut w = enc.write_header().map_err(|e| Error::internal(format!("PNG encoder: {e}")))?;
-            w.write_image_data(&data).map_err(|e| Error::internal(format!("PNG encoder: {e}")))?;
+            let mut w = enc
+                .write_header()
+                .map_err(|e| Error::internal(format!("PNG encoder: {e}")))?;
+            w.write_image_data(&data)
+                .map_err(|e| Error::internal(format!("PNG encoder: {e}")))?;
         }
         out
     } else {
@@ -163,7 +212,10 @@ pub fn render(work: &[Work], opts: &TextureOptions) -> Result<(Vec<u8>, serde_js
         });
         let image = Image::from_channels((n, n), channels);
         let mut out = std::io::Cursor::new(Vec::new());
-        image.write().to_buffered(&mut out).map_err(|e| sunbeam_common::Error::internal(format!("EXR encoder: {e}")))?;
+        image
+            .write()
+            .to_buffered(&mut out)
+            .map_err(|e| sunbeam_common::Error::internal(format!("EXR encoder: {e}")))?;
         out.into_inner()
     };
     let rep = json!({"path": opts.path.display().to_string(), "size": opts.size, "covered_texels": covered, "dilated_texels": dilated, "format": ext});

@@ -1,5 +1,6 @@
 //! The orientation field: unit and tangent, samples reproduced, axial symmetry,
 //! convergence on an analytic field, and the awkward inputs.
+#![allow(clippy::needless_range_loop)]
 
 mod common;
 use common::*;
@@ -21,28 +22,49 @@ fn angle(w: &Work, i: usize) -> f64 {
 fn uv_samples(items: Vec<([f64; 2], f64)>) -> Source {
     Source::Samples(Samples {
         path: "test.csv".into(),
-        items: items.into_iter().enumerate().map(|(k, (uv, a))| Sample { line: k + 2, at: SampleAt::Uv { uv, angle: a } }).collect(),
+        items: items
+            .into_iter()
+            .enumerate()
+            .map(|(k, (uv, a))| Sample {
+                line: k + 2,
+                at: SampleAt::Uv { uv, angle: a },
+            })
+            .collect(),
     })
 }
 
 fn small_snake() -> sunbeam_mesh::gltf::Document {
-    snake::generate(&SnakeParams { rings: 80, segments: 16, ..Default::default() })
+    snake::generate(&SnakeParams {
+        rings: 80,
+        segments: 16,
+        ..Default::default()
+    })
 }
 
 /// Every output vector, as stored (f32) in the GLB: unit, orthogonal to the stored normal, w = +-1.
 fn check_stored(doc: &mut sunbeam_mesh::gltf::Document) {
     let glb = doc.to_glb();
-    let back = sunbeam_mesh::gltf::Document::from_bytes(&glb, std::path::Path::new("out.glb")).unwrap();
+    let back =
+        sunbeam_mesh::gltf::Document::from_bytes(&glb, std::path::Path::new("out.glb")).unwrap();
     for (m, mesh) in back.array("meshes").iter().enumerate() {
         for (k, _) in mesh["primitives"].as_array().unwrap().iter().enumerate() {
-            let p = sunbeam_mesh::scene::read_primitive(&back, m, k, 0).unwrap().unwrap();
+            let p = sunbeam_mesh::scene::read_primitive(&back, m, k, 0)
+                .unwrap()
+                .unwrap();
             let n = p.normals.unwrap();
             let t = p.tangents.unwrap();
             let o = p.orientation.unwrap();
             for i in 0..n.len() {
                 let tt = [t[i][0], t[i][1], t[i][2]];
-                assert!((norm(tt) - 1.0).abs() < 1e-5 && (norm(o[i]) - 1.0).abs() < 1e-5, "not unit at {i}");
-                assert!(dot(tt, n[i]).abs() < 1e-5 && dot(o[i], n[i]).abs() < 1e-5, "not orthogonal at {i}: {}", dot(o[i], n[i]));
+                assert!(
+                    (norm(tt) - 1.0).abs() < 1e-5 && (norm(o[i]) - 1.0).abs() < 1e-5,
+                    "not unit at {i}"
+                );
+                assert!(
+                    dot(tt, n[i]).abs() < 1e-5 && dot(o[i], n[i]).abs() < 1e-5,
+                    "not orthogonal at {i}: {}",
+                    dot(o[i], n[i])
+                );
                 assert!(t[i][3] == 1.0 || t[i][3] == -1.0);
                 assert!((norm(n[i]) - 1.0).abs() < 1e-5);
             }
@@ -52,10 +74,16 @@ fn check_stored(doc: &mut sunbeam_mesh::gltf::Document) {
 
 #[test]
 fn every_source_gives_unit_tangent_directions() {
-    let sp = snake::spine(&SnakeParams { rings: 80, segments: 16, ..Default::default() });
+    let sp = snake::spine(&SnakeParams {
+        rings: 80,
+        segments: 16,
+        ..Default::default()
+    });
     let curve = Curve::from_points(std::path::Path::new("spine"), sp).unwrap();
     let mut rng = Lcg(7);
-    let samples: Vec<([f64; 2], f64)> = (0..200).map(|_| ([rng.next(), rng.next()], rng.next() * 2.0 * PI)).collect();
+    let samples: Vec<([f64; 2], f64)> = (0..200)
+        .map(|_| ([rng.next(), rng.next()], rng.next() * 2.0 * PI))
+        .collect();
     for (name, src) in [
         ("axis", Source::Axis([0.0, 0.0, 1.0])),
         ("curve", Source::Curve(curve)),
@@ -88,10 +116,20 @@ fn samples_are_reproduced_at_their_own_positions() {
     let (pos, uv, idx) = grid(41, |x, y| 0.3 * (3.0 * x).sin() + 0.2 * y * y);
     let d = doc_from(&pos, None, Some(&uv), &idx, json!({}));
     let mut rng = Lcg(11);
-    let picks: Vec<usize> = (0..150).map(|_| (rng.next() * pos.len() as f64) as usize).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
+    let picks: Vec<usize> = (0..150)
+        .map(|_| (rng.next() * pos.len() as f64) as usize)
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
     let angles: Vec<f64> = picks.iter().map(|_| (rng.next() - 0.5) * PI).collect();
     for interp in [Interp::Natural, Interp::Linear] {
-        let mut o = BakeOptions::new(uv_samples(picks.iter().zip(&angles).map(|(&i, &a)| (uv[i], a)).collect()));
+        let mut o = BakeOptions::new(uv_samples(
+            picks
+                .iter()
+                .zip(&angles)
+                .map(|(&i, &a)| (uv[i], a))
+                .collect(),
+        ));
         o.interp = interp;
         let (w, r) = compute(&d, &o).unwrap();
         assert_eq!(r.samples.as_ref().unwrap().used, picks.len());
@@ -115,10 +153,19 @@ fn samples_are_reproduced_at_their_own_positions() {
             u[1] * a.cos() + cross(n, u)[1] * a.sin() + 0.3 * n[1],
             u[2] * a.cos() + cross(n, u)[2] * a.sin() + 0.3 * n[2],
         ];
-        items.push(Sample { line: k + 2, at: SampleAt::Xyz { p: wk.p_world[i], d } });
+        items.push(Sample {
+            line: k + 2,
+            at: SampleAt::Xyz {
+                p: wk.p_world[i],
+                d,
+            },
+        });
         want.push((i, a));
     }
-    let src = Source::Samples(Samples { path: "s.csv".into(), items });
+    let src = Source::Samples(Samples {
+        path: "s.csv".into(),
+        items,
+    });
     let (w, r) = compute(&doc, &BakeOptions::new(src)).unwrap();
     let sr = r.samples.unwrap();
     assert!(sr.rejected.is_empty(), "{:?}", sr.rejected);
@@ -137,8 +184,14 @@ fn opposite_directions_give_the_same_field() {
     let (pos, uv, idx) = grid(21, |_, _| 0.0);
     let d = doc_from(&pos, None, Some(&uv), &idx, json!({}));
     let mut rng = Lcg(3);
-    let s: Vec<([f64; 2], f64)> = (0..60).map(|_| ([rng.next(), rng.next()], rng.next() * PI)).collect();
-    let flipped: Vec<([f64; 2], f64)> = s.iter().enumerate().map(|(k, &(p, a))| (p, if k % 2 == 0 { a + PI } else { a - 3.0 * PI })).collect();
+    let s: Vec<([f64; 2], f64)> = (0..60)
+        .map(|_| ([rng.next(), rng.next()], rng.next() * PI))
+        .collect();
+    let flipped: Vec<([f64; 2], f64)> = s
+        .iter()
+        .enumerate()
+        .map(|(k, &(p, a))| (p, if k % 2 == 0 { a + PI } else { a - 3.0 * PI }))
+        .collect();
     let (a, _) = compute(&d, &BakeOptions::new(uv_samples(s))).unwrap();
     let (b, _) = compute(&d, &BakeOptions::new(uv_samples(flipped))).unwrap();
     for i in 0..pos.len() {
@@ -146,7 +199,16 @@ fn opposite_directions_give_the_same_field() {
     }
     // Raw vector averaging would cancel here; the doubled angle does not: two samples
     // at +x and -x give +x everywhere between them.
-    let (c, _) = compute(&d, &BakeOptions::new(uv_samples(vec![([0.0, 0.5], 0.0), ([1.0, 0.5], PI), ([0.5, 0.0], PI), ([0.5, 1.0], 0.0)]))).unwrap();
+    let (c, _) = compute(
+        &d,
+        &BakeOptions::new(uv_samples(vec![
+            ([0.0, 0.5], 0.0),
+            ([1.0, 0.5], PI),
+            ([0.5, 0.0], PI),
+            ([0.5, 1.0], 0.0),
+        ])),
+    )
+    .unwrap();
     for i in 0..pos.len() {
         assert!(axial_diff(angle(&c[0], i), 0.0) < 1e-9);
     }
@@ -192,12 +254,24 @@ fn analytic_field_error_falls_with_sample_density() {
         for n in [100, 400, 1600, 6400] {
             let (mx, rms) = convergence_error(n, interp);
             println!("{interp:?} samples {n}: max {mx:.3e} rad, rms {rms:.3e} rad");
-            assert!(rms < prev.1 * 0.6, "{interp:?}: rms {rms} did not fall enough from {}", prev.1);
-            assert!(mx < prev.0, "{interp:?}: max {mx} did not fall from {}", prev.0);
+            assert!(
+                rms < prev.1 * 0.6,
+                "{interp:?}: rms {rms} did not fall enough from {}",
+                prev.1
+            );
+            assert!(
+                mx < prev.0,
+                "{interp:?}: max {mx} did not fall from {}",
+                prev.0
+            );
             prev = (mx, rms);
         }
         // Stated bound (docs/BAKE.md): with 6400 samples on the unit square, max error < 2e-3 rad.
-        assert!(prev.0 < 2e-3, "{interp:?}: max error {} at 6400 samples", prev.0);
+        assert!(
+            prev.0 < 2e-3,
+            "{interp:?}: max error {} at 6400 samples",
+            prev.0
+        );
     }
 }
 
@@ -207,7 +281,18 @@ fn duplicate_collinear_and_single_samples() {
     let d = doc_from(&pos, None, Some(&uv), &idx, json!({}));
     // Duplicates: same position twice with d and -d merge into one sample; perpendicular
     // duplicates cancel and are dropped with a reason.
-    let (w, r) = compute(&d, &BakeOptions::new(uv_samples(vec![([0.2, 0.2], 0.3), ([0.2, 0.2], 0.3 + PI), ([0.8, 0.2], 0.3), ([0.5, 0.9], 0.3), ([0.5, 0.5], 0.0), ([0.5, 0.5], PI / 2.0)]))).unwrap();
+    let (w, r) = compute(
+        &d,
+        &BakeOptions::new(uv_samples(vec![
+            ([0.2, 0.2], 0.3),
+            ([0.2, 0.2], 0.3 + PI),
+            ([0.8, 0.2], 0.3),
+            ([0.5, 0.9], 0.3),
+            ([0.5, 0.5], 0.0),
+            ([0.5, 0.5], PI / 2.0),
+        ])),
+    )
+    .unwrap();
     let sr = r.samples.unwrap();
     assert_eq!(sr.merged_duplicates, 2);
     assert_eq!(sr.used, 3);
@@ -216,11 +301,23 @@ fn duplicate_collinear_and_single_samples() {
         assert!(axial_diff(angle(&w[0], i), 0.3) < 1e-9);
     }
     // Collinear: linear along the line, constant across it.
-    let (w, r) = compute(&d, &BakeOptions::new(uv_samples(vec![([0.0, 0.5], 0.0), ([0.5, 0.5], 0.4), ([1.0, 0.5], 0.8)]))).unwrap();
+    let (w, r) = compute(
+        &d,
+        &BakeOptions::new(uv_samples(vec![
+            ([0.0, 0.5], 0.0),
+            ([0.5, 0.5], 0.4),
+            ([1.0, 0.5], 0.8),
+        ])),
+    )
+    .unwrap();
     assert!(!r.samples.unwrap().layout_notes.is_empty());
     for i in 0..pos.len() {
         let want = 0.8 * uv[i][0];
-        assert!(axial_diff(angle(&w[0], i), want) < 0.02, "collinear: {} vs {want}", angle(&w[0], i));
+        assert!(
+            axial_diff(angle(&w[0], i), want) < 0.02,
+            "collinear: {} vs {want}",
+            angle(&w[0], i)
+        );
     }
     // Single sample: constant.
     let (w, _) = compute(&d, &BakeOptions::new(uv_samples(vec![([0.3, 0.3], 1.0)]))).unwrap();
@@ -234,17 +331,56 @@ fn off_surface_nan_and_missing_uvs() {
     let (pos, uv, idx) = grid(11, |_, _| 0.0);
     let d = doc_from(&pos, None, Some(&uv), &idx, json!({}));
     let items = vec![
-        Sample { line: 2, at: SampleAt::Xyz { p: [0.5, 0.5, 0.001], d: [1.0, 0.0, 0.0] } },
-        Sample { line: 3, at: SampleAt::Xyz { p: [0.5, 0.5, 5.0], d: [1.0, 0.0, 0.0] } },
-        Sample { line: 4, at: SampleAt::Xyz { p: [0.2, 0.5, 0.0], d: [0.0, 0.0, 1.0] } },
+        Sample {
+            line: 2,
+            at: SampleAt::Xyz {
+                p: [0.5, 0.5, 0.001],
+                d: [1.0, 0.0, 0.0],
+            },
+        },
+        Sample {
+            line: 3,
+            at: SampleAt::Xyz {
+                p: [0.5, 0.5, 5.0],
+                d: [1.0, 0.0, 0.0],
+            },
+        },
+        Sample {
+            line: 4,
+            at: SampleAt::Xyz {
+                p: [0.2, 0.5, 0.0],
+                d: [0.0, 0.0, 1.0],
+            },
+        },
     ];
-    let (_, r) = compute(&d, &BakeOptions::new(Source::Samples(Samples { path: "s.csv".into(), items }))).unwrap();
+    let (_, r) = compute(
+        &d,
+        &BakeOptions::new(Source::Samples(Samples {
+            path: "s.csv".into(),
+            items,
+        })),
+    )
+    .unwrap();
     let sr = r.samples.unwrap();
     let rows: Vec<usize> = sr.rejected.iter().map(|x| x.row).collect();
     assert_eq!(rows, vec![3, 4], "{:?}", sr.rejected);
     // All off the surface: an input error naming the samples file.
-    let items = vec![Sample { line: 2, at: SampleAt::Xyz { p: [9.0, 9.0, 9.0], d: [1.0, 0.0, 0.0] } }];
-    let e = compute(&d, &BakeOptions::new(Source::Samples(Samples { path: "far.csv".into(), items }))).err().unwrap();
+    let items = vec![Sample {
+        line: 2,
+        at: SampleAt::Xyz {
+            p: [9.0, 9.0, 9.0],
+            d: [1.0, 0.0, 0.0],
+        },
+    }];
+    let e = compute(
+        &d,
+        &BakeOptions::new(Source::Samples(Samples {
+            path: "far.csv".into(),
+            items,
+        })),
+    )
+    .err()
+    .unwrap();
     assert_eq!(e.exit_code(), 2);
     assert!(e.message.contains("far.csv"));
     // NaN in a samples file: error naming file and row.
@@ -252,17 +388,32 @@ fn off_surface_nan_and_missing_uvs() {
     let f = dir.join("s.csv");
     std::fs::write(&f, "u,v,angle_deg\n0.1,0.2,30\n0.3,nan,10\n").unwrap();
     let e = Samples::load(&f).unwrap_err();
-    assert!(e.message.contains("s.csv") && e.message.contains("row 3"), "{}", e.message);
+    assert!(
+        e.message.contains("s.csv") && e.message.contains("row 3"),
+        "{}",
+        e.message
+    );
     std::fs::write(&f, "a,b\n1,2\n").unwrap();
     assert_eq!(Samples::load(&f).unwrap_err().exit_code(), 2);
-    std::fs::write(&f, "{\"samples\": [{\"x\": 0, \"y\": 0, \"z\": 0, \"dx\": 1, \"dy\": 0, \"dz\": 0}]}").unwrap();
+    std::fs::write(
+        &f,
+        "{\"samples\": [{\"x\": 0, \"y\": 0, \"z\": 0, \"dx\": 1, \"dy\": 0, \"dz\": 0}]}",
+    )
+    .unwrap();
     assert_eq!(Samples::load(&f).unwrap().items.len(), 1);
     // No UVs with a UV mode: input error naming the mesh file.
     let d2 = doc_from(&pos, None, None, &idx, json!({}));
-    for src in [Source::UvDirection(UvAxis::U), uv_samples(vec![([0.5, 0.5], 0.0)])] {
+    for src in [
+        Source::UvDirection(UvAxis::U),
+        uv_samples(vec![([0.5, 0.5], 0.0)]),
+    ] {
         let e = compute(&d2, &BakeOptions::new(src)).err().unwrap();
         assert_eq!(e.exit_code(), 2);
-        assert!(e.message.contains("test.glb") && e.message.contains("TEXCOORD_0"), "{}", e.message);
+        assert!(
+            e.message.contains("test.glb") && e.message.contains("TEXCOORD_0"),
+            "{}",
+            e.message
+        );
     }
     let _ = std::fs::remove_dir_all(dir);
 }
@@ -279,11 +430,61 @@ fn degenerate_triangles_and_axis_along_the_normal() {
     let d = doc_from(&pos, None, Some(&uv), &idx, json!({}));
     let mut b = bake(d, &BakeOptions::new(Source::Axis([0.0, 0.0, 1.0]))).unwrap();
     assert!(b.report.degenerate_triangles >= 3);
-    assert_eq!(b.report.without_direction.values().sum::<usize>(), pos.len());
+    assert_eq!(
+        b.report.without_direction.values().sum::<usize>(),
+        pos.len()
+    );
     assert_eq!(b.report.arbitrary, pos.len());
     check_stored(&mut b.doc);
     // Tilted axis: only the isolated vertex lacks nothing... every vertex gets the projection.
     let d = doc_from(&pos, None, Some(&uv), &idx, json!({}));
     let b = bake(d, &BakeOptions::new(Source::Axis([1.0, 0.0, 1.0]))).unwrap();
     assert_eq!(b.report.arbitrary, 0);
+}
+
+#[test]
+fn curve_nearest_point_matches_brute_force_and_is_projected() {
+    let sp = snake::spine(&SnakeParams::default());
+    let c = Curve::from_points(std::path::Path::new("spine"), sp).unwrap();
+    let mut rng = Lcg(5);
+    for _ in 0..2000 {
+        let p = [
+            rng.next() - 0.5,
+            (rng.next() - 0.5) * 0.4,
+            (rng.next() - 0.5) * 0.1,
+        ];
+        let (a, b) = (c.tangent_at(p), c.tangent_at_brute_force(p));
+        assert!(
+            norm([a[0] - b[0], a[1] - b[1], a[2] - b[2]]) < 1e-9,
+            "{a:?} vs {b:?}"
+        );
+    }
+    // On the snake baked with its own spine, the direction runs along the body (+u) up to
+    // the spine's curvature: within a few degrees of +u away from the tips.
+    let (w, _) = compute(
+        &small_snake(),
+        &BakeOptions::new(Source::Curve(
+            Curve::from_points(
+                std::path::Path::new("s"),
+                snake::spine(&SnakeParams {
+                    rings: 80,
+                    segments: 16,
+                    ..Default::default()
+                }),
+            )
+            .unwrap(),
+        )),
+    )
+    .unwrap();
+    let uv = w[0].local.uvs.as_ref().unwrap();
+    for i in 0..uv.len() {
+        if (0.1..0.9).contains(&uv[i][0]) {
+            assert!(
+                axial_diff(angle(&w[0], i), 0.0) < 0.1,
+                "vertex {i} at u={}: {}",
+                uv[i][0],
+                angle(&w[0], i)
+            );
+        }
+    }
 }

@@ -17,31 +17,60 @@ fn close(a: [f32; 3], b: [f64; 3], tol: f64) -> bool {
 
 #[test]
 fn node_hierarchy_is_applied() {
-    let mut d = doc_from(&TRI, Some(&[[0.0, 0.0, 1.0]; 3]), Some(&UV), &[0, 1, 2], json!({"translation": [5.0, 0.0, 0.0], "children": [1]}));
+    let mut d = doc_from(
+        &TRI,
+        Some(&[[0.0, 0.0, 1.0]; 3]),
+        Some(&UV),
+        &[0, 1, 2],
+        json!({"translation": [5.0, 0.0, 0.0], "children": [1]}),
+    );
     let s = std::f64::consts::FRAC_1_SQRT_2;
-    d.json_array_mut("nodes").push(json!({"mesh": 0, "rotation": [0.0, 0.0, s, s], "scale": [2.0, 2.0, 2.0]}));
+    d.json_array_mut("nodes")
+        .push(json!({"mesh": 0, "rotation": [0.0, 0.0, s, s], "scale": [2.0, 2.0, 2.0]}));
     let m = scene_mesh(&d).unwrap();
     assert_eq!(m.positions.len(), 6);
     assert_eq!(m.submeshes.len(), 2);
     assert!(close(m.positions[1], [6.0, 0.0, 0.0], 1e-6));
     // Child: rotate 90 degrees about z, scale 2, then the parent's translation.
-    assert!(close(m.positions[4], [5.0, 2.0, 0.0], 1e-6), "{:?}", m.positions[4]);
-    assert!(close(m.positions[5], [3.0, 0.0, 0.0], 1e-6), "{:?}", m.positions[5]);
+    assert!(
+        close(m.positions[4], [5.0, 2.0, 0.0], 1e-6),
+        "{:?}",
+        m.positions[4]
+    );
+    assert!(
+        close(m.positions[5], [3.0, 0.0, 0.0], 1e-6),
+        "{:?}",
+        m.positions[5]
+    );
     for n in &m.normals {
         assert!(close(*n, [0.0, 0.0, 1.0], 1e-6));
     }
     // Not baked: the orientation is derived from the UVs (+u), rotated with the node.
     assert_eq!(m.orientation_source, Some(OrientationSource::Derived));
     assert!(close(m.orientation[0], [1.0, 0.0, 0.0], 1e-6));
-    assert!(close(m.orientation[3], [0.0, 1.0, 0.0], 1e-6), "{:?}", m.orientation[3]);
+    assert!(
+        close(m.orientation[3], [0.0, 1.0, 0.0], 1e-6),
+        "{:?}",
+        m.orientation[3]
+    );
     assert!(m.has_uvs);
 }
 
 #[test]
 fn mirroring_node_keeps_front_faces_ccw() {
-    let d = doc_from(&TRI, None, None, &[0, 1, 2], json!({"scale": [-1.0, 1.0, 1.0]}));
+    let d = doc_from(
+        &TRI,
+        None,
+        None,
+        &[0, 1, 2],
+        json!({"scale": [-1.0, 1.0, 1.0]}),
+    );
     let m = scene_mesh(&d).unwrap();
-    let p: Vec<[f64; 3]> = m.indices.iter().map(|&i| m.positions[i as usize].map(|x| x as f64)).collect();
+    let p: Vec<[f64; 3]> = m
+        .indices
+        .iter()
+        .map(|&i| m.positions[i as usize].map(|x| x as f64))
+        .collect();
     let e1 = [p[1][0] - p[0][0], p[1][1] - p[0][1], 0.0];
     let e2 = [p[2][0] - p[0][0], p[2][1] - p[0][1], 0.0];
     let cz = e1[0] * e2[1] - e1[1] * e2[0];
@@ -96,7 +125,13 @@ fn baked_orientation_comes_back_in_world_space() {
     // A rotated, non-uniformly scaled node: the baked world direction must be the
     // world axis projected, after the loader applies the node transform.
     let (pos, uv, idx) = grid(9, |x, y| 0.3 * (x * 2.0).sin() * y);
-    let d = doc_from(&pos, None, Some(&uv), &idx, json!({"rotation": [0.2, 0.1, 0.3, 0.927], "scale": [1.0, 3.0, 0.5], "translation": [1.0, 2.0, 3.0]}));
+    let d = doc_from(
+        &pos,
+        None,
+        Some(&uv),
+        &idx,
+        json!({"rotation": [0.2, 0.1, 0.3, 0.927], "scale": [1.0, 3.0, 0.5], "translation": [1.0, 2.0, 3.0]}),
+    );
     let axis = [0.3, -0.8, 0.52];
     let mut b = bake(d, &BakeOptions::new(Source::Axis(axis))).unwrap();
     let dir = tmpdir("world");
@@ -107,7 +142,12 @@ fn baked_orientation_comes_back_in_world_space() {
     for i in 0..m.positions.len() {
         let n = m.normals[i].map(|x| x as f64);
         let p = sunbeam_mesh::geom::normalize(sunbeam_mesh::geom::project(a, n)).unwrap();
-        assert!(close(m.orientation[i], p, 2e-5), "vertex {i}: {:?} vs {:?}", m.orientation[i], p);
+        assert!(
+            close(m.orientation[i], p, 2e-5),
+            "vertex {i}: {:?} vs {:?}",
+            m.orientation[i],
+            p
+        );
         let t = m.tangents[i];
         assert!(t[3] == 1.0 || t[3] == -1.0);
     }
@@ -124,7 +164,10 @@ fn obj_with_and_without_normals_and_uvs() {
     assert_eq!(m.indices.len(), 9);
     // OBJ v is up, glTF v is down.
     assert_eq!(m.uvs[0], [0.0, 1.0]);
-    assert!(close(m.normals[0], [0.0, 0.0, 1.0], 1e-6), "normalised from (0,0,2)");
+    assert!(
+        close(m.normals[0], [0.0, 0.0, 1.0], 1e-6),
+        "normalised from (0,0,2)"
+    );
     // Second group has no normals: computed.
     let last = m.positions.len() - 1;
     assert!(close(m.normals[last], [0.0, 0.0, 1.0], 1e-6));
@@ -132,7 +175,11 @@ fn obj_with_and_without_normals_and_uvs() {
     std::fs::write(&f, "v 0 0 0\nf 1 2 3\n").unwrap();
     let e = load_scene_mesh(&f).unwrap_err();
     assert_eq!(e.exit_code(), 2);
-    assert!(e.message.contains("q.obj") && e.message.contains("line 2"), "{}", e.message);
+    assert!(
+        e.message.contains("q.obj") && e.message.contains("line 2"),
+        "{}",
+        e.message
+    );
     std::fs::write(&f, "v 0 nan 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let e = load_scene_mesh(&f).unwrap_err();
     assert!(e.message.contains("NaN"), "{}", e.message);

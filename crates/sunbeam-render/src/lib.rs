@@ -15,6 +15,7 @@
 
 pub mod gpu;
 pub mod renderer;
+pub mod table;
 pub mod window;
 
 pub use gpu::{Backend, Gpu};

@@ -29,9 +29,11 @@ pub const THESIS_TERMS: u32 = 39;
 /// Which shading the pipeline does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Mode {
-    /// PHYSICS.md 2 with the pack's basis, model and interpolation (the default).
+    /// PHYSICS.md 2 through the pack's response table (built at load, trilinear).
     #[default]
     Default,
+    /// PHYSICS.md 2 summed per fragment (terms, taps, wavelengths), no table.
+    Direct,
     /// The thesis' shader: fixed 39 terms, 5 nm steps, nearest bin.
     Thesis,
     /// Plain Lambert with the base colour (benchmark baseline).
@@ -42,10 +44,11 @@ impl std::str::FromStr for Mode {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
         match s {
-            "default" => Ok(Mode::Default),
+            "default" | "table" => Ok(Mode::Default),
+            "direct" => Ok(Mode::Direct),
             "thesis" => Ok(Mode::Thesis),
             "lambert" => Ok(Mode::Lambert),
-            _ => Err(Error::usage(format!("unknown mode '{s}' (default, thesis, lambert)"))),
+            _ => Err(Error::usage(format!("unknown mode '{s}' (default, direct, thesis, lambert)"))),
         }
     }
 }
@@ -60,6 +63,8 @@ pub struct Settings {
     /// Bound on |dR| from truncating the series per fragment (None: the pack's own
     /// tolerance or series bound, whichever is larger).
     pub term_tolerance: Option<f64>,
+    /// Response table resolution of the default mode.
+    pub table: crate::table::Dims,
 }
 
 /// Default wavelength sample count (docs/PLAY.md: chosen by measurement).
@@ -72,6 +77,7 @@ impl Default for Settings {
             lambda_samples: DEFAULT_LAMBDA_SAMPLES,
             curve: ToneCurve::default(),
             term_tolerance: None,
+            table: Default::default(),
         }
     }
 }
@@ -144,6 +150,16 @@ struct MaterialU {
     sigma_bins: [f32; 2],
     kb_norm: f32,
     table_dt: f32,
+    tab_nu: u32,
+    tab_nv: u32,
+    tab_nw: u32,
+    tab_on: u32,
+    tab_u0: f32,
+    tab_du: f32,
+    tab_dv: f32,
+    tab_w0: f32,
+    tab_dw: f32,
+    _q: [f32; 3],
 }
 
 struct GpuMesh {
@@ -244,7 +260,7 @@ impl Renderer {
         });
         let gl1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("material"),
-            entries: &[uniform_entry(0), storage_entry(1), storage_entry(2)],
+            entries: &[uniform_entry(0), storage_entry(1), storage_entry(2), storage_entry(3)],
         });
         let global_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("globals"),
@@ -284,6 +300,7 @@ impl Renderer {
                 table_dt: 1.0,
                 ..Default::default()
             };
+            let mut response: Option<Vec<[f32; 4]>> = None;
             let (terms_buf, table): (Arc<wgpu::Buffer>, Vec<u32>) = match &mat.pack {
                 Some(pack) if settings.mode != Mode::Lambert => {
                     let m = &pack.manifest;
@@ -357,6 +374,35 @@ impl Renderer {
                     mu.kb_norm =
                         if m.kernel.beta > 0.0 { (m.kernel.beta / (w * m.kernel.beta.sinh())) as f32 } else { 0.0 };
                     mu.table_dt = dt as f32;
+                    if settings.mode == Mode::Default {
+                        let t0 = std::time::Instant::now();
+                        let tt = table.clone();
+                        let terms_at = move |at: f64| -> usize {
+                            let i = ((at / dt).floor() as usize).min(tt.len() - 1);
+                            tt[i] as usize
+                        };
+                        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+                        let rt = crate::table::build(pack, &samples, settings.table, &terms_at, threads);
+                        let bytes = (rt.data.len() * 16) as u64;
+                        if bytes > max_binding {
+                            return Err(Error::input(format!(
+                                "meshes[{mi}]: the response table ({} MiB) exceeds this GPU's storage buffer limit; \
+                                 use a smaller table",
+                                bytes >> 20
+                            )));
+                        }
+                        log::info!("response table {:?} built in {:.2?}", rt.dims, t0.elapsed());
+                        mu.tab_nu = rt.dims.nu as u32;
+                        mu.tab_nv = rt.dims.nv as u32;
+                        mu.tab_nw = rt.dims.nw as u32;
+                        mu.tab_on = 1;
+                        mu.tab_u0 = crate::table::U_MIN as f32;
+                        mu.tab_du = rt.du as f32;
+                        mu.tab_dv = rt.dv as f32;
+                        mu.tab_w0 = crate::table::W_MIN as f32;
+                        mu.tab_dw = rt.dw as f32;
+                        response = Some(rt.data);
+                    }
                     (buf, table)
                 }
                 _ => (
@@ -378,6 +424,12 @@ impl Renderer {
                 contents: bytemuck::cast_slice(&table),
                 usage: wgpu::BufferUsages::STORAGE,
             });
+            let rdata = response.unwrap_or_else(|| vec![[0.0f32; 4]]);
+            let rbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("response table"),
+                contents: bytemuck::cast_slice(&rdata),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
             let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("material"),
                 layout: &gl1,
@@ -385,6 +437,7 @@ impl Renderer {
                     wgpu::BindGroupEntry { binding: 0, resource: mbuf.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: terms_buf.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 2, resource: tbuf.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: rbuf.as_entire_binding() },
                 ],
             });
             meshes.push(GpuMesh { vbuf, ibuf, count: mesh.indices.len() as u32, bind });
@@ -478,6 +531,7 @@ impl Renderer {
                 Mode::Default => 0,
                 Mode::Thesis => 1,
                 Mode::Lambert => 2,
+                Mode::Direct => 3,
             },
             curve: match self.settings.curve {
                 ToneCurve::Clamp => 0,

@@ -35,7 +35,12 @@ struct Cli {
     output: PathBuf,
 
     /// A world direction projected onto each tangent plane.
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, group = "source")]
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true,
+        group = "source"
+    )]
     axis: Option<String>,
     /// A spine polyline (JSON {"points": [[x,y,z], ...]}): the tangent at the nearest spine point, projected.
     #[arg(long, value_name = "SPINE.json", group = "source")]
@@ -48,7 +53,12 @@ struct Cli {
     uv_direction: Option<UvDir>,
 
     /// Extra rotation about the normal, degrees (counter-clockwise seen from outside).
-    #[arg(long, value_name = "A", default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "A",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
     rotate_deg: f64,
     /// TEXCOORD set the UV modes use.
     #[arg(long, value_name = "N", default_value_t = 0)]
@@ -112,7 +122,9 @@ fn run(cli: Cli) -> Result<()> {
         return Err(Error::usage("--depfile needs a file output, not -o -"));
     }
     if to_stdout && cli.json {
-        return Err(Error::usage("--json prints on stdout; it cannot be combined with -o -"));
+        return Err(Error::usage(
+            "--json prints on stdout; it cannot be combined with -o -",
+        ));
     }
     if !(cli.max_snap.is_none_or(|d| d >= 0.0)) {
         return Err(Error::usage("--max-snap must be >= 0"));
@@ -125,7 +137,11 @@ fn run(cli: Cli) -> Result<()> {
     }
     let mut inputs: Vec<PathBuf> = Vec::new();
     let (doc, snake_spine) = match (&cli.mesh, cli.generate_snake) {
-        (Some(_), true) => return Err(Error::usage("give either MESH or --generate-snake, not both")),
+        (Some(_), true) => {
+            return Err(Error::usage(
+                "give either MESH or --generate-snake, not both",
+            ))
+        }
         (None, false) => return Err(Error::usage("no input: give MESH or --generate-snake")),
         (Some(m), false) => {
             let d = sunbeam_mesh::load_document(m)?;
@@ -159,7 +175,9 @@ fn run(cli: Cli) -> Result<()> {
     } else if let Some(sp) = &snake_spine {
         Source::Curve(Curve::from_points(Path::new("<snake spine>"), sp.clone())?)
     } else {
-        return Err(Error::usage("no orientation source: give one of --axis, --curve, --samples, --uv-direction"));
+        return Err(Error::usage(
+            "no orientation source: give one of --axis, --curve, --samples, --uv-direction",
+        ));
     };
     let opts = BakeOptions {
         source,
@@ -180,13 +198,23 @@ fn run(cli: Cli) -> Result<()> {
     }
     let mut tex_bytes = None;
     if let Some(t) = &cli.texture {
-        let (bytes, rep) = texture::render(&baked.work, &TextureOptions { size: cli.texture_size, dilate: cli.texture_dilate, path: t.clone() })?;
+        let (bytes, rep) = texture::render(
+            &baked.work,
+            &TextureOptions {
+                size: cli.texture_size,
+                dilate: cli.texture_dilate,
+                path: t.clone(),
+            },
+        )?;
         baked.report.texture = Some(rep);
         tex_bytes = Some(bytes);
     }
     let glb = baked.doc.to_glb();
     if to_stdout {
-        std::io::stdout().lock().write_all(&glb).map_err(|e| Error::output(format!("stdout: {e}")))?;
+        std::io::stdout()
+            .lock()
+            .write_all(&glb)
+            .map_err(|e| Error::output(format!("stdout: {e}")))?;
     } else {
         sunbeam_common::output::write_atomic(&cli.output, &glb)?;
         baked.report.output = Some(cli.output.display().to_string());
@@ -196,7 +224,12 @@ fn run(cli: Cli) -> Result<()> {
     }
     if let (Some(p), Some(sp)) = (&cli.spine_out, &snake_spine) {
         let js = serde_json::json!({ "points": sp });
-        sunbeam_common::output::write_atomic(p, serde_json::to_string_pretty(&js).map_err(|e| Error::internal(e.to_string()))?.as_bytes())?;
+        sunbeam_common::output::write_atomic(
+            p,
+            serde_json::to_string_pretty(&js)
+                .map_err(|e| Error::internal(e.to_string()))?
+                .as_bytes(),
+        )?;
     }
     if let Some(d) = &cli.depfile {
         let mut outs: Vec<&Path> = vec![cli.output.as_path()];
@@ -211,7 +244,10 @@ fn run(cli: Cli) -> Result<()> {
     }
     let r = &baked.report;
     if cli.json {
-        println!("{}", serde_json::to_string_pretty(r).map_err(|e| Error::internal(e.to_string()))?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(r).map_err(|e| Error::internal(e.to_string()))?
+        );
     }
     if !cli.quiet {
         for w in &r.warnings {
@@ -226,11 +262,18 @@ fn run(cli: Cli) -> Result<()> {
         }
         if let Some(s) = &r.samples {
             if !s.rejected.is_empty() {
-                eprintln!("sunbeam-bake: warning: {} of {} samples rejected (see --json)", s.rejected.len(), s.rows);
+                eprintln!(
+                    "sunbeam-bake: warning: {} of {} samples rejected (see --json)",
+                    s.rejected.len(),
+                    s.rows
+                );
             }
         }
         if cli.verbose {
-            eprintln!("sunbeam-bake: {} vertices, {} triangles, {} primitives, source {}", r.vertices, r.triangles, r.primitives, r.source);
+            eprintln!(
+                "sunbeam-bake: {} vertices, {} triangles, {} primitives, source {}",
+                r.vertices, r.triangles, r.primitives, r.source
+            );
         }
     }
     Ok(())

@@ -14,11 +14,19 @@ fn tmpdir(name: &str) -> PathBuf {
 }
 
 fn bake(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().expect("run sunbeam-bake")
+    Command::new(BIN)
+        .args(args)
+        .output()
+        .expect("run sunbeam-bake")
 }
 
 fn ok(o: &Output) {
-    assert!(o.status.success(), "exit {:?}\nstderr: {}", o.status.code(), String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.status.success(),
+        "exit {:?}\nstderr: {}",
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 /// The Khronos validator on `files` (skips, or fails under SUNBEAM_REQUIRE_ALL=1, without node).
@@ -29,18 +37,31 @@ fn validate(files: &[&Path]) {
         return;
     }
     if !node_dir.join("node_modules/gltf-validator").is_dir() {
-        assert!(!sunbeam_common::testdata::require_all(), "tests/node/node_modules/gltf-validator missing (run scripts/ensure-deps.sh)");
+        assert!(
+            !sunbeam_common::testdata::require_all(),
+            "tests/node/node_modules/gltf-validator missing (run scripts/ensure-deps.sh)"
+        );
         eprintln!("SKIP: tests/node/node_modules/gltf-validator missing");
         return;
     }
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/validate.mjs");
-    let o = Command::new("node").arg(script).arg(&node_dir).args(files).output().expect("run node");
+    let o = Command::new("node")
+        .arg(script)
+        .arg(&node_dir)
+        .args(files)
+        .output()
+        .expect("run node");
     let out = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "glTF-Validator reports errors:\n{out}\n{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.status.success(),
+        "glTF-Validator reports errors:\n{out}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     assert_eq!(out.lines().count(), files.len(), "{out}");
 }
 
-const OBJ_PLAIN: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 0.4\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";
+const OBJ_PLAIN: &str =
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 0.4\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";
 const OBJ_FULL: &str = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nusemtl red\nf 1/1/1 2/2/1 3/3/1\nusemtl blue\nf 1/1/1 3/3/1 4/4/1\n";
 
 #[test]
@@ -49,40 +70,116 @@ fn every_output_passes_the_validator() {
     let p = |n: &str| d.join(n);
     std::fs::write(p("plain.obj"), OBJ_PLAIN).unwrap();
     std::fs::write(p("full.obj"), OBJ_FULL).unwrap();
-    std::fs::write(p("m.mtl"), "newmtl red\nKd 1 0 0\nmap_Kd tex.png\nnewmtl blue\nKd 0 0 1\nd 0.5\n").unwrap();
+    std::fs::write(
+        p("m.mtl"),
+        "newmtl red\nKd 1 0 0\nmap_Kd tex.png\nnewmtl blue\nKd 0 0 1\nd 0.5\n",
+    )
+    .unwrap();
     // A tiny valid PNG for map_Kd (1x1 grey), made with the png encoder through the baker's texture path
     // is overkill: write a known 1x1 PNG.
     std::fs::write(p("tex.png"), TINY_PNG).unwrap();
-    std::fs::write(p("uv.csv"), "u,v,angle_deg\n0.1,0.1,0\n0.9,0.2,45\n0.5,0.9,90\n0.5,0.5,-30\n").unwrap();
+    std::fs::write(
+        p("uv.csv"),
+        "u,v,angle_deg\n0.1,0.1,0\n0.9,0.2,45\n0.5,0.9,90\n0.5,0.5,-30\n",
+    )
+    .unwrap();
     let s = |x: &PathBuf| x.to_str().unwrap().to_string();
     let runs: Vec<Vec<String>> = vec![
-        vec!["--generate-snake".into(), "-o".into(), s(&p("snake.glb")), "--spine-out".into(), s(&p("spine.json")), "--snake-detail".into(), "0.5".into()],
-        vec![s(&p("snake.glb")), "-o".into(), s(&p("snake_curve.glb")), "--curve".into(), s(&p("spine.json")), "--texture".into(), s(&p("dir.png")), "--texture-size".into(), "128".into()],
-        vec![s(&p("snake.glb")), "-o".into(), s(&p("snake_uv.glb")), "--uv-direction".into(), "v".into(), "--rotate-deg".into(), "15".into(), "--texture".into(), s(&p("dir.exr")), "--texture-size".into(), "64".into()],
-        vec![s(&p("snake.glb")), "-o".into(), s(&p("snake_samples.glb")), "--samples".into(), s(&p("uv.csv"))],
-        vec![s(&p("plain.obj")), "-o".into(), s(&p("plain.glb")), "--axis".into(), "1,0.2,0".into()],
-        vec![s(&p("full.obj")), "-o".into(), s(&p("full.glb")), "--axis".into(), "0,1,0".into()],
-        vec![s(&p("full.glb")), "-o".into(), s(&p("full2.glb")), "--uv-direction".into(), "u".into()],
+        vec![
+            "--generate-snake".into(),
+            "-o".into(),
+            s(&p("snake.glb")),
+            "--spine-out".into(),
+            s(&p("spine.json")),
+            "--snake-detail".into(),
+            "0.5".into(),
+        ],
+        vec![
+            s(&p("snake.glb")),
+            "-o".into(),
+            s(&p("snake_curve.glb")),
+            "--curve".into(),
+            s(&p("spine.json")),
+            "--texture".into(),
+            s(&p("dir.png")),
+            "--texture-size".into(),
+            "128".into(),
+        ],
+        vec![
+            s(&p("snake.glb")),
+            "-o".into(),
+            s(&p("snake_uv.glb")),
+            "--uv-direction".into(),
+            "v".into(),
+            "--rotate-deg".into(),
+            "15".into(),
+            "--texture".into(),
+            s(&p("dir.exr")),
+            "--texture-size".into(),
+            "64".into(),
+        ],
+        vec![
+            s(&p("snake.glb")),
+            "-o".into(),
+            s(&p("snake_samples.glb")),
+            "--samples".into(),
+            s(&p("uv.csv")),
+        ],
+        vec![
+            s(&p("plain.obj")),
+            "-o".into(),
+            s(&p("plain.glb")),
+            "--axis".into(),
+            "1,0.2,0".into(),
+        ],
+        vec![
+            s(&p("full.obj")),
+            "-o".into(),
+            s(&p("full.glb")),
+            "--axis".into(),
+            "0,1,0".into(),
+        ],
+        vec![
+            s(&p("full.glb")),
+            "-o".into(),
+            s(&p("full2.glb")),
+            "--uv-direction".into(),
+            "u".into(),
+        ],
     ];
     for r in &runs {
         let args: Vec<&str> = r.iter().map(String::as_str).collect();
         ok(&bake(&args));
     }
-    let outs = ["snake.glb", "snake_curve.glb", "snake_uv.glb", "snake_samples.glb", "plain.glb", "full.glb", "full2.glb"].map(p);
+    let outs = [
+        "snake.glb",
+        "snake_curve.glb",
+        "snake_uv.glb",
+        "snake_samples.glb",
+        "plain.glb",
+        "full.glb",
+        "full2.glb",
+    ]
+    .map(p);
     let refs: Vec<&Path> = outs.iter().map(PathBuf::as_path).collect();
     validate(&refs);
     // Everything of the input is kept: materials (2), the embedded texture image.
     let m = sunbeam_mesh::load_document(&p("full2.glb")).unwrap();
     assert_eq!(m.array("materials").len(), 2);
     assert_eq!(m.array("images").len(), 1);
-    assert_eq!(m.json["materials"][1]["pbrMetallicRoughness"]["baseColorFactor"][3], 0.5);
+    assert_eq!(
+        m.json["materials"][1]["pbrMetallicRoughness"]["baseColorFactor"][3],
+        0.5
+    );
     let _ = std::fs::remove_dir_all(d);
 }
 
 const TINY_PNG: &[u8] = &[
-    0x89, 0x50, 0x4E, 0x47, 0x0D, 0x0A, 0x1A, 0x0A, 0x00, 0x00, 0x00, 0x0D, 0x49, 0x48, 0x44, 0x52, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x01, 0x08, 0x00, 0x00, 0x00,
-    0x00, 0x3A, 0x7E, 0x9B, 0x55, 0x00, 0x00, 0x00, 0x0A, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9C, 0x63, 0x68, 0x00, 0x00, 0x00, 0x82, 0x00, 0x81, 0x4C, 0x17, 0xD7, 0xDF, 0x00,
-    0x00, 0x00, 0x00, 0x49, 0x45, 0x4E, 0x44, 0xAE, 0x42, 0x60, 0x82,
+    0x89, 0x50, 0x4E, 0x47, 0x0D, 0x0A, 0x1A, 0x0A, 0x00, 0x00, 0x00, 0x0D, 0x49, 0x48, 0x44, 0x52,
+    0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x01, 0x08, 0x00, 0x00, 0x00, 0x00, 0x3A, 0x7E, 0x9B,
+    0x55, 0x00, 0x00, 0x00, 0x0A, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9C, 0x63, 0x68, 0x00, 0x00, 0x00,
+    0x82, 0x00, 0x81, 0x4C, 0x17, 0xD7, 0xDF, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4E, 0x44, 0xAE,
+    0x42, 0x60, 0x82,
 ];
 
 #[test]
@@ -94,17 +191,86 @@ fn exit_codes_json_depfile_and_determinism() {
     std::fs::write(p("junk.glb"), b"glTF\x02\0\0\0junkjunkjunkjunk").unwrap();
     std::fs::write(p("bad.csv"), "x,y,z,dx,dy,dz\n0,0,nan,1,0,0\n").unwrap();
     // Usage errors: 1.
-    assert_eq!(bake(&[&s(p("plain.obj")), "-o", &s(p("o.glb"))]).status.code(), Some(1), "no source");
-    assert_eq!(bake(&[&s(p("plain.obj")), "-o", &s(p("o.glb")), "--axis", "0,0,0"]).status.code(), Some(1));
-    assert_eq!(bake(&[&s(p("plain.obj")), "-o", &s(p("o.glb")), "--axis", "1,0,0", "--curve", "x.json"]).status.code(), Some(1));
+    assert_eq!(
+        bake(&[&s(p("plain.obj")), "-o", &s(p("o.glb"))])
+            .status
+            .code(),
+        Some(1),
+        "no source"
+    );
+    assert_eq!(
+        bake(&[&s(p("plain.obj")), "-o", &s(p("o.glb")), "--axis", "0,0,0"])
+            .status
+            .code(),
+        Some(1)
+    );
+    assert_eq!(
+        bake(&[
+            &s(p("plain.obj")),
+            "-o",
+            &s(p("o.glb")),
+            "--axis",
+            "1,0,0",
+            "--curve",
+            "x.json"
+        ])
+        .status
+        .code(),
+        Some(1)
+    );
     assert_eq!(bake(&["--bogus"]).status.code(), Some(1));
     // Bad inputs: 2, naming the file, no output left.
     for (args, name) in [
-        (vec![s(p("junk.glb")), "-o".into(), s(p("o.glb")), "--axis".into(), "1,0,0".into()], "junk.glb"),
-        (vec![s(p("missing.obj")), "-o".into(), s(p("o.glb")), "--axis".into(), "1,0,0".into()], "missing.obj"),
-        (vec![s(p("plain.obj")), "-o".into(), s(p("o.glb")), "--samples".into(), s(p("bad.csv"))], "bad.csv"),
-        (vec![s(p("plain.obj")), "-o".into(), s(p("o.glb")), "--uv-direction".into(), "u".into()], "plain.obj"),
-        (vec![s(p("plain.obj")), "-o".into(), s(p("o.glb")), "--curve".into(), s(p("bad.csv"))], "bad.csv"),
+        (
+            vec![
+                s(p("junk.glb")),
+                "-o".into(),
+                s(p("o.glb")),
+                "--axis".into(),
+                "1,0,0".into(),
+            ],
+            "junk.glb",
+        ),
+        (
+            vec![
+                s(p("missing.obj")),
+                "-o".into(),
+                s(p("o.glb")),
+                "--axis".into(),
+                "1,0,0".into(),
+            ],
+            "missing.obj",
+        ),
+        (
+            vec![
+                s(p("plain.obj")),
+                "-o".into(),
+                s(p("o.glb")),
+                "--samples".into(),
+                s(p("bad.csv")),
+            ],
+            "bad.csv",
+        ),
+        (
+            vec![
+                s(p("plain.obj")),
+                "-o".into(),
+                s(p("o.glb")),
+                "--uv-direction".into(),
+                "u".into(),
+            ],
+            "plain.obj",
+        ),
+        (
+            vec![
+                s(p("plain.obj")),
+                "-o".into(),
+                s(p("o.glb")),
+                "--curve".into(),
+                s(p("bad.csv")),
+            ],
+            "bad.csv",
+        ),
     ] {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let o = bake(&args);
@@ -114,10 +280,30 @@ fn exit_codes_json_depfile_and_determinism() {
         assert!(!p("o.glb").exists());
     }
     // Output not writable: 3.
-    let o = bake(&[&s(p("plain.obj")), "-o", &s(p("no/such/dir/o.glb")), "--axis", "1,0,0"]);
-    assert_eq!(o.status.code(), Some(3), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = bake(&[
+        &s(p("plain.obj")),
+        "-o",
+        &s(p("no/such/dir/o.glb")),
+        "--axis",
+        "1,0,0",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     // JSON report + depfile; identical bytes on a second run.
-    let o = bake(&[&s(p("plain.obj")), "-o", &s(p("a.glb")), "--axis", "1,0,0", "--json", "--depfile", &s(p("a.d"))]);
+    let o = bake(&[
+        &s(p("plain.obj")),
+        "-o",
+        &s(p("a.glb")),
+        "--axis",
+        "1,0,0",
+        "--json",
+        "--depfile",
+        &s(p("a.d")),
+    ]);
     ok(&o);
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(r["vertices"], 5);
@@ -125,8 +311,17 @@ fn exit_codes_json_depfile_and_determinism() {
     assert_eq!(r["without_direction"], serde_json::json!({}));
     let dep = std::fs::read_to_string(p("a.d")).unwrap();
     assert!(dep.contains("a.glb:") && dep.contains("plain.obj"), "{dep}");
-    ok(&bake(&[&s(p("plain.obj")), "-o", &s(p("b.glb")), "--axis", "1,0,0"]));
-    assert_eq!(std::fs::read(p("a.glb")).unwrap(), std::fs::read(p("b.glb")).unwrap());
+    ok(&bake(&[
+        &s(p("plain.obj")),
+        "-o",
+        &s(p("b.glb")),
+        "--axis",
+        "1,0,0",
+    ]));
+    assert_eq!(
+        std::fs::read(p("a.glb")).unwrap(),
+        std::fs::read(p("b.glb")).unwrap()
+    );
     // Stdout output.
     let o = bake(&[&s(p("plain.obj")), "-o", "-", "--axis", "1,0,0"]);
     ok(&o);
@@ -144,9 +339,15 @@ fn rich_gltf_keeps_everything() {
     use serde_json::json;
     let d = tmpdir("rich");
     let mut bin: Vec<u8> = Vec::new();
-    let f32s = |b: &mut Vec<u8>, v: &[f32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
+    let f32s =
+        |b: &mut Vec<u8>, v: &[f32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
     // View 0: interleaved POSITION + NORMAL, 4 vertices, stride 24.
-    for (p, n) in [([0f32, 0., 0.], [0f32, 0., 1.]), ([1., 0., 0.], [0., 0., 1.]), ([1., 1., 0.], [0., 0., 1.]), ([0., 1., 0.], [0., 0., 1.])] {
+    for (p, n) in [
+        ([0f32, 0., 0.], [0f32, 0., 1.]),
+        ([1., 0., 0.], [0., 0., 1.]),
+        ([1., 1., 0.], [0., 0., 1.]),
+        ([0., 1., 0.], [0., 0., 1.]),
+    ] {
         f32s(&mut bin, &p);
         f32s(&mut bin, &n);
     }
@@ -222,7 +423,7 @@ fn rich_gltf_keeps_everything() {
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
         "nodes": [
             {"name": "a", "mesh": 0, "translation": [2, 0, 0]},
-            {"name": "b", "mesh": 0, "rotation": [0, 0, 0.7071068, 0.7071068], "children": [2]},
+            {"name": "b", "mesh": 0, "rotation": [0, 0, 0.6, 0.8], "children": [2]},
             {"name": "c", "mesh": 1, "matrix": [2,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,-1,1]},
             {"name": "cam", "camera": 0, "extras": {"x": true}}
         ],
@@ -235,7 +436,16 @@ fn rich_gltf_keeps_everything() {
     std::fs::write(&input, serde_json::to_vec_pretty(&g).unwrap()).unwrap();
     validate(&[&input]);
     let out = d.join("rich.glb");
-    let o = bake(&[input.to_str().unwrap(), "-o", out.to_str().unwrap(), "--axis", "1,1,0", "--json", "--depfile", d.join("rich.d").to_str().unwrap()]);
+    let o = bake(&[
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--axis",
+        "1,1,0",
+        "--json",
+        "--depfile",
+        d.join("rich.d").to_str().unwrap(),
+    ]);
     ok(&o);
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(r["primitives"], 3, "{r}");
@@ -245,21 +455,43 @@ fn rich_gltf_keeps_everything() {
     let back = sunbeam_mesh::load_document(&out).unwrap();
     let j = &back.json;
     assert_eq!(j["asset"]["extras"]["who"], "test");
-    assert_eq!(j["materials"][0]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"], 2.0);
+    assert_eq!(
+        j["materials"][0]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"],
+        2.0
+    );
     assert_eq!(j["materials"][0]["normalTexture"]["scale"], 0.5);
     assert_eq!(j["images"][0]["name"], "nrm");
     assert_eq!(j["animations"].as_array().unwrap().len(), 1);
     assert_eq!(j["cameras"][0]["type"], "perspective");
     assert_eq!(j["nodes"][3]["extras"]["x"], true);
     assert_eq!(j["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"], 3);
-    assert!(j["meshes"][0]["primitives"][2]["attributes"].get("TANGENT").is_none(), "points untouched");
-    assert_ne!(j["meshes"][1]["primitives"][0]["attributes"]["TANGENT"], 6, "old TANGENT replaced");
+    assert!(
+        j["meshes"][0]["primitives"][2]["attributes"]
+            .get("TANGENT")
+            .is_none(),
+        "points untouched"
+    );
+    assert_ne!(
+        j["meshes"][1]["primitives"][0]["attributes"]["TANGENT"], 6,
+        "old TANGENT replaced"
+    );
     // The sparse vertex was read with its override, and the loader sees the baked field.
     let m = sunbeam_mesh::load_scene_mesh(&out).unwrap();
-    assert_eq!(m.orientation_source, Some(sunbeam_mesh::OrientationSource::Baked));
+    assert_eq!(
+        m.orientation_source,
+        Some(sunbeam_mesh::OrientationSource::Baked)
+    );
     // Node c (x2, z-1) is a child of b (90 degrees about z): (0.5,2,0) -> (1,2,-1) -> (-2,1,-1).
-    assert!(m.positions.iter().any(|p| (p[0] + 2.0).abs() < 1e-6 && (p[1] - 1.0).abs() < 1e-6 && (p[2] + 1.0).abs() < 1e-6), "sparse override");
+    assert!(
+        m.positions.iter().any(|p| (p[0] + 2.0).abs() < 1e-6
+            && (p[1] - 1.0).abs() < 1e-6
+            && (p[2] + 1.0).abs() < 1e-6),
+        "sparse override"
+    );
     let dep = std::fs::read_to_string(d.join("rich.d")).unwrap();
-    assert!(dep.contains("rich.bin") && dep.contains("normal.png"), "{dep}");
+    assert!(
+        dep.contains("rich.bin") && dep.contains("normal.png"),
+        "{dep}"
+    );
     let _ = std::fs::remove_dir_all(d);
 }

@@ -209,6 +209,7 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
             "patch_m": [src.patch_size().0, src.patch_size().1],
             "peaks": out.peaks.iter().map(|p| json!([p.lambda_m, p.theta_r_deg])).collect::<Vec<_>>(),
             "peak_r": out.peaks.iter().map(|p| p.r).collect::<Vec<_>>(),
+            "peak_f_per_m": out.peaks.iter().map(|p| p.f).collect::<Vec<_>>(),
         });
         println!("{report}");
     } else if !quiet {

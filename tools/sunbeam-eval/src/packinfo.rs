@@ -1,10 +1,6 @@
 //! What the tools need to know about a pack, from its manifest.
 
-use sunbeam_pack::{Manifest, Model, Pack};
-
-pub fn manifest(p: &Pack) -> &Manifest {
-    &p.manifest
-}
+use sunbeam_pack::{Model, Pack};
 
 pub fn patch_size(p: &Pack) -> (f64, f64) {
     (p.manifest.patch.lx_m, p.manifest.patch.ly_m)

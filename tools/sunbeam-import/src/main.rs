@@ -342,15 +342,26 @@ fn run(cli: Cli) -> Result<()> {
         return Ok(());
     }
     let ch = sunbeam_afm::select_channel(&chans, cli.channel.as_deref()).map_err(in_file)?;
-    if ch.z_unit != "m" {
+    // A channel without a z unit: --z-scale (metres per unit) calibrates it.
+    let unitless_scale = match (ch.z_unit.is_empty(), plan.read.z_scale) {
+        (true, Some(s)) => Some(s),
+        _ => None,
+    };
+    if ch.z_unit != "m" && unitless_scale.is_none() {
         return Err(in_file(Error::input(format!(
-            "channel '{}' is in '{}', not metres: not a height field (pick a height channel with --channel; --list shows them)",
+            "channel '{}' is in '{}', not metres: not a height field (pick a height channel with --channel, --list shows them; a channel without unit takes --z-scale)",
             ch.name,
             if ch.z_unit.is_empty() { "no unit" } else { &ch.z_unit }
         ))));
     }
     let mut field = ch.field.clone();
     let mut processing = Vec::new();
+    if let Some(sc) = unitless_scale {
+        field.data.iter_mut().for_each(|v| *v *= sc);
+        let d = format!("calibrate z scale {} per unit", format_length(sc));
+        field.provenance.processing.push(d.clone());
+        processing.push(d);
+    }
     let mut steps = plan.steps.clone();
     let pixel_size_role;
     if ch.xy_unit != "m" {

@@ -6,7 +6,13 @@ use std::path::Path;
 use sunbeam_mesh::gltf::Document;
 
 /// A single-primitive document from raw arrays (NORMAL/UV optional), one node with `node` JSON merged in.
-pub fn doc_from(pos: &[[f64; 3]], nrm: Option<&[[f64; 3]]>, uv: Option<&[[f64; 2]]>, idx: &[u32], node: serde_json::Value) -> Document {
+pub fn doc_from(
+    pos: &[[f64; 3]],
+    nrm: Option<&[[f64; 3]]>,
+    uv: Option<&[[f64; 2]]>,
+    idx: &[u32],
+    node: serde_json::Value,
+) -> Document {
     let mut d = Document::new_empty(Path::new("test.glb"));
     let fp: Vec<f32> = pos.iter().flat_map(|v| v.map(|x| x as f32)).collect();
     let pa = d.push_f32_accessor(&fp, 3, true);
@@ -18,10 +24,14 @@ pub fn doc_from(pos: &[[f64; 3]], nrm: Option<&[[f64; 3]]>, uv: Option<&[[f64; 2
     }
     if let Some(u) = uv {
         let f: Vec<f32> = u.iter().flat_map(|v| v.map(|x| x as f32)).collect();
-        attrs.insert("TEXCOORD_0".into(), json!(d.push_f32_accessor(&f, 2, false)));
+        attrs.insert(
+            "TEXCOORD_0".into(),
+            json!(d.push_f32_accessor(&f, 2, false)),
+        );
     }
     let ia = d.push_index_accessor(idx);
-    d.json_array_mut("meshes").push(json!({"primitives": [{"attributes": attrs, "indices": ia}]}));
+    d.json_array_mut("meshes")
+        .push(json!({"primitives": [{"attributes": attrs, "indices": ia}]}));
     let mut n = json!({"mesh": 0});
     if let Some(o) = node.as_object() {
         for (k, v) in o {
@@ -35,7 +45,10 @@ pub fn doc_from(pos: &[[f64; 3]], nrm: Option<&[[f64; 3]]>, uv: Option<&[[f64; 2
 }
 
 /// An n x n vertex grid on [0,1]^2 in the x-y plane (z = height(x,y)), UV = (x, y).
-pub fn grid(n: usize, height: impl Fn(f64, f64) -> f64) -> (Vec<[f64; 3]>, Vec<[f64; 2]>, Vec<u32>) {
+pub fn grid(
+    n: usize,
+    height: impl Fn(f64, f64) -> f64,
+) -> (Vec<[f64; 3]>, Vec<[f64; 2]>, Vec<u32>) {
     let mut pos = Vec::new();
     let mut uv = Vec::new();
     for j in 0..n {
@@ -49,7 +62,14 @@ pub fn grid(n: usize, height: impl Fn(f64, f64) -> f64) -> (Vec<[f64; 3]>, Vec<[
     for j in 0..n as u32 - 1 {
         for i in 0..n as u32 - 1 {
             let a = j * n as u32 + i;
-            idx.extend_from_slice(&[a, a + 1, a + n as u32 + 1, a, a + n as u32 + 1, a + n as u32]);
+            idx.extend_from_slice(&[
+                a,
+                a + 1,
+                a + n as u32 + 1,
+                a,
+                a + n as u32 + 1,
+                a + n as u32,
+            ]);
         }
     }
     (pos, uv, idx)
@@ -59,7 +79,10 @@ pub fn grid(n: usize, height: impl Fn(f64, f64) -> f64) -> (Vec<[f64; 3]>, Vec<[
 pub struct Lcg(pub u64);
 impl Lcg {
     pub fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (self.0 >> 11) as f64 / (1u64 << 53) as f64
     }
 }
