@@ -145,8 +145,8 @@ pub fn read(b: &[u8], opts: &ReadOptions) -> Result<Vec<Channel>> {
             (s, s)
         }
     };
-    let nx = (w / d.0).floor() as i64 + 1;
-    let ny = (h / d.1).floor() as i64 + 1;
+    let nx = ((w / d.0).floor() + 1.0).min(1e15) as i64;
+    let ny = ((h / d.1).floor() + 1.0).min(1e15) as i64;
     let (nx, ny) = check_dims(nx, ny, "XYZ resampling grid")?;
     if nx * ny > 1 << 26 {
         bail!("XYZ resampling grid {nx}x{ny} is too large; give a larger --pixel-size");

@@ -253,3 +253,20 @@ fn uncalibrated_images_name_the_missing_flags() {
         "{m}"
     );
 }
+
+/// Inputs the fuzzer found (fuzz/, docs/bench/fuzz.md), kept as regressions.
+#[test]
+fn fuzzer_findings() {
+    use sunbeam_afm::Format;
+    let cases: &[(&str, Format, &[u8])] = &[
+        // xyz: extreme aspect ratio -> grid size overflowed i64 (add overflow)
+        // (with the fuzz targets' --pixel-size 1nm)
+        ("xyz grid overflow", Format::Xyz, b"0 0 0\n333333333333330 2 0\n0 20 62 \n\n"),
+    ];
+    for (what, f, b) in cases {
+        let o = ReadOptions { format: Some(*f), ..uncal() };
+        if let Err(e) = read_bytes(b, &o) {
+            assert_eq!(e.code, ExitCode::Input, "{what}: {e}");
+        }
+    }
+}

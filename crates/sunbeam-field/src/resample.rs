@@ -156,7 +156,12 @@ fn axis(n_in: usize, d_in: f64, n_out: usize, d_out: f64) -> Axis {
             *v /= sum;
         }
     }
-    Axis { taps, idx, w, contiguous }
+    Axis {
+        taps,
+        idx,
+        w,
+        contiguous,
+    }
 }
 
 /// Dot product with four accumulators (vectorises; fixed order, so the result
@@ -192,11 +197,14 @@ fn apply_rows(src: &[f64], n_in: usize, ax: &Axis, n_out: usize) -> Vec<f64> {
             s.spawn(move || {
                 for (orow, irow) in chunk_out.chunks_mut(n_out).zip(chunk_in.chunks(n_in)) {
                     for (k, o) in orow.iter_mut().enumerate() {
-                        let (ix, wt) = (
-                            &ax.idx[k * ax.taps..(k + 1) * ax.taps],
-                            &ax.w[k * ax.taps..(k + 1) * ax.taps],
-                        );
-                        *o = ix.iter().zip(wt).map(|(&j, &w)| irow[j] * w).sum();
+                        let wt = &ax.w[k * ax.taps..(k + 1) * ax.taps];
+                        *o = match ax.contiguous[k] {
+                            Some(first) => dot(&irow[first..first + ax.taps], wt),
+                            None => {
+                                let ix = &ax.idx[k * ax.taps..(k + 1) * ax.taps];
+                                ix.iter().zip(wt).map(|(&j, &w)| irow[j] * w).sum()
+                            }
+                        };
                     }
                 }
             });

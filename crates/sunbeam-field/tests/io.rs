@@ -207,10 +207,19 @@ fn oiiotool_reads_our_exr() {
 #[test]
 fn mutated_files_never_panic() {
     // A small deterministic mutation fuzzer over both decoders.
-    let f = HeightField::new(9, 7, 1e-9, 2e-9, (0..63).map(|v| v as f64 * 1e-10).collect()).unwrap();
+    let f = HeightField::new(
+        9,
+        7,
+        1e-9,
+        2e-9,
+        (0..63).map(|v| v as f64 * 1e-10).collect(),
+    )
+    .unwrap();
     let mut seed = 0x1234_5678_9abc_def0u64;
     let mut next = move || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (seed >> 33) as usize
     };
     for kind in [Kind::Exr, Kind::Gsf] {

@@ -680,9 +680,16 @@ pub fn bake(mut doc: Document, opts: &BakeOptions) -> Result<Baked> {
         attrs.push(("TANGENT", doc.push_f32_accessor(&t, 4, false)));
         let o: Vec<f32> = w.t_local.iter().flat_map(|v| v.map(|x| x as f32)).collect();
         attrs.push(("_ORIENTATION", doc.push_f32_accessor(&o, 3, false)));
-        let a = &mut doc.json["meshes"][w.mesh]["primitives"][w.prim]["attributes"];
+        let a = doc
+            .json
+            .pointer_mut(&format!(
+                "/meshes/{}/primitives/{}/attributes",
+                w.mesh, w.prim
+            ))
+            .and_then(|a| a.as_object_mut())
+            .ok_or_else(|| Error::internal("primitive attributes vanished"))?;
         for (k, v) in attrs {
-            a[k] = json!(v);
+            a.insert(k.to_string(), json!(v));
         }
     }
     Ok(Baked { doc, work, report })

@@ -226,8 +226,9 @@ impl Document {
             .unwrap_or(false);
         let total = count
             .checked_mul(ncomp)
-            .ok_or_else(|| self.err(format!("{what}.count too large")))?;
-        let mut out = vec![0.0f64; total];
+            .filter(|&t| t <= 1 << 30)
+            .ok_or_else(|| self.err(format!("{what}.count {count} too large")))?;
+        let mut out = Vec::new();
         if let Some(bv) = acc.get("bufferView").and_then(Value::as_u64) {
             let off = acc.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
             let (data, stride) = self.view_bytes(bv as usize, &what)?;
@@ -249,12 +250,17 @@ impl Document {
                     )));
                 }
             }
+            out = vec![0.0f64; total];
             for i in 0..count {
                 let base = off + i * stride;
                 for c in 0..ncomp {
                     out[i * ncomp + c] = read_comp(&data[base + c * csize..], ctype, normalized);
                 }
             }
+        }
+        if out.is_empty() {
+            // No buffer view: zeros (count checked above; a sparse part may follow).
+            out = vec![0.0f64; total];
         }
         if let Some(sp) = acc.get("sparse") {
             let n = sp.get("count").and_then(Value::as_u64).unwrap_or(0) as usize;
@@ -428,8 +434,12 @@ impl Document {
     /// Keep `buffers[0].byteLength` equal to the bytes held.
     fn sync_len(&mut self) {
         let len = self.buffers.first().map_or(0, |b| b.len());
-        if let Some(b0) = self.json_array_mut("buffers").first_mut() {
-            b0["byteLength"] = json!(len);
+        if let Some(b0) = self
+            .json_array_mut("buffers")
+            .first_mut()
+            .and_then(Value::as_object_mut)
+        {
+            b0.insert("byteLength".into(), json!(len));
         }
     }
 
@@ -468,8 +478,14 @@ impl Document {
                 ));
             }
             let off = v.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize + bases[b];
-            v["buffer"] = json!(0);
-            v["byteOffset"] = json!(off);
+            let Some(o) = v.as_object_mut() else {
+                return Err(Error::input_file(
+                    &self.source,
+                    format!("bufferViews[{i}] is not an object"),
+                ));
+            };
+            o.insert("buffer".into(), json!(0));
+            o.insert("byteOffset".into(), json!(off));
         }
         // Buffer 0 keeps its name/extras, loses its uri.
         let mut b0 = self
@@ -516,9 +532,7 @@ impl Document {
         if self.buffers.is_empty() {
             // A document without geometry: no buffers at all.
         } else {
-            let len = self.buffers[0].len();
-            let b0 = &mut self.json_array_mut("buffers")[0];
-            b0["byteLength"] = json!(len);
+            self.sync_len();
         }
         // Empty top-level arrays are invalid glTF ("must have at least 1 item").
         if let Some(o) = self.json.as_object_mut() {

@@ -488,3 +488,90 @@ fn curve_nearest_point_matches_brute_force_and_is_projected() {
         }
     }
 }
+
+#[test]
+fn direction_map_png_and_exr() {
+    use sunbeam_mesh::texture::{render, TextureOptions};
+    // A grid covering UV [0.25, 0.75]^2, direction 30 degrees from +u everywhere.
+    let (pos, uv, idx) = grid(6, |x, y| 0.1 * x * y);
+    let uv: Vec<[f64; 2]> = uv
+        .iter()
+        .map(|q| [0.25 + 0.5 * q[0], 0.25 + 0.5 * q[1]])
+        .collect();
+    let d = doc_from(&pos, None, Some(&uv), &idx, json!({}));
+    let mut o = BakeOptions::new(Source::UvDirection(UvAxis::U));
+    o.rotate_deg = 30.0;
+    let (w, _) = compute(&d, &o).unwrap();
+    let (c30, s30) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    // PNG
+    let (bytes, rep) = render(
+        &w,
+        &TextureOptions {
+            size: 64,
+            dilate: 2,
+            path: "d.png".into(),
+        },
+    )
+    .unwrap();
+    assert_eq!(rep["covered_texels"], 32 * 32);
+    assert!(rep["dilated_texels"].as_u64().unwrap() > 0);
+    let dec = png::Decoder::new(std::io::Cursor::new(bytes));
+    let mut r = dec.read_info().unwrap();
+    let mut buf = vec![0u8; r.output_buffer_size()];
+    let info = r.next_frame(&mut buf).unwrap();
+    assert_eq!((info.width, info.bit_depth), (64, png::BitDepth::Sixteen));
+    let px = |x: usize, y: usize, c: usize| {
+        u16::from_be_bytes([
+            buf[(y * 64 + x) * 6 + 2 * c],
+            buf[(y * 64 + x) * 6 + 2 * c + 1],
+        ]) as f64
+            / 65535.0
+    };
+    for (x, y) in [(32, 32), (17, 40), (46, 17)] {
+        assert!(
+            (px(x, y, 0) - (0.5 + 0.5 * c30)).abs() < 1e-4
+                && (px(x, y, 1) - (0.5 + 0.5 * s30)).abs() < 1e-4
+        );
+        assert_eq!(px(x, y, 2), 1.0);
+    }
+    assert_eq!(px(2, 2, 2), 0.0, "far outside: empty");
+    assert!(
+        (px(15, 32, 2) - 0.5).abs() < 1e-4,
+        "the first ring outside the island is dilated"
+    );
+    assert!(
+        (px(15, 32, 0) - (0.5 + 0.5 * c30)).abs() < 1e-4,
+        "with the island's direction"
+    );
+    // EXR
+    let (bytes, _) = render(
+        &w,
+        &TextureOptions {
+            size: 32,
+            dilate: 0,
+            path: "d.exr".into(),
+        },
+    )
+    .unwrap();
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        {
+            let f = std::env::temp_dir().join(format!("sb-dir-{}.exr", std::process::id()));
+            std::fs::write(&f, &bytes).unwrap();
+            f
+        },
+        |res, _| vec![vec![(0f32, 0f32, 0f32, 0f32); res.width()]; res.height()],
+        |px: &mut Vec<Vec<(f32, f32, f32, f32)>>, p, (r, g, b, a): (f32, f32, f32, f32)| {
+            px[p.y()][p.x()] = (r, g, b, a)
+        },
+    )
+    .unwrap();
+    let p = img.layer_data.channel_data.pixels[16][16];
+    assert!(
+        (p.0 as f64 - c30).abs() < 1e-6 && (p.1 as f64 - s30).abs() < 1e-6 && p.3 == 1.0,
+        "{p:?}"
+    );
+    assert!((p.2 as f64 - 60f64.to_radians().cos()).abs() < 1e-6);
+    let _ = std::fs::remove_file(
+        std::env::temp_dir().join(format!("sb-dir-{}.exr", std::process::id())),
+    );
+}

@@ -211,3 +211,74 @@ fn bad_files_are_input_errors_naming_the_file() {
     assert!(e.is_err());
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// Mutated and truncated files never panic: each load/bake is Ok or an input error.
+#[test]
+fn mutated_files_never_panic() {
+    let mut d = sunbeam_mesh::snake::generate(&sunbeam_mesh::snake::SnakeParams {
+        rings: 10,
+        segments: 4,
+        ..Default::default()
+    });
+    let glb = d.to_glb();
+    let json_len = u32::from_le_bytes([glb[12], glb[13], glb[14], glb[15]]) as usize;
+    let mut rng = Lcg(99);
+    let dir = tmpdir("fuzz");
+    let f = dir.join("f.glb");
+    let tokens: [&[u8]; 8] = [
+        b"0",
+        b"-1",
+        b"99999999999",
+        b"null",
+        b"[]",
+        b"{}",
+        b"\"x\"",
+        b"1e308",
+    ];
+    for round in 0..600 {
+        let mut b = glb.clone();
+        match round % 3 {
+            0 => b.truncate((rng.next() * b.len() as f64) as usize),
+            1 => {
+                for _ in 0..3 {
+                    let i = 20 + (rng.next() * json_len as f64) as usize;
+                    b[i] = (rng.next() * 256.0) as u8;
+                }
+            }
+            _ => {
+                // Replace a number in the JSON with another token (keeps it parseable more often).
+                let js = String::from_utf8_lossy(&b[20..20 + json_len]).into_owned();
+                let digits: Vec<usize> = js
+                    .char_indices()
+                    .filter(|(_, c)| c.is_ascii_digit())
+                    .map(|(i, _)| i)
+                    .collect();
+                let at = digits[(rng.next() * digits.len() as f64) as usize];
+                let tok = tokens[(rng.next() * tokens.len() as f64) as usize];
+                let mut njs = js.as_bytes()[..at].to_vec();
+                njs.extend_from_slice(tok);
+                njs.extend_from_slice(&js.as_bytes()[at + 1..]);
+                njs.resize(njs.len().next_multiple_of(4), b' ');
+                let mut nb = b[..12].to_vec();
+                nb.extend_from_slice(&(njs.len() as u32).to_le_bytes());
+                nb.extend_from_slice(b"JSON");
+                nb.extend_from_slice(&njs);
+                nb.extend_from_slice(&b[20 + json_len..]);
+                let total = nb.len() as u32;
+                nb[8..12].copy_from_slice(&total.to_le_bytes());
+                b = nb;
+            }
+        }
+        std::fs::write(&f, &b).unwrap();
+        let r = std::panic::catch_unwind(|| {
+            if let Ok(doc) = sunbeam_mesh::load_document(&f) {
+                let _ = scene_mesh(&doc);
+                if let Ok(mut baked) = bake(doc, &BakeOptions::new(Source::Axis([1.0, 0.0, 0.0]))) {
+                    let _ = baked.doc.to_glb();
+                }
+            }
+        });
+        assert!(r.is_ok(), "round {round} panicked");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -107,11 +107,13 @@ fn scene_for(mesh_name: &str, mesh: &Mesh, size: [u32; 2]) -> Scene {
     s
 }
 
-/// Blazed grating on `builtin:quad`, light at 30 degrees in the x-z plane so that the
-/// first orders cross the image.
+/// Blazed grating on `builtin:quad` filling the frame (eye at z = 1.5), light at
+/// 30 degrees in the x-z plane so that the first orders cross the image.
 pub fn quad_scene(size: [u32; 2]) -> (Scene, Mesh) {
     let mesh = Mesh::quad();
     let mut s = scene_for("builtin:quad", &mesh, size);
+    // close enough that the quad fills the frame
+    s.camera.eye = [0.0, 0.0, 1.5];
     s.lights = vec![Light { direction: [0.5, 0.0, 0.866], intensity: 1.0, spectrum: "D65".into() }];
     (s, mesh)
 }

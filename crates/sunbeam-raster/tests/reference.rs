@@ -23,6 +23,8 @@ fn lambert_quad_centre_and_coverage() {
         assert!((got[k] as f64 - want[k]).abs() < 1e-6, "{got:?} vs {want:?}");
     }
     // Coverage: the quad's projected area in pixels (square, centred) within one pixel row/column.
+    let mut p = p;
+    p.scene.camera.eye = [0.0, 0.0, 2.5];
     let g = raster::rasterise(&p, 64, 64);
     let covered = g.iter().filter(|f| f.mesh.is_some()).count() as f64;
     let d = (scene.camera.eye[2] - 0.0).abs();

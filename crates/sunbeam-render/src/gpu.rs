@@ -60,6 +60,7 @@ impl Gpu {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
             compatible_surface: None,
+            ..Default::default()
         }))
         .map_err(|e| Error::input(format!("{INSTALL_HINT} (backend {backend:?}: {e})")))?;
         Self::from_adapter(instance, adapter)

@@ -443,7 +443,7 @@ impl Renderer {
             meshes.push(GpuMesh { vbuf, ibuf, count: mesh.indices.len() as u32, bind });
         }
 
-        device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("diffraction.wgsl"),
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
@@ -489,7 +489,7 @@ impl Renderer {
             multiview_mask: None,
             cache: None,
         });
-        if let Some(e) = pollster::block_on(device.pop_error_scope()) {
+        if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::internal(format!("shader/pipeline creation failed: {e}")));
         }
         Ok(Renderer {

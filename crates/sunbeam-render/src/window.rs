@@ -118,6 +118,7 @@ impl App {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
             compatible_surface: Some(&surface),
+            ..Default::default()
         }))
         .map_err(|e| Error::input(format!("{INSTALL_HINT} ({e})")))?;
         let gpu = Gpu::from_adapter(instance, adapter)?;

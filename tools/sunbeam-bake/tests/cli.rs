@@ -151,6 +151,59 @@ fn every_output_passes_the_validator() {
         let args: Vec<&str> = r.iter().map(String::as_str).collect();
         ok(&bake(&args));
     }
+    // 3D samples: points of the spine (inside the body, ~radius from the surface) with the
+    // spine direction, snapped with a generous --max-snap; one sample far away is rejected.
+    let spine: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(p("spine.json")).unwrap()).unwrap();
+    let pts = spine["points"].as_array().unwrap();
+    let mut csv = String::from("x,y,z,dx,dy,dz,comment\n");
+    for k in (1..pts.len() - 1).step_by(15) {
+        let a: Vec<f64> = pts[k - 1]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let b: Vec<f64> = pts[k + 1]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let c: Vec<f64> = pts[k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        // Every other sample points backwards: axial data.
+        let sg = if k % 2 == 0 { 1.0 } else { -1.0 };
+        csv += &format!(
+            "{},{},{},{},{},{},spine\n",
+            c[0],
+            c[1],
+            c[2] + 0.02,
+            sg * (b[0] - a[0]),
+            sg * (b[1] - a[1]),
+            sg * (b[2] - a[2])
+        );
+    }
+    csv += "5,5,5,1,0,0,far\n";
+    std::fs::write(p("xyz.csv"), csv).unwrap();
+    let o = bake(&[
+        &s(&p("snake.glb")),
+        "-o",
+        &s(&p("snake_xyz.glb")),
+        "--samples",
+        &s(&p("xyz.csv")),
+        "--max-snap",
+        "0.1",
+        "--json",
+    ]);
+    ok(&o);
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["samples"]["rejected"].as_array().unwrap().len(), 1, "{r}");
+    assert!(r["samples"]["used"].as_u64().unwrap() > 10, "{r}");
     let outs = [
         "snake.glb",
         "snake_curve.glb",
@@ -402,7 +455,8 @@ fn rich_gltf_keeps_everything() {
              "sparse": {"count": 1, "indices": {"bufferView": 4, "componentType": 5121}, "values": {"bufferView": 5}}},
             {"bufferView": 6, "componentType": 5126, "count": 4, "type": "VEC4"},
             {"bufferView": 7, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
-            {"bufferView": 8, "componentType": 5126, "count": 2, "type": "VEC3"}
+            {"bufferView": 8, "componentType": 5126, "count": 2, "type": "VEC3"},
+            {"bufferView": 0, "byteOffset": 12, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 1], "max": [0, 0, 1]}
         ],
         "images": [{"uri": "normal.png", "name": "nrm"}],
         "samplers": [{"magFilter": 9729}],
@@ -417,8 +471,9 @@ fn rich_gltf_keeps_everything() {
                 {"attributes": {"POSITION": 0}, "mode": 0}
             ]},
             {"name": "sparse", "primitives": [
-                {"attributes": {"POSITION": 5, "NORMAL": 1, "TEXCOORD_0": 2, "TANGENT": 6}, "indices": 4, "material": 0}
-            ]}
+                {"attributes": {"POSITION": 5, "NORMAL": 1, "TEXCOORD_0": 2, "TANGENT": 6}, "indices": 4, "material": 0,
+                 "targets": [{"POSITION": 9}]}
+            ], "weights": [0.5]}
         ],
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
         "nodes": [
@@ -463,6 +518,8 @@ fn rich_gltf_keeps_everything() {
     assert_eq!(j["images"][0]["name"], "nrm");
     assert_eq!(j["animations"].as_array().unwrap().len(), 1);
     assert_eq!(j["cameras"][0]["type"], "perspective");
+    assert_eq!(j["meshes"][1]["primitives"][0]["targets"][0]["POSITION"], 9);
+    assert_eq!(j["meshes"][1]["weights"][0], 0.5);
     assert_eq!(j["nodes"][3]["extras"]["x"], true);
     assert_eq!(j["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"], 3);
     assert!(
@@ -481,10 +538,11 @@ fn rich_gltf_keeps_everything() {
         m.orientation_source,
         Some(sunbeam_mesh::OrientationSource::Baked)
     );
-    // Node c (x2, z-1) is a child of b (90 degrees about z): (0.5,2,0) -> (1,2,-1) -> (-2,1,-1).
+    // Node c (x2, z-1) is a child of b (quaternion (0,0,0.6,0.8): cos 0.28, sin 0.96 about z):
+    // (0.5,2,0) -> (1,2,-1) -> (0.28-1.92, 0.96+0.56, -1).
     assert!(
-        m.positions.iter().any(|p| (p[0] + 2.0).abs() < 1e-6
-            && (p[1] - 1.0).abs() < 1e-6
+        m.positions.iter().any(|p| (p[0] + 1.64).abs() < 1e-5
+            && (p[1] - 1.52).abs() < 1e-5
             && (p[2] + 1.0).abs() < 1e-6),
         "sparse override"
     );

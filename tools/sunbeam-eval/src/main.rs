@@ -1,6 +1,9 @@
 //! sunbeam-eval: ground truth, error and run-time benchmarks, the thesis'
 //! grating check, and BRDF pictures (docs/EVAL.md).
 
+mod bench;
+mod brdf;
+mod compare;
 mod grating;
 mod grating_plot;
 mod input;
@@ -8,6 +11,7 @@ mod packinfo;
 mod plot;
 mod probe;
 mod render;
+mod sample;
 mod source;
 
 use clap::{Parser, Subcommand};
@@ -35,8 +39,87 @@ enum Cmd {
     Probe(ProbeArgs),
     /// The thesis' grating evaluation: peak viewing angle per wavelength and the period.
     Grating(GratingArgs),
+    /// Spectral and colour errors of a pack against the ground truth of its height field.
+    Compare(CompareArgs),
+    /// Picture of a pack's reflected colour over the hemisphere and R over (angle, wavelength).
+    Brdf(BrdfArgs),
+    /// Run time against error sweeps (CSV, Pareto plot, markdown summary on stdout).
+    Bench(BenchArgs),
     /// The CPU reference image of a scene (needs sunbeam-raster).
     Render(RenderArgs),
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// The pack (KTX2/EXR).
+    pack: PathBuf,
+    /// The height field it was built from.
+    height: PathBuf,
+    /// Random (wi, wr, lambda) points for the spectral error.
+    #[arg(long, default_value_t = 2000)]
+    points: usize,
+    /// View directions per light for the colour error.
+    #[arg(long, default_value_t = 64)]
+    views: usize,
+    /// Light directions `THETA[,PHI]` (repeatable); default 0, 30, 60, 75 deg at phi 0 and 60 deg at phi 90.
+    #[arg(long, allow_hyphen_values = true)]
+    light: Vec<String>,
+    /// Wavelength samples of the pack's colour integral (the truth uses 1 nm).
+    #[arg(long, default_value_t = 64)]
+    lambda_samples: usize,
+    /// Fail (exit 5) when max |dR| exceeds this.
+    #[arg(long, default_value_t = 1e-3)]
+    tolerance: f64,
+    /// Fail (exit 5) when the 99th percentile CIEDE2000 exceeds this.
+    #[arg(long, default_value_t = 1.0)]
+    de_tolerance: f64,
+    /// Machine-readable report on stdout.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    heights: input::HeightArgs,
+}
+
+#[derive(clap::Args)]
+struct BrdfArgs {
+    /// The pack (KTX2/EXR).
+    pack: PathBuf,
+    /// Light direction `THETA[,PHI]`.
+    #[arg(long, default_value = "60deg,0deg", allow_hyphen_values = true)]
+    light: String,
+    /// Output PNG.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Disk resolution in pixels.
+    #[arg(long, default_value_t = 200)]
+    size: usize,
+    /// Wavelength samples of the colour integral.
+    #[arg(long, default_value_t = 32)]
+    lambda_samples: usize,
+    /// Exposure in stops (default: the 95th percentile of Y maps to 1).
+    #[arg(long, allow_hyphen_values = true)]
+    exposure: Option<f64>,
+    /// Tone curve: clamp or reinhard.
+    #[arg(long, default_value = "clamp")]
+    tone: String,
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Folder with the snake patches (default: ../shared/data/snake when found).
+    #[arg(long)]
+    snake: Option<PathBuf>,
+    /// Output folder for bench.csv, colour.csv, stress.csv and pareto.png.
+    #[arg(short, long, default_value = "bench-out")]
+    output: PathBuf,
+    /// Random evaluation points per field.
+    #[arg(long, default_value_t = 400)]
+    points: usize,
+    /// Fewer configurations and smaller fields (a smoke run).
+    #[arg(long)]
+    quick: bool,
 }
 
 #[derive(clap::Args)]
@@ -134,6 +217,14 @@ fn main() {
                 probe::run(&src, &a.points)
             }
             Cmd::Grating(a) => grating_cmd(a, cli.quiet),
+            Cmd::Compare(a) => compare_cmd(a),
+            Cmd::Brdf(a) => brdf_cmd(a),
+            Cmd::Bench(a) => {
+                let snake = a.snake.clone().or_else(|| {
+                    sunbeam_common::testdata::shared_data().map(|d| d.join("snake")).filter(|d| d.is_dir())
+                });
+                bench::run(&bench::Options { snake_dir: snake, out_dir: a.output, points: a.points.max(10), quick: a.quick })
+            }
             Cmd::Render(a) => render::run(&a),
         }
     })
@@ -147,6 +238,7 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
     let astep = units::parse_angle(&a.angle_step)?;
     let max_period = a.max_period.as_deref().map(units::parse_positive_length).transpose()?;
     let true_period = a.true_period.as_deref().map(units::parse_positive_length).transpose()?;
+    let params = a.model.params()?;
     let src = if input::is_pack(&a.input)? {
         if a.tile.is_some() {
             return Err(Error::usage("--tile applies to height fields, not packs"));
@@ -158,7 +250,7 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
             let (nx, ny) = input::parse_tile(t)?;
             f = input::tile(&f, nx, ny)?;
         }
-        Source::from_field(f, &a.model.params()?).map_err(|e| e.context(a.input.display()))?
+        Source::from_field(f, &params).map_err(|e| e.context(a.input.display()))?
     };
     let opts = grating::Options {
         theta_i,
@@ -221,6 +313,123 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
             out.period_std_m * 1e9,
             rel.map(|r| format!(", {:+.4} % from the true period", r * 100.0)).unwrap_or_default()
         );
+    }
+    Ok(())
+}
+
+fn compare_cmd(a: CompareArgs) -> Result<()> {
+    use sunbeam_optics::truth::{Model, Params, Truth};
+    if a.points == 0 || a.views == 0 || a.lambda_samples == 0 {
+        return Err(Error::usage("--points, --views and --lambda-samples must be positive"));
+    }
+    let mut lights = Vec::new();
+    for l in &a.light {
+        lights.push(sample::parse_light(l)?);
+    }
+    if lights.is_empty() {
+        for (t, p) in [(0.0, 0.0), (30.0, 0.0), (60.0, 0.0), (75.0, 0.0), (60.0, 90.0)] {
+            lights.push(sample::dir(f64::to_radians(t), f64::to_radians(p)));
+        }
+    }
+    let pack = sunbeam_pack::Pack::read(&a.pack)?;
+    let field = input::read_height(&a.height, &a.heights)?;
+    let m = &pack.manifest;
+    if field.width != m.patch.width || field.height != m.patch.height {
+        return Err(Error::input_file(
+            &a.height,
+            format!(
+                "height field is {}x{} but the pack was built from {}x{} pixels",
+                field.width, field.height, m.patch.width, m.patch.height
+            ),
+        ));
+    }
+    let model = match m.model {
+        sunbeam_pack::Model::Window => Model::Window,
+        sunbeam_pack::Model::Tiled => Model::Tiled,
+    };
+    let truth = Truth::new(&field, &Params { model, coherence_m: m.coherence_m }).map_err(|e| e.context(a.height.display()))?;
+    let spec = compare::spectral(&pack, &truth, a.points, 1);
+    let cols: Vec<compare::ColourError> =
+        lights.iter().map(|l| compare::colour(&pack, &truth, *l, a.views, a.lambda_samples, None)).collect();
+    let mean = cols.iter().map(|c| c.mean).sum::<f64>() / cols.len() as f64;
+    let p99 = cols.iter().map(|c| c.p99).fold(0.0, f64::max);
+    let pass = spec.max_abs <= a.tolerance && p99 <= a.de_tolerance;
+    if a.json {
+        let report = json!({
+            "pack": a.pack.file_name().map(|n| n.to_string_lossy().into_owned()),
+            "height": a.height.file_name().map(|n| n.to_string_lossy().into_owned()),
+            "model": format!("{model}"),
+            "spectral": {
+                "points": spec.points,
+                "max_abs_dR": spec.max_abs,
+                "peak_relative": spec.peak_relative,
+                "strong_relative": spec.strong_relative,
+                "worst_point": spec.worst,
+            },
+            "colour": {
+                "lambda_samples": a.lambda_samples,
+                "views_per_light": a.views,
+                "de_mean": mean,
+                "de_p99": p99,
+                "lights": cols.iter().map(|c| json!({
+                    "light": c.light, "exposure_scale": c.exposure_scale,
+                    "de_mean": c.mean, "de_p99": c.p99, "de_max": c.max
+                })).collect::<Vec<_>>(),
+            },
+            "tolerance": a.tolerance,
+            "de_tolerance": a.de_tolerance,
+            "pass": pass,
+        });
+        println!("{report}");
+    } else {
+        println!(
+            "spectral: max |dR| {:.3e}, peak-relative {:.3e}, strong lobes {:.3e} ({} points)",
+            spec.max_abs, spec.peak_relative, spec.strong_relative, spec.points
+        );
+        for c in &cols {
+            println!(
+                "colour, light ({:.0} deg, {:.0} deg): dE00 mean {:.3}, p99 {:.3}, max {:.3}",
+                c.light[2].acos().to_degrees(),
+                c.light[1].atan2(c.light[0]).to_degrees(),
+                c.mean,
+                c.p99,
+                c.max
+            );
+        }
+        println!("{}", if pass { "PASS" } else { "FAIL" });
+    }
+    if !pass {
+        use std::io::Write;
+        let _ = std::io::stdout().flush();
+        eprintln!(
+            "sunbeam-eval: compare: above tolerance (max |dR| {:.3e} vs {:.1e}, p99 dE00 {:.3} vs {:.2})",
+            spec.max_abs, a.tolerance, p99, a.de_tolerance
+        );
+        std::process::exit(5);
+    }
+    Ok(())
+}
+
+fn brdf_cmd(a: BrdfArgs) -> Result<()> {
+    use sunbeam_optics::colour::{ToneCurve, ToneMap};
+    let light = sample::parse_light(&a.light)?;
+    if !(16..=2048).contains(&a.size) || a.lambda_samples == 0 {
+        return Err(Error::usage("--size must be 16..2048 and --lambda-samples positive"));
+    }
+    let curve: ToneCurve = a.tone.parse()?;
+    let pack = sunbeam_pack::Pack::read(&a.pack)?;
+    let title = a.pack.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let o = brdf::Options {
+        light,
+        size: a.size,
+        lambda_samples: a.lambda_samples,
+        exposure_ev: a.exposure,
+        tone: ToneMap { exposure_ev: 0.0, curve },
+        title,
+    };
+    let out = brdf::run(&pack, &o, &a.output)?;
+    if a.json {
+        println!("{}", json!({"output": a.output.display().to_string(), "exposure_ev": out.exposure_ev, "max_y": out.max_y}));
     }
     Ok(())
 }

@@ -36,6 +36,7 @@ impl Source {
     /// Open `path` as a pack (KTX2, or EXR with a manifest) unless `force_truth`,
     /// else as a height field with its ground truth.
     pub fn open(path: &Path, heights: &HeightArgs, truth: &TruthArgs, force_truth: bool) -> Result<Source> {
+        let params = truth.params()?;
         if input::is_pack(path)? {
             if force_truth {
                 return Err(Error::usage(format!(
@@ -47,7 +48,7 @@ impl Source {
             return Ok(Source::Pack(Box::new(p)));
         }
         let field = input::read_height(path, heights)?;
-        Self::from_field(field, &truth.params()?).map_err(|e| e.context(path.display()))
+        Self::from_field(field, &params).map_err(|e| e.context(path.display()))
     }
 
     pub fn from_field(field: HeightField, p: &Params) -> Result<Source> {

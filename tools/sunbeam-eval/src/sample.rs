@@ -1,0 +1,68 @@
+//! Deterministic direction and point sampling shared by compare, brdf and bench.
+
+/// xorshift64*: a small deterministic generator (same sequence everywhere).
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+    pub fn next_f64(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// A direction uniform in solid angle on the upper hemisphere with d.n >= min_cos.
+    pub fn hemisphere(&mut self, min_cos: f64) -> [f64; 3] {
+        let z = min_cos + (1.0 - min_cos) * self.next_f64();
+        let phi = 2.0 * std::f64::consts::PI * self.next_f64();
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        [s * phi.cos(), s * phi.sin(), z]
+    }
+}
+
+/// `n` directions on the upper hemisphere (Fibonacci lattice, uniform in solid
+/// angle), with d.n in [min_cos, 1].
+pub fn fibonacci_hemisphere(n: usize, min_cos: f64) -> Vec<[f64; 3]> {
+    let ga = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - (1.0 - min_cos) * (i as f64 + 0.5) / n as f64;
+            let s = (1.0 - z * z).max(0.0).sqrt();
+            let phi = ga * i as f64;
+            [s * phi.cos(), s * phi.sin(), z]
+        })
+        .collect()
+}
+
+/// A light direction from polar angle and azimuth (radians).
+pub fn dir(theta: f64, phi: f64) -> [f64; 3] {
+    [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
+}
+
+/// Parse `THETA[,PHI]` (angles with units, e.g. `60deg,90deg`).
+pub fn parse_light(s: &str) -> sunbeam_common::Result<[f64; 3]> {
+    use sunbeam_common::{units, Error};
+    let (a, b) = s.split_once(',').unwrap_or((s, "0deg"));
+    let th = units::parse_angle(a)?;
+    let ph = units::parse_angle(b)?;
+    if !(0.0..89.9f64.to_radians()).contains(&th.abs()) {
+        return Err(Error::usage(format!("--light '{s}': polar angle must be in [0, 89.9) degrees")));
+    }
+    Ok(dir(th.abs(), ph))
+}
+
+/// Percentile (0..100) of a slice (nearest rank on a sorted copy).
+pub fn percentile(v: &[f64], p: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if s.is_empty() {
+        return f64::NAN;
+    }
+    s.sort_by(|a, b| a.total_cmp(b));
+    let rank = ((p / 100.0) * s.len() as f64).ceil() as usize;
+    s[rank.clamp(1, s.len()) - 1]
+}
