@@ -68,6 +68,8 @@ pub struct SampleReport {
     /// Largest distance a used 3D sample was moved to reach the surface.
     pub max_snapped: Option<f64>,
     pub extrapolated_vertices: usize,
+    /// Vertices on UV islands without any 3D sample: given the nearest sample's direction.
+    pub nearest_sample_vertices: usize,
     pub layout_notes: Vec<String>,
 }
 
@@ -338,9 +340,21 @@ fn samples(
         },
         ..Default::default()
     };
-    // Per-domain sample lists: (row, uv, angle from +u).
+    // Domains: one for u,v samples (every primitive's UVs); for 3D samples one per
+    // UV island (a chart: triangles connected through vertices of equal position and UV).
     let all_uv = s.items.iter().all(|x| matches!(x.at, SampleAt::Uv { .. }));
-    let ndom = if all_uv { 1 } else { work.len() };
+    let islands: Vec<(Vec<u32>, usize)> = if all_uv {
+        Vec::new()
+    } else {
+        work.iter().map(uv_islands).collect()
+    };
+    let mut base = Vec::with_capacity(islands.len());
+    let mut ndom = 0;
+    for (_, n) in &islands {
+        base.push(ndom);
+        ndom += n;
+    }
+    let ndom = if all_uv { 1 } else { ndom };
     let mut dom: Vec<Vec<(usize, [f64; 2], f64)>> = vec![Vec::new(); ndom];
     // 3D samples: snap.
     let mut snapped: Vec<(V3, V3)> = Vec::new(); // (point, unit direction) for primitives without samples
@@ -431,7 +445,7 @@ fn samples(
                 a[1] * b[0] + bb[1] * b[1] + c[1] * b[2],
             ];
             max_snapped = max_snapped.max(dist);
-            dom[wi].push((smp.line, suv, ang));
+            dom[base[wi] + islands[wi].0[t[0] as usize] as usize].push((smp.line, suv, ang));
             snapped.push((hit.point, dp));
         }
         rep.max_snapped = Some(max_snapped);
@@ -448,38 +462,61 @@ fn samples(
             "no usable samples (see the reasons with --json); nothing to interpolate",
         ));
     }
-    for (di, samples) in dom.iter().enumerate() {
-        let targets: Vec<usize> = if all_uv {
-            (0..work.len()).collect()
+    // Vertex lists per domain: (work index, vertex indices).
+    let mut members: Vec<Vec<(usize, Vec<usize>)>> = vec![Vec::new(); ndom];
+    for (wi, w) in work.iter().enumerate() {
+        if all_uv {
+            members[0].push((wi, (0..w.dir.len()).collect()));
         } else {
-            vec![di]
-        };
-        match AxialField::new(samples, opts.interp) {
-            Some(f) => {
-                rep.used += f.used;
-                rep.merged_duplicates += f.merged_duplicates;
-                for (row, why) in &f.dropped {
-                    rep.rejected.push(RejectedSample {
-                        row: *row,
-                        reason: why.clone(),
-                    });
-                }
-                if let Some(note) = f.degenerate_layout() {
+            let (isl, n) = &islands[wi];
+            let mut lists: Vec<Vec<usize>> = vec![Vec::new(); *n];
+            for (i, &k) in isl.iter().enumerate() {
+                lists[k as usize].push(i);
+            }
+            for (k, l) in lists.into_iter().enumerate() {
+                members[base[wi] + k].push((wi, l));
+            }
+        }
+    }
+    let near = Bvh::new(snapped.iter().map(|(p, _)| [*p, *p, *p]).collect());
+    let mut without = 0usize;
+    let mut notes = 0usize;
+    for (di, samples) in dom.iter().enumerate() {
+        let field = AxialField::new(samples, opts.interp);
+        if let Some(f) = &field {
+            rep.used += f.used;
+            rep.merged_duplicates += f.merged_duplicates;
+            for (row, why) in &f.dropped {
+                rep.rejected.push(RejectedSample {
+                    row: *row,
+                    reason: why.clone(),
+                });
+            }
+            if let Some(note) = f.degenerate_layout() {
+                notes += 1;
+                if notes <= 20 {
                     rep.layout_notes.push(if all_uv {
                         note.to_string()
                     } else {
+                        let (wi, _) = &members[di][0];
                         format!(
-                            "meshes[{}].primitives[{}]: {note}",
-                            work[di].mesh, work[di].prim
+                            "meshes[{}].primitives[{}], UV island {}: {note}",
+                            work[*wi].mesh,
+                            work[*wi].prim,
+                            di - base[*wi]
                         )
                     });
                 }
-                for &wi in &targets {
-                    let w = &mut work[wi];
-                    let uv = w.local.uvs.clone().expect("checked by need_uvs");
+            }
+        }
+        for (wi, verts) in &members[di] {
+            let w = &mut work[*wi];
+            match &field {
+                Some(f) => {
+                    let uv = w.local.uvs.as_ref().expect("checked by need_uvs");
+                    let pts: Vec<[f64; 2]> = verts.iter().map(|&i| uv[i]).collect();
                     let uw = w.u_world.clone().expect("checked by need_uvs");
-                    let results = eval_parallel(&f, &uv);
-                    for (i, r) in results.into_iter().enumerate() {
+                    for (&i, r) in verts.iter().zip(eval_parallel(f, &pts)) {
                         match (r, uw[i]) {
                             (
                                 AxialValue::Angle {
@@ -509,27 +546,76 @@ fn samples(
                         }
                     }
                 }
-            }
-            None => {
-                for &wi in &targets {
-                    let w = &mut work[wi];
-                    // No sample on this primitive: the nearest snapped sample in 3D, projected.
-                    for i in 0..w.dir.len() {
-                        let best = snapped.iter().min_by(|a, b| {
-                            let da = crate::geom::sub(a.0, w.p_world[i]);
-                            let db = crate::geom::sub(b.0, w.p_world[i]);
-                            dot(da, da).total_cmp(&dot(db, db))
-                        });
-                        w.set(i, best.map(|b| b.1), "no samples on this primitive and the nearest 3D sample is parallel to the normal");
-                    }
-                    if !snapped.is_empty() {
-                        rep.layout_notes.push(format!("meshes[{}].primitives[{}]: no samples on it; nearest sample in 3D used", w.mesh, w.prim));
+                None => {
+                    // No sample on this UV island: the nearest snapped sample in 3D, projected.
+                    for &i in verts {
+                        let best = near.closest(w.p_world[i]).map(|h| snapped[h.tri].1);
+                        w.set(i, best, "no sample on its UV island, and the nearest 3D sample is parallel to the normal");
+                        without += 1;
                     }
                 }
             }
         }
     }
+    if notes > 20 {
+        rep.layout_notes
+            .push(format!("... and {} more", notes - 20));
+    }
+    rep.nearest_sample_vertices = without;
     Ok(rep)
+}
+
+/// UV islands of a primitive: connected components of its triangles, where
+/// vertices with the same position and UV count as one. Returns (island per
+/// vertex, island count); vertices used by no triangle are islands of their own.
+pub fn uv_islands(w: &Work) -> (Vec<u32>, usize) {
+    let n = w.dir.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    let union = |p: &mut Vec<u32>, a: u32, b: u32| {
+        let (ra, rb) = (find(p, a), find(p, b));
+        if ra != rb {
+            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+            p[hi as usize] = lo;
+        }
+    };
+    for t in &w.local.triangles {
+        union(&mut parent, t[0], t[1]);
+        union(&mut parent, t[1], t[2]);
+    }
+    if let Some(uv) = &w.local.uvs {
+        let mut first: HashMap<[u64; 5], u32> = HashMap::new();
+        for i in 0..n {
+            let p = w.local.positions[i];
+            let k = [
+                (p[0] + 0.0).to_bits(),
+                (p[1] + 0.0).to_bits(),
+                (p[2] + 0.0).to_bits(),
+                (uv[i][0] + 0.0).to_bits(),
+                (uv[i][1] + 0.0).to_bits(),
+            ];
+            match first.get(&k) {
+                Some(&j) => union(&mut parent, i as u32, j),
+                None => {
+                    first.insert(k, i as u32);
+                }
+            }
+        }
+    }
+    let mut id: HashMap<u32, u32> = HashMap::new();
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n as u32 {
+        let r = find(&mut parent, i);
+        let next = id.len() as u32;
+        out.push(*id.entry(r).or_insert(next));
+    }
+    (out, id.len())
 }
 
 /// Evaluate a field at many UVs on all cores (results do not depend on the thread count).

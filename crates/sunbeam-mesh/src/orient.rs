@@ -351,6 +351,11 @@ impl Samples {
 
 // ---------------------------------------------------------------- axial interpolation
 
+/// The triangulation: a hierarchy hint generator makes every lookup O(log n),
+/// whatever the query order or thread interleaving (the default last-used-vertex
+/// hint walks O(n) triangles in thin layouts, e.g. samples along one band).
+type Tri = DelaunayTriangulation<Node, (), (), (), spade::HierarchyHintGenerator<f64>>;
+
 #[derive(Debug, Clone, Copy)]
 struct Node {
     p: Point2<f64>,
@@ -384,7 +389,7 @@ enum Layout {
         dir: [f64; 2],
         pts: Vec<(f64, f64, f64)>,
     },
-    Tri(DelaunayTriangulation<Node>),
+    Tri(Tri),
 }
 
 /// An axial direction field over the plane from scattered samples.
@@ -454,7 +459,7 @@ impl AxialField {
             0 => return None,
             1 => Layout::Constant(nodes[0].c, nodes[0].s),
             _ => {
-                let tri = DelaunayTriangulation::<Node>::bulk_load_stable(nodes.clone()).ok();
+                let tri = Tri::bulk_load_stable(nodes.clone()).ok();
                 match tri {
                     Some(t) if !t.all_vertices_on_line() && t.num_inner_faces() > 0 => {
                         Layout::Tri(t)
@@ -525,8 +530,8 @@ impl AxialField {
 pub struct Evaluator<'a> {
     f: &'a AxialField,
     w: Vec<(spade::handles::FixedVertexHandle, f64)>,
-    nn: Option<NaturalNeighbor<'a, DelaunayTriangulation<Node>>>,
-    bc: Option<Barycentric<'a, DelaunayTriangulation<Node>>>,
+    nn: Option<NaturalNeighbor<'a, Tri>>,
+    bc: Option<Barycentric<'a, Tri>>,
 }
 
 fn finish(c: f64, s: f64, extrapolated: bool) -> AxialValue {

@@ -575,3 +575,53 @@ fn direction_map_png_and_exr() {
         std::env::temp_dir().join(format!("sb-dir-{}.exr", std::process::id())),
     );
 }
+
+#[test]
+fn samples_3d_are_interpolated_per_uv_island() {
+    // Three copies of a grid in one primitive, all with UVs over [0,1]^2 (overlapping
+    // islands): A at x in [0,1], B at [2,3], C at [10,11]. Samples on A point along +x,
+    // on B along +y; C has none and takes its nearest sample (on B).
+    let (p0, uv0, i0) = grid(9, |_, _| 0.0);
+    let (mut pos, mut uv, mut idx) = (Vec::new(), Vec::new(), Vec::new());
+    for dx in [0.0, 2.0, 10.0] {
+        let b = pos.len() as u32;
+        pos.extend(p0.iter().map(|p| [p[0] + dx, p[1], p[2]]));
+        uv.extend_from_slice(&uv0);
+        idx.extend(i0.iter().map(|i| i + b));
+    }
+    let d = doc_from(&pos, None, Some(&uv), &idx, json!({}));
+    let mut rng = Lcg(21);
+    let mut items = Vec::new();
+    for k in 0..40 {
+        let (x, y) = (rng.next(), rng.next());
+        let (off, dir) = if k % 2 == 0 {
+            (0.0, [1.0, 0.0, 0.0])
+        } else {
+            (2.0, [0.0, -1.0, 0.0])
+        };
+        items.push(Sample {
+            line: k + 2,
+            at: SampleAt::Xyz {
+                p: [x + off, y, 0.001],
+                d: dir,
+            },
+        });
+    }
+    let mut o = BakeOptions::new(Source::Samples(Samples {
+        path: "s.csv".into(),
+        items,
+    }));
+    o.max_snap = Some(0.01);
+    let (w, r) = compute(&d, &o).unwrap();
+    let sr = r.samples.unwrap();
+    assert_eq!(sr.used, 40);
+    assert_eq!(sr.nearest_sample_vertices, 81);
+    for i in 0..pos.len() {
+        let want = if i < 81 { 0.0 } else { PI / 2.0 };
+        assert!(
+            axial_diff(angle(&w[0], i), want) < 1e-9,
+            "vertex {i}: {}",
+            angle(&w[0], i)
+        );
+    }
+}

@@ -4,7 +4,8 @@
 //! - `atlas`: one file, plain `R` / `G`, the terms in a grid of cells (Unity flipbooks).
 //!
 //! Every file carries the manifest in the header attribute `sunbeam.manifest`
-//! (JSON, ASCII) and `sunbeam.layout`; split files also `sunbeam.term`.
+//! (JSON, ASCII) and either `sunbeam.layout` (`layers`, `atlas`) or, in split
+//! files, `sunbeam.term` (the term number).
 
 use crate::manifest::{Manifest, Precision, MANIFEST_KEY};
 use crate::pack::Pack;
@@ -79,14 +80,16 @@ fn samples(values: Vec<f32>, precision: Precision) -> FlatSamples {
     }
 }
 
-fn write_image(channels: Vec<AnyChannel<FlatSamples>>, size: (usize, usize), attrs: Vec<(&str, String)>) -> Result<Vec<u8>> {
+/// Write one single-part image. The manifest goes into the layer's attributes and the
+/// layout (or the split term) into the image's: each map holds one entry, so the
+/// header is written in a fixed order (the exr crate keeps these maps as HashMaps).
+fn write_image(channels: Vec<AnyChannel<FlatSamples>>, size: (usize, usize), manifest: &str, extra: (&str, String)) -> Result<Vec<u8>> {
     let mut la = LayerAttributes::default();
-    for (k, v) in attrs {
-        la.other.insert(Text::new_or_panic(k), AttributeValue::Text(Text::new_or_panic(ascii_json(&v))));
-    }
+    la.other.insert(Text::new_or_panic(MANIFEST_KEY), AttributeValue::Text(Text::new_or_panic(ascii_json(manifest))));
     let encoding = Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
     let layer = Layer::new(size, la, encoding, AnyChannels::sort(SmallVec::from_vec(channels)));
-    let image = Image::from_layer(layer);
+    let mut image = Image::from_layer(layer);
+    image.attributes.other.insert(Text::new_or_panic(extra.0), AttributeValue::Text(Text::new_or_panic(ascii_json(&extra.1))));
     let mut out = Cursor::new(Vec::new());
     image.write().non_parallel().to_buffered(&mut out).map_err(|e| Error::internal(format!("EXR encode: {e}")))?;
     Ok(out.into_inner())
@@ -109,11 +112,7 @@ pub fn encode_layers(pack: &Pack) -> Result<Vec<u8>> {
             ));
         }
     }
-    write_image(
-        ch,
-        (m.crop.width, m.crop.height),
-        vec![(MANIFEST_KEY, m.to_json()), (LAYOUT_KEY, Layout::Layers.name().into())],
-    )
+    write_image(ch, (m.crop.width, m.crop.height), &m.to_json(), (LAYOUT_KEY, Layout::Layers.name().into()))
 }
 
 /// Encode term `n` as its own EXR with plain R/G channels.
@@ -123,11 +122,7 @@ pub fn encode_split_term(pack: &Pack, n: usize) -> Result<Vec<u8>> {
         AnyChannel::new("R", samples(plane(pack, n, 0), m.precision)),
         AnyChannel::new("G", samples(plane(pack, n, 1), m.precision)),
     ];
-    write_image(
-        ch,
-        (m.crop.width, m.crop.height),
-        vec![(MANIFEST_KEY, m.to_json()), (LAYOUT_KEY, Layout::Split.name().into()), (TERM_KEY, n.to_string())],
-    )
+    write_image(ch, (m.crop.width, m.crop.height), &m.to_json(), (TERM_KEY, n.to_string()))
 }
 
 /// Encode as a grid atlas with plain R/G channels.
@@ -150,7 +145,7 @@ pub fn encode_atlas(pack: &Pack) -> Result<Vec<u8>> {
         }
     }
     let ch = vec![AnyChannel::new("R", samples(r, m.precision)), AnyChannel::new("G", samples(g, m.precision))];
-    write_image(ch, (aw, rows * h), vec![(MANIFEST_KEY, m.to_json()), (LAYOUT_KEY, Layout::Atlas.name().into())])
+    write_image(ch, (aw, rows * h), &m.to_json(), (LAYOUT_KEY, Layout::Atlas.name().into()))
 }
 
 /// What one EXR file holds.
@@ -188,13 +183,15 @@ pub fn decode_file(bytes: &[u8]) -> Result<Decoded> {
     let text = text_attr(layer, &image.attributes, MANIFEST_KEY)
         .ok_or_else(|| Error::input(format!("EXR: no '{MANIFEST_KEY}' attribute: not a sunbeam pack")))?;
     let manifest = Manifest::from_json(&text)?;
+    let term_attr = text_attr(layer, &image.attributes, TERM_KEY);
     let layout = match text_attr(layer, &image.attributes, LAYOUT_KEY).as_deref() {
+        _ if term_attr.is_some() => Layout::Split,
         Some("layers") | None => Layout::Layers,
         Some("split") => Layout::Split,
         Some("atlas") => Layout::Atlas,
         Some(o) => return Err(Error::input(format!("EXR: unknown {LAYOUT_KEY} '{o}'"))),
     };
-    let term = match text_attr(layer, &image.attributes, TERM_KEY) {
+    let term = match term_attr {
         Some(t) => Some(t.trim().parse::<usize>().map_err(|_| Error::input(format!("EXR: bad {TERM_KEY} '{t}'")))?),
         None => None,
     };

@@ -114,7 +114,7 @@ pub fn quad_scene(size: [u32; 2]) -> (Scene, Mesh) {
     let mut s = scene_for("builtin:quad", &mesh, size);
     // close enough that the quad fills the frame
     s.camera.eye = [0.0, 0.0, 1.5];
-    s.lights = vec![Light { direction: [0.5, 0.0, 0.866], intensity: 1.0, spectrum: "D65".into() }];
+    s.lights = vec![Light { direction: [-0.5, 0.0, 0.866], intensity: 1.0, spectrum: "D65".into() }];
     (s, mesh)
 }
 

@@ -27,7 +27,7 @@ fn lambert_quad_centre_and_coverage() {
     p.scene.camera.eye = [0.0, 0.0, 2.5];
     let g = raster::rasterise(&p, 64, 64);
     let covered = g.iter().filter(|f| f.mesh.is_some()).count() as f64;
-    let d = (scene.camera.eye[2] - 0.0).abs();
+    let d = (p.scene.camera.eye[2] - 0.0).abs();
     let half = 0.5 / d / (scene.camera.fov_y_deg.to_radians() / 2.0).tan() * 32.0; // half side in pixels
     let side = 2.0 * half;
     assert!((covered - side * side).abs() <= 2.0 * side + 2.0, "{covered} px vs {}", side * side);
@@ -87,6 +87,7 @@ fn blazed_quad_pixels_match_ground_truth() {
             bright += 1;
         }
         let de = colour::ciede2000_xyz(ours, want);
+        eprintln!("({i},{j}) wi {:?} wr {:?}: ours {ours:?} truth {want:?} dE {de:.3}", loc(wi), loc(wr));
         worst = worst.max(de);
         assert!(de < 1.0 || want[1] < 1e-4, "pixel ({i},{j}): {ours:?} vs truth {want:?}, dE {de}");
     }
