@@ -7,7 +7,14 @@ use sunbeam_afm::{list_channels_bytes, read_bytes, ErrorCode, ReadOptions};
 
 fuzz_target!(|data: &[u8]| {
     let _ = sunbeam_afm::detect(data);
-    for o in [ReadOptions::default(), ReadOptions { pixel_size: Some((1e-9, 2e-9)), z_range: Some(1e-6), ..Default::default() }] {
+    for o in [
+        ReadOptions::default(),
+        ReadOptions {
+            pixel_size: Some((1e-9, 2e-9)),
+            z_range: Some(1e-6),
+            ..Default::default()
+        },
+    ] {
         if let Err(e) = read_bytes(data, &o) {
             assert_eq!(e.code, ErrorCode::Input, "{e}");
         }

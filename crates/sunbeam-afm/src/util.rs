@@ -104,30 +104,32 @@ pub fn decode(
         .checked_mul(t.size())
         .ok_or_else(|| Error::input(format!("{what}: data size overflows")))?;
     let s = slice(bytes, off, len, what)?;
-    let sz = t.size();
     let mut out = Vec::with_capacity(n);
-    for c in s.chunks_exact(sz) {
-        let v = match (t, e) {
-            (Sample::I8, _) => c[0] as i8 as f64,
-            (Sample::U8, _) => c[0] as f64,
-            (Sample::I16, Endian::Little) => i16::from_le_bytes([c[0], c[1]]) as f64,
-            (Sample::I16, Endian::Big) => i16::from_be_bytes([c[0], c[1]]) as f64,
-            (Sample::U16, Endian::Little) => u16::from_le_bytes([c[0], c[1]]) as f64,
-            (Sample::U16, Endian::Big) => u16::from_be_bytes([c[0], c[1]]) as f64,
-            (Sample::I32, Endian::Little) => i32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64,
-            (Sample::I32, Endian::Big) => i32::from_be_bytes([c[0], c[1], c[2], c[3]]) as f64,
-            (Sample::U32, Endian::Little) => u32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64,
-            (Sample::U32, Endian::Big) => u32::from_be_bytes([c[0], c[1], c[2], c[3]]) as f64,
-            (Sample::F32, Endian::Little) => f32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64,
-            (Sample::F32, Endian::Big) => f32::from_be_bytes([c[0], c[1], c[2], c[3]]) as f64,
-            (Sample::F64, Endian::Little) => {
-                f64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])
-            }
-            (Sample::F64, Endian::Big) => {
-                f64::from_be_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])
-            }
+    // One tight loop per sample type and byte order (the match stays outside).
+    macro_rules! run {
+        ($ty:ty, $sz:expr, $conv:ident) => {
+            out.extend(s.chunks_exact($sz).map(|c| {
+                let mut a = [0u8; $sz];
+                a.copy_from_slice(c);
+                <$ty>::$conv(a) as f64
+            }))
         };
-        out.push(v);
+    }
+    match (t, e) {
+        (Sample::I8, _) => out.extend(s.iter().map(|&x| x as i8 as f64)),
+        (Sample::U8, _) => out.extend(s.iter().map(|&x| x as f64)),
+        (Sample::I16, Endian::Little) => run!(i16, 2, from_le_bytes),
+        (Sample::I16, Endian::Big) => run!(i16, 2, from_be_bytes),
+        (Sample::U16, Endian::Little) => run!(u16, 2, from_le_bytes),
+        (Sample::U16, Endian::Big) => run!(u16, 2, from_be_bytes),
+        (Sample::I32, Endian::Little) => run!(i32, 4, from_le_bytes),
+        (Sample::I32, Endian::Big) => run!(i32, 4, from_be_bytes),
+        (Sample::U32, Endian::Little) => run!(u32, 4, from_le_bytes),
+        (Sample::U32, Endian::Big) => run!(u32, 4, from_be_bytes),
+        (Sample::F32, Endian::Little) => run!(f32, 4, from_le_bytes),
+        (Sample::F32, Endian::Big) => run!(f32, 4, from_be_bytes),
+        (Sample::F64, Endian::Little) => run!(f64, 8, from_le_bytes),
+        (Sample::F64, Endian::Big) => run!(f64, 8, from_be_bytes),
     }
     Ok(out)
 }

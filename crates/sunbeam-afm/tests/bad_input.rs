@@ -261,10 +261,17 @@ fn fuzzer_findings() {
     let cases: &[(&str, Format, &[u8])] = &[
         // xyz: extreme aspect ratio -> grid size overflowed i64 (add overflow)
         // (with the fuzz targets' --pixel-size 1nm)
-        ("xyz grid overflow", Format::Xyz, b"0 0 0\n333333333333330 2 0\n0 20 62 \n\n"),
+        (
+            "xyz grid overflow",
+            Format::Xyz,
+            b"0 0 0\n333333333333330 2 0\n0 20 62 \n\n",
+        ),
     ];
     for (what, f, b) in cases {
-        let o = ReadOptions { format: Some(*f), ..uncal() };
+        let o = ReadOptions {
+            format: Some(*f),
+            ..uncal()
+        };
         if let Err(e) = read_bytes(b, &o) {
             assert_eq!(e.code, ExitCode::Input, "{what}: {e}");
         }

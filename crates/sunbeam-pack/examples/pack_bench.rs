@@ -10,7 +10,8 @@ use sunbeam_pack::io::{write_pack, OutputKind};
 pub fn height(c: usize, r: usize, dx: f64) -> f64 {
     let (x, y) = (c as f64 * dx, r as f64 * dx);
     let tau = std::f64::consts::TAU;
-    200e-9 * (tau * x / 1.1e-6).sin() * (0.5 + 0.5 * (tau * y / 3.7e-6).cos()) + 80e-9 * (tau * (x + 0.6 * y) / 0.83e-6).sin()
+    200e-9 * (tau * x / 1.1e-6).sin() * (0.5 + 0.5 * (tau * y / 3.7e-6).cos())
+        + 80e-9 * (tau * (x + 0.6 * y) / 0.83e-6).sin()
 }
 
 fn main() {
@@ -26,8 +27,18 @@ fn main() {
     let dx = 30e-9;
     let data: Vec<f64> = (0..m * m).map(|i| height(i % m, i / m, dx)).collect();
     let t0 = Instant::now();
-    let f = FieldRef { width: m, height: m, dx, dy: dx, data: &data };
-    let o = BuildOptions { terms: Some(n), threads, ..BuildOptions::default() };
+    let f = FieldRef {
+        width: m,
+        height: m,
+        dx,
+        dy: dx,
+        data: &data,
+    };
+    let o = BuildOptions {
+        terms: Some(n),
+        threads,
+        ..BuildOptions::default()
+    };
     let pack = build::build(f, &o, &mut |_, _| {}).expect("build");
     let t_build = t0.elapsed().as_secs_f64();
     let files = write_pack(&pack, &out, OutputKind::Ktx2).expect("write");

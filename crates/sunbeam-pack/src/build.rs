@@ -13,7 +13,10 @@
 //!    patch centre in pixels, and the negative kx half from Hermitian symmetry.
 
 use crate::kernel;
-use crate::manifest::{Basis, Crop, ErrorInfo, Kernel, Manifest, Model, Patch, Precision, Source, FORMAT_NAME, FORMAT_VERSION};
+use crate::manifest::{
+    Basis, Crop, ErrorInfo, Kernel, Manifest, Model, Patch, Precision, Source, FORMAT_NAME,
+    FORMAT_VERSION,
+};
 use crate::pack::Pack;
 use crate::series;
 use realfft::RealFftPlanner;
@@ -74,7 +77,10 @@ impl Default for BuildOptions {
             max_w: 2.0,
             freq_limit_per_m: None,
             taps: 6,
-            threads: std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(8),
+            threads: std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+                .min(8),
             generator: format!("sunbeam-pack {}", env!("CARGO_PKG_VERSION")),
             source: Source::default(),
             notes: vec![],
@@ -153,7 +159,12 @@ pub struct Plan {
 /// Validate the field and options and derive the manifest (no FFT yet).
 pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
     if f.width == 0 || f.height == 0 || f.data.len() != f.width * f.height {
-        return Err(Error::input(format!("height field {}x{} with {} values", f.width, f.height, f.data.len())));
+        return Err(Error::input(format!(
+            "height field {}x{} with {} values",
+            f.width,
+            f.height,
+            f.data.len()
+        )));
     }
     if !(f.dx.is_finite() && f.dx > 0.0 && f.dy.is_finite() && f.dy > 0.0) {
         return Err(Error::input("pixel size must be finite and positive"));
@@ -166,7 +177,9 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
     }
     let pos = |v: f64| v.is_finite() && v > 0.0;
     if !(pos(o.lambda_min_m) && pos(o.lambda_max_m) && o.lambda_max_m >= o.lambda_min_m) {
-        return Err(Error::usage("wavelength range must be positive with min <= max"));
+        return Err(Error::usage(
+            "wavelength range must be positive with min <= max",
+        ));
     }
     if !pos(o.coherence_m) {
         return Err(Error::usage("coherence length must be positive"));
@@ -182,19 +195,27 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
             return Err(Error::usage("--terms must be 1..1024"));
         }
     }
-    if o.taps < 2 || o.taps % 2 != 0 || o.taps > 32 {
+    if o.taps < 2 || o.taps & 1 == 1 || o.taps > 32 {
         return Err(Error::usage("taps must be even, 2..32"));
     }
     let (mx, my) = (f.width, f.height);
     let (lx, ly) = (mx as f64 * f.dx, my as f64 * f.dy);
-    let (lo, hi) = f.data.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    let (lo, hi) = f
+        .data
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
     let hc = 0.5 * (lo + hi);
     let half = 0.5 * (hi - lo);
     let t_max = 2.0 * std::f64::consts::PI / o.lambda_min_m * o.max_w * half;
 
     let (terms, tolerance) = match o.terms {
         Some(n) => (n, None),
-        None => (series::terms_for_tolerance(o.basis, t_max, o.max_error), Some(o.max_error)),
+        None => (
+            series::terms_for_tolerance(o.basis, t_max, o.max_error),
+            Some(o.max_error),
+        ),
     };
     if terms > 1024 {
         return Err(Error::input(format!(
@@ -211,13 +232,31 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
     let (z, kern, bin_scale) = match o.model {
         Model::Window => {
             let beta = kernel::kb_beta(o.taps);
-            (2usize, Kernel { kind: "kaiser-bessel".into(), taps: o.taps, beta, sigma_bins: [0.0, 0.0] }, [2.0 * lx, 2.0 * ly])
+            (
+                2usize,
+                Kernel {
+                    kind: "kaiser-bessel".into(),
+                    taps: o.taps,
+                    beta,
+                    sigma_bins: [0.0, 0.0],
+                },
+                [2.0 * lx, 2.0 * ly],
+            )
         }
         Model::Tiled => {
             let sigma_f = 1.0 / (2.0 * std::f64::consts::PI * sigma_s);
             let sb = [sigma_f * lx, sigma_f * ly];
             let taps = kernel::gauss_taps(sb[0].max(sb[1]));
-            (1usize, Kernel { kind: "gaussian".into(), taps, beta: 0.0, sigma_bins: sb }, [lx, ly])
+            (
+                1usize,
+                Kernel {
+                    kind: "gaussian".into(),
+                    taps,
+                    beta: 0.0,
+                    sigma_bins: sb,
+                },
+                [lx, ly],
+            )
         }
     };
     let half_taps = (kern.taps / 2) as i64;
@@ -236,16 +275,22 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
     let (wx, wy, window_sigma, norm_name, norm_value) = match o.model {
         Model::Window => {
             let sigma = sigma_s.min(lx.min(ly) / 6.0);
-            let gx: Vec<f64> =
-                (0..mx).map(|c| (-((c as f64 - cx) * f.dx).powi(2) / (2.0 * sigma * sigma)).exp()).collect();
-            let gy: Vec<f64> =
-                (0..my).map(|r| (-((r as f64 - cy) * f.dy).powi(2) / (2.0 * sigma * sigma)).exp()).collect();
+            let gx: Vec<f64> = (0..mx)
+                .map(|c| (-((c as f64 - cx) * f.dx).powi(2) / (2.0 * sigma * sigma)).exp())
+                .collect();
+            let gy: Vec<f64> = (0..my)
+                .map(|r| (-((r as f64 - cy) * f.dy).powi(2) / (2.0 * sigma * sigma)).exp())
+                .collect();
             let sum_g = gx.iter().sum::<f64>() * gy.iter().sum::<f64>();
             let wx: Vec<f64> = (0..mx)
                 .map(|c| gx[c] / kernel::kb_hat((c as f64 - cx) / nx as f64, kern.taps, kern.beta))
                 .collect();
             let wy: Vec<f64> = (0..my)
-                .map(|r| gy[r] / kernel::kb_hat((r as f64 - cy) / ny as f64, kern.taps, kern.beta) / sum_g)
+                .map(|r| {
+                    gy[r]
+                        / kernel::kb_hat((r as f64 - cy) / ny as f64, kern.taps, kern.beta)
+                        / sum_g
+                })
                 .collect();
             (wx, wy, sigma, "sum_g", sum_g)
         }
@@ -258,8 +303,11 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
     let mut series_bound = series::tail_bound_upto(o.basis, t_max, terms);
     if o.model == Model::Tiled {
         // R sums |.|^2 over bins weighted by phi: the bound scales with the largest sum of weights.
-        let s: f64 =
-            kern.sigma_bins.iter().map(|sb| (2.0 * std::f64::consts::PI).sqrt() * sb.max(1.0 / 2.5)).product();
+        let s: f64 = kern
+            .sigma_bins
+            .iter()
+            .map(|sb| (2.0 * std::f64::consts::PI).sqrt() * sb.max(1.0 / 2.5))
+            .product();
         series_bound *= s.max(1.0);
     }
     let manifest = Manifest {
@@ -270,7 +318,14 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
         basis: o.basis,
         terms,
         precision: o.precision,
-        patch: Patch { width: mx, height: my, dx_m: f.dx, dy_m: f.dy, lx_m: lx, ly_m: ly },
+        patch: Patch {
+            width: mx,
+            height: my,
+            dx_m: f.dx,
+            dy_m: f.dy,
+            lx_m: lx,
+            ly_m: ly,
+        },
         height_centre_m: hc,
         height_half_range_m: half,
         lambda_min_m: o.lambda_min_m,
@@ -279,12 +334,21 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
         t_max,
         coherence_m: o.coherence_m,
         window_sigma_m: window_sigma,
-        sigma_f_per_m: if o.model == Model::Tiled { 1.0 / (2.0 * std::f64::consts::PI * sigma_s) } else { 0.0 },
+        sigma_f_per_m: if o.model == Model::Tiled {
+            1.0 / (2.0 * std::f64::consts::PI * sigma_s)
+        } else {
+            0.0
+        },
         padding: z,
         grid: [nx, ny],
         bin_scale_m: bin_scale,
         freq_limit_per_m: flim,
-        crop: Crop { kx, ky, width: cw, height: ch },
+        crop: Crop {
+            kx,
+            ky,
+            width: cw,
+            height: ch,
+        },
         kernel: kern,
         normalisation: norm_name.into(),
         normalisation_value: norm_value,
@@ -297,30 +361,47 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
         source: o.source.clone(),
         notes: o.notes.clone(),
     };
-    manifest.validate().map_err(|e| Error::internal(e.message))?;
+    manifest
+        .validate()
+        .map_err(|e| Error::internal(e.message))?;
     Ok(Plan { manifest, wx, wy })
 }
 
 fn split_ranges(n: usize, parts: usize) -> Vec<std::ops::Range<usize>> {
     let parts = parts.clamp(1, n.max(1));
-    (0..parts).map(|i| (i * n / parts)..((i + 1) * n / parts)).collect()
+    (0..parts)
+        .map(|i| (i * n / parts)..((i + 1) * n / parts))
+        .collect()
 }
 
 /// Build the pack. `progress(done, total)` is called after each term.
-pub fn build(f: FieldRef, o: &BuildOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<Pack> {
+pub fn build(
+    f: FieldRef,
+    o: &BuildOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Pack> {
     let p = plan(f, o)?;
     run(f, &p, o.threads, progress)
 }
 
 /// Run a plan: the FFTs, term by term.
-pub fn run(f: FieldRef, p: &Plan, threads: usize, progress: &mut dyn FnMut(usize, usize)) -> Result<Pack> {
+pub fn run(
+    f: FieldRef,
+    p: &Plan,
+    threads: usize,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Pack> {
     let m = &p.manifest;
     let (mx, my) = (f.width, f.height);
     let [nx, ny] = m.grid;
     let (kx, ky) = (m.crop.kx, m.crop.ky);
     let (cw, chh) = (m.crop.width, m.crop.height);
     let ncols = kx as usize + 1;
-    let inv_h = if m.height_half_range_m > 0.0 { 1.0 / m.height_half_range_m } else { 0.0 };
+    let inv_h = if m.height_half_range_m > 0.0 {
+        1.0 / m.height_half_range_m
+    } else {
+        0.0
+    };
     let hc = m.height_centre_m;
     let (cx, cy) = ((mx as f64 - 1.0) / 2.0, (my as f64 - 1.0) / 2.0);
 
@@ -329,8 +410,9 @@ pub fn run(f: FieldRef, p: &Plan, threads: usize, progress: &mut dyn FnMut(usize
 
     // Phase factors per kept bin.
     let two_pi = 2.0 * std::f64::consts::PI;
-    let phx: Vec<Complex64> =
-        (0..=kx).map(|k| Complex64::from_polar(1.0, two_pi * ((k as f64 * cx) / nx as f64).fract())).collect();
+    let phx: Vec<Complex64> = (0..=kx)
+        .map(|k| Complex64::from_polar(1.0, two_pi * ((k as f64 * cx) / nx as f64).fract()))
+        .collect();
     let phy: Vec<Complex64> = (-ky..=ky)
         .map(|k| Complex64::from_polar(1.0, two_pi * ((k as f64 * cy) / ny as f64).fract()))
         .collect();
@@ -365,7 +447,12 @@ pub fn run(f: FieldRef, p: &Plan, threads: usize, progress: &mut dyn FnMut(usize
                 rb = b;
             }
             std::thread::scope(|sc| {
-                for (((range, pv), cv), rbuf) in row_ranges.iter().zip(prev_chunks).zip(cur_chunks).zip(row_chunks) {
+                for (((range, pv), cv), rbuf) in row_ranges
+                    .iter()
+                    .zip(prev_chunks)
+                    .zip(cur_chunks)
+                    .zip(row_chunks)
+                {
                     let r2c = r2c.clone();
                     let wx = &p.wx;
                     let wy = &p.wy;
@@ -390,11 +477,16 @@ pub fn run(f: FieldRef, p: &Plan, threads: usize, progress: &mut dyn FnMut(usize
                                 input[c] = b * wx[c] * wy[ru];
                             }
                             input[mx..].iter_mut().for_each(|v| *v = 0.0);
-                            r2c.process_with_scratch(&mut input, &mut output, &mut scratch).expect("fft sizes");
+                            r2c.process_with_scratch(&mut input, &mut output, &mut scratch)
+                                .expect("fft sizes");
                             let out_row = &mut rbuf[i * ncols..(i + 1) * ncols];
                             for (k, o) in out_row.iter_mut().enumerate() {
                                 let kk = k % nx;
-                                *o = if kk <= nx / 2 { output[kk] } else { output[nx - kk].conj() };
+                                *o = if kk <= nx / 2 {
+                                    output[kk]
+                                } else {
+                                    output[nx - kk].conj()
+                                };
                             }
                         }
                     });
@@ -413,13 +505,16 @@ pub fn run(f: FieldRef, p: &Plan, threads: usize, progress: &mut dyn FnMut(usize
                     let range = range.clone();
                     sc.spawn(move || {
                         let mut buf = vec![Complex64::new(0.0, 0.0); ny];
-                        let mut scratch = vec![Complex64::new(0.0, 0.0); cfft.get_inplace_scratch_len()];
+                        let mut scratch =
+                            vec![Complex64::new(0.0, 0.0); cfft.get_inplace_scratch_len()];
                         let mut out = Vec::with_capacity(range.len() * chh);
                         for k in range {
                             for (ru, b) in buf.iter_mut().enumerate().take(my) {
                                 *b = rowbuf[ru * ncols + k];
                             }
-                            buf[my..].iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
+                            buf[my..]
+                                .iter_mut()
+                                .for_each(|v| *v = Complex64::new(0.0, 0.0));
                             cfft.process_with_scratch(&mut buf, &mut scratch);
                             for (j, kyv) in (-ky..=ky).enumerate() {
                                 let kk = kyv.rem_euclid(ny as i64) as usize;
@@ -430,14 +525,17 @@ pub fn run(f: FieldRef, p: &Plan, threads: usize, progress: &mut dyn FnMut(usize
                     })
                 })
                 .collect();
-            handles.into_iter().map(|h| h.join().expect("worker")).collect()
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("worker"))
+                .collect()
         });
         let layer = &mut terms[2 * n * lt..2 * (n + 1) * lt];
         // Tiled model: each DFT bin once, b in [-floor(M/2), M-1-floor(M/2)] per axis (no periodic images).
         let tiled = m.model == Model::Tiled;
         let in_range = |k: i64, mm: usize| {
             let lo = -((mm / 2) as i64);
-            !tiled || (k >= lo && k <= lo + mm as i64 - 1)
+            !tiled || (k >= lo && k < lo + mm as i64)
         };
         for (range, res) in col_ranges.iter().zip(results) {
             for (i, k) in range.clone().enumerate() {
@@ -465,7 +563,9 @@ pub fn run(f: FieldRef, p: &Plan, threads: usize, progress: &mut dyn FnMut(usize
             }
         }
         if layer.iter().any(|v| !v.is_finite()) {
-            return Err(Error::internal(format!("term {n} holds NaN/Inf (a bug; please report)")));
+            return Err(Error::internal(format!(
+                "term {n} holds NaN/Inf (a bug; please report)"
+            )));
         }
         progress(n + 1, m.terms);
     }

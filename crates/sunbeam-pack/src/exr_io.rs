@@ -64,7 +64,10 @@ pub fn ascii_json(s: &str) -> String {
 
 /// The file name of term `n` of a split pack written as `path`: `STEM.nNN.exr`.
 pub fn split_path(path: &Path, n: usize) -> PathBuf {
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "pack".into());
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "pack".into());
     path.with_file_name(format!("{stem}.{}.exr", term_name(n)))
 }
 
@@ -83,21 +86,50 @@ fn samples(values: Vec<f32>, precision: Precision) -> FlatSamples {
 /// Write one single-part image. The manifest goes into the layer's attributes and the
 /// layout (or the split term) into the image's: each map holds one entry, so the
 /// header is written in a fixed order (the exr crate keeps these maps as HashMaps).
-fn write_image(channels: Vec<AnyChannel<FlatSamples>>, size: (usize, usize), manifest: &str, extra: (&str, String)) -> Result<Vec<u8>> {
+fn write_image(
+    channels: Vec<AnyChannel<FlatSamples>>,
+    size: (usize, usize),
+    manifest: &str,
+    extra: (&str, String),
+) -> Result<Vec<u8>> {
     let mut la = LayerAttributes::default();
-    la.other.insert(Text::new_or_panic(MANIFEST_KEY), AttributeValue::Text(Text::new_or_panic(ascii_json(manifest))));
-    let encoding = Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
-    let layer = Layer::new(size, la, encoding, AnyChannels::sort(SmallVec::from_vec(channels)));
+    la.other.insert(
+        Text::new_or_panic(MANIFEST_KEY),
+        AttributeValue::Text(Text::new_or_panic(ascii_json(manifest))),
+    );
+    let encoding = Encoding {
+        compression: Compression::ZIP16,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
+    let layer = Layer::new(
+        size,
+        la,
+        encoding,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
     let mut image = Image::from_layer(layer);
-    image.attributes.other.insert(Text::new_or_panic(extra.0), AttributeValue::Text(Text::new_or_panic(ascii_json(&extra.1))));
+    image.attributes.other.insert(
+        Text::new_or_panic(extra.0),
+        AttributeValue::Text(Text::new_or_panic(ascii_json(&extra.1))),
+    );
     let mut out = Cursor::new(Vec::new());
-    image.write().non_parallel().to_buffered(&mut out).map_err(|e| Error::internal(format!("EXR encode: {e}")))?;
+    image
+        .write()
+        .non_parallel()
+        .to_buffered(&mut out)
+        .map_err(|e| Error::internal(format!("EXR encode: {e}")))?;
     Ok(out.into_inner())
 }
 
 fn plane(pack: &Pack, n: usize, comp: usize) -> Vec<f32> {
     let lt = pack.manifest.layer_texels();
-    pack.terms[2 * n * lt..2 * (n + 1) * lt].iter().skip(comp).step_by(2).copied().collect()
+    pack.terms[2 * n * lt..2 * (n + 1) * lt]
+        .iter()
+        .skip(comp)
+        .step_by(2)
+        .copied()
+        .collect()
 }
 
 /// Encode as one multi-layer EXR (`Pack.nNN.R/G`).
@@ -112,7 +144,12 @@ pub fn encode_layers(pack: &Pack) -> Result<Vec<u8>> {
             ));
         }
     }
-    write_image(ch, (m.crop.width, m.crop.height), &m.to_json(), (LAYOUT_KEY, Layout::Layers.name().into()))
+    write_image(
+        ch,
+        (m.crop.width, m.crop.height),
+        &m.to_json(),
+        (LAYOUT_KEY, Layout::Layers.name().into()),
+    )
 }
 
 /// Encode term `n` as its own EXR with plain R/G channels.
@@ -122,7 +159,12 @@ pub fn encode_split_term(pack: &Pack, n: usize) -> Result<Vec<u8>> {
         AnyChannel::new("R", samples(plane(pack, n, 0), m.precision)),
         AnyChannel::new("G", samples(plane(pack, n, 1), m.precision)),
     ];
-    write_image(ch, (m.crop.width, m.crop.height), &m.to_json(), (TERM_KEY, n.to_string()))
+    write_image(
+        ch,
+        (m.crop.width, m.crop.height),
+        &m.to_json(),
+        (TERM_KEY, n.to_string()),
+    )
 }
 
 /// Encode as a grid atlas with plain R/G channels.
@@ -144,8 +186,16 @@ pub fn encode_atlas(pack: &Pack) -> Result<Vec<u8>> {
             }
         }
     }
-    let ch = vec![AnyChannel::new("R", samples(r, m.precision)), AnyChannel::new("G", samples(g, m.precision))];
-    write_image(ch, (aw, rows * h), &m.to_json(), (LAYOUT_KEY, Layout::Atlas.name().into()))
+    let ch = vec![
+        AnyChannel::new("R", samples(r, m.precision)),
+        AnyChannel::new("G", samples(g, m.precision)),
+    ];
+    write_image(
+        ch,
+        (aw, rows * h),
+        &m.to_json(),
+        (LAYOUT_KEY, Layout::Atlas.name().into()),
+    )
 }
 
 /// What one EXR file holds.
@@ -159,7 +209,11 @@ pub struct Decoded {
     size: (usize, usize),
 }
 
-fn text_attr(l: &Layer<AnyChannels<FlatSamples>>, img: &ImageAttributes, key: &str) -> Option<String> {
+fn text_attr(
+    l: &Layer<AnyChannels<FlatSamples>>,
+    img: &ImageAttributes,
+    key: &str,
+) -> Option<String> {
     let k = Text::new_or_panic(key);
     let v = l.attributes.other.get(&k).or_else(|| img.other.get(&k))?;
     match v {
@@ -179,9 +233,15 @@ pub fn decode_file(bytes: &[u8]) -> Result<Decoded> {
         .non_parallel()
         .from_buffered(Cursor::new(bytes))
         .map_err(|e| Error::input(format!("EXR: {e}")))?;
-    let layer = image.layer_data.first().ok_or_else(|| Error::input("EXR: no layers"))?;
-    let text = text_attr(layer, &image.attributes, MANIFEST_KEY)
-        .ok_or_else(|| Error::input(format!("EXR: no '{MANIFEST_KEY}' attribute: not a sunbeam pack")))?;
+    let layer = image
+        .layer_data
+        .first()
+        .ok_or_else(|| Error::input("EXR: no layers"))?;
+    let text = text_attr(layer, &image.attributes, MANIFEST_KEY).ok_or_else(|| {
+        Error::input(format!(
+            "EXR: no '{MANIFEST_KEY}' attribute: not a sunbeam pack"
+        ))
+    })?;
     let manifest = Manifest::from_json(&text)?;
     let term_attr = text_attr(layer, &image.attributes, TERM_KEY);
     let layout = match text_attr(layer, &image.attributes, LAYOUT_KEY).as_deref() {
@@ -192,7 +252,11 @@ pub fn decode_file(bytes: &[u8]) -> Result<Decoded> {
         Some(o) => return Err(Error::input(format!("EXR: unknown {LAYOUT_KEY} '{o}'"))),
     };
     let term = match term_attr {
-        Some(t) => Some(t.trim().parse::<usize>().map_err(|_| Error::input(format!("EXR: bad {TERM_KEY} '{t}'")))?),
+        Some(t) => Some(
+            t.trim()
+                .parse::<usize>()
+                .map_err(|_| Error::input(format!("EXR: bad {TERM_KEY} '{t}'")))?,
+        ),
         None => None,
     };
     let size = (layer.size.width(), layer.size.height());
@@ -200,9 +264,20 @@ pub fn decode_file(bytes: &[u8]) -> Result<Decoded> {
         .channel_data
         .list
         .iter()
-        .map(|c| (String::from_utf8_lossy(c.name.as_slice()).into_owned(), c.sample_data.values_as_f32().collect()))
+        .map(|c| {
+            (
+                String::from_utf8_lossy(c.name.as_slice()).into_owned(),
+                c.sample_data.values_as_f32().collect(),
+            )
+        })
         .collect();
-    Ok(Decoded { manifest, layout, term, channels, size })
+    Ok(Decoded {
+        manifest,
+        layout,
+        term,
+        channels,
+        size,
+    })
 }
 
 impl Decoded {
@@ -216,7 +291,10 @@ impl Decoded {
 
     fn expect_size(&self, w: usize, h: usize) -> Result<()> {
         if self.size != (w, h) {
-            return Err(Error::input(format!("EXR: image is {}x{}, the manifest needs {w}x{h}", self.size.0, self.size.1)));
+            return Err(Error::input(format!(
+                "EXR: image is {}x{}, the manifest needs {w}x{h}",
+                self.size.0, self.size.1
+            )));
         }
         Ok(())
     }
@@ -249,13 +327,18 @@ impl Decoded {
                         let (cx, cy) = (n % cols, n / cols);
                         for ty in 0..h {
                             for tx in 0..w {
-                                terms[2 * (n * lt + ty * w + tx) + c] = v[(cy * h + ty) * aw + cx * w + tx];
+                                terms[2 * (n * lt + ty * w + tx) + c] =
+                                    v[(cy * h + ty) * aw + cx * w + tx];
                             }
                         }
                     }
                 }
             }
-            Layout::Split => return Err(Error::input("EXR: one term of a split pack (read it by path)")),
+            Layout::Split => {
+                return Err(Error::input(
+                    "EXR: one term of a split pack (read it by path)",
+                ))
+            }
         }
         Pack::new(m, terms)
     }
@@ -274,7 +357,10 @@ pub fn read_path(path: &Path, bytes: &[u8]) -> Result<Pack> {
         return d.into_pack().map_err(|e| e.context(path.display()));
     }
     // STEM.nNN.exr -> the pack's own name STEM.exr, from which split_path derives siblings.
-    let name = path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let base = name
         .strip_suffix(".exr")
         .and_then(|s| s.rsplit_once('.'))
@@ -289,9 +375,13 @@ pub fn read_path(path: &Path, bytes: &[u8]) -> Result<Pack> {
         let b = std::fs::read(&p).map_err(|e| Error::input_file(&p, e))?;
         let dn = decode_file(&b).map_err(|e| e.context(p.display()))?;
         if dn.manifest != m || dn.term != Some(n) {
-            return Err(Error::input_file(&p, format!("not term {n} of the same split pack")));
+            return Err(Error::input_file(
+                &p,
+                format!("not term {n} of the same split pack"),
+            ));
         }
-        dn.expect_size(m.crop.width, m.crop.height).map_err(|e| e.context(p.display()))?;
+        dn.expect_size(m.crop.width, m.crop.height)
+            .map_err(|e| e.context(p.display()))?;
         for (c, name) in ["R", "G"].iter().enumerate() {
             let v = dn.channel(name).map_err(|e| e.context(p.display()))?;
             for (i, x) in v.iter().enumerate() {

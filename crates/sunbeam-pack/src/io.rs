@@ -26,7 +26,8 @@ pub fn read_height(path: &Path, o: &InputOptions) -> Result<HeightField> {
         z_scale: None,
     };
     let chans = sunbeam_afm::read_file(path, &ro)?;
-    let ch = sunbeam_afm::select_channel(&chans, o.channel.as_deref()).map_err(|e| e.context(path.display()))?;
+    let ch = sunbeam_afm::select_channel(&chans, o.channel.as_deref())
+        .map_err(|e| e.context(path.display()))?;
     if ch.z_unit != "m" {
         return Err(Error::input_file(
             path,
@@ -37,7 +38,10 @@ pub fn read_height(path: &Path, o: &InputOptions) -> Result<HeightField> {
         ));
     }
     if ch.xy_unit != "m" {
-        return Err(Error::input_file(path, "the file records no lateral size in metres: give --pixel-size"));
+        return Err(Error::input_file(
+            path,
+            "the file records no lateral size in metres: give --pixel-size",
+        ));
     }
     let mut f = ch.field.clone();
     if f.provenance.channel.is_empty() {
@@ -65,7 +69,10 @@ pub enum OutputKind {
 impl OutputKind {
     /// From the output name and the --split/--atlas flags.
     pub fn from_path(path: &Path, split: bool, atlas: bool) -> Result<OutputKind> {
-        let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
         match ext.as_str() {
             "ktx2" => {
                 if split || atlas {
@@ -79,7 +86,10 @@ impl OutputKind {
                 (false, true) => Ok(OutputKind::ExrAtlas),
                 _ => Ok(OutputKind::ExrLayers),
             },
-            _ => Err(Error::usage(format!("{}: output must end in .ktx2 or .exr", path.display()))),
+            _ => Err(Error::usage(format!(
+                "{}: output must end in .ktx2 or .exr",
+                path.display()
+            ))),
         }
     }
 }

@@ -64,9 +64,11 @@ pub fn gauss(d: f64, sigma_bins: f64) -> f64 {
     (-d * d / (2.0 * sigma_bins * sigma_bins)).exp()
 }
 
-/// Taps per axis for the tiled model's Gaussian: covers +-4 sigma, at least 2, even.
+/// Taps per axis for the tiled model's Gaussian: `W = 2 (ceil(5 sigma) + 1)`, so that
+/// the taps `floor(kappa) - W/2 + 1 .. floor(kappa) + W/2` reach at least 5 sigma on
+/// both sides (weights beyond are below 4e-6); at most 64.
 pub fn gauss_taps(sigma_bins: f64) -> usize {
-    let half = (4.0 * sigma_bins).ceil().max(1.0) as usize;
+    let half = (5.0 * sigma_bins).ceil().max(0.0) as usize + 1;
     (2 * half).min(64)
 }
 
@@ -94,7 +96,11 @@ mod tests {
                 s += kb(x, taps, beta) * (2.0 * std::f64::consts::PI * x * nu).cos();
             }
             s *= h;
-            assert!((s - kb_hat(nu, taps, beta)).abs() < 1e-7, "nu={nu}: {s} vs {}", kb_hat(nu, taps, beta));
+            assert!(
+                (s - kb_hat(nu, taps, beta)).abs() < 1e-7,
+                "nu={nu}: {s} vs {}",
+                kb_hat(nu, taps, beta)
+            );
         }
         assert!((kb_hat(0.0, taps, beta) - 1.0).abs() < 1e-14);
     }
@@ -104,6 +110,6 @@ mod tests {
         // Abramowitz & Stegun table 9.8: I0(1) = 1.266065878, I0(5) = 27.23987182, I0(10) = 2815.716628.
         assert!((bessel_i0(1.0) - 1.266_065_878).abs() < 1e-8);
         assert!((bessel_i0(5.0) / 27.239_871_82 - 1.0).abs() < 1e-8);
-        assert!((bessel_i0(10.0) / 2815.716_628 - 1.0).abs() < 1e-8);
+        assert!((bessel_i0(10.0) / 2_815.716_628 - 1.0).abs() < 1e-8);
     }
 }

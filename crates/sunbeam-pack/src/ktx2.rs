@@ -7,7 +7,9 @@ use crate::pack::Pack;
 use sunbeam_common::{Error, Result};
 
 /// The 12-byte file identifier «KTX 20»\r\n\x1A\n.
-pub const IDENTIFIER: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
+pub const IDENTIFIER: [u8; 12] = [
+    0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A,
+];
 /// VK_FORMAT_R32G32_SFLOAT.
 pub const VK_R32G32_SFLOAT: u32 = 103;
 /// VK_FORMAT_R16G16_SFLOAT.
@@ -31,7 +33,7 @@ pub fn dfd(precision: Precision) -> Vec<u8> {
     d.extend_from_slice(&((4 + block_size) as u32).to_le_bytes()); // dfdTotalSize
     d.extend_from_slice(&0u32.to_le_bytes()); // vendorId 0 (Khronos), descriptorType 0 (basic)
     d.extend_from_slice(&(2u32 | ((block_size as u32) << 16)).to_le_bytes()); // version 2, block size
-    // colorModel RGBSDA (1), primaries unspecified (0), transfer LINEAR (1), flags 0
+                                                                              // colorModel RGBSDA (1), primaries unspecified (0), transfer LINEAR (1), flags 0
     d.extend_from_slice(&[1, 0, 1, 0]);
     d.extend_from_slice(&[0, 0, 0, 0]); // texelBlockDimension 1x1x1x1 (stored minus 1)
     d.extend_from_slice(&[bytes_plane, 0, 0, 0]); // bytesPlane0..3
@@ -80,8 +82,10 @@ fn encode_parts(m: &Manifest, writer: &str) -> (usize, Vec<u8>) {
     let d = dfd(precision);
     let mut writer_value = writer.as_bytes().to_vec();
     writer_value.push(0); // KTXwriter is a NUL-terminated UTF-8 string
-    let mut entries =
-        vec![(b"KTXwriter".to_vec(), writer_value), (MANIFEST_KEY.as_bytes().to_vec(), m.to_json().into_bytes())];
+    let mut entries = vec![
+        (b"KTXwriter".to_vec(), writer_value),
+        (MANIFEST_KEY.as_bytes().to_vec(), m.to_json().into_bytes()),
+    ];
     let k = kvd(&mut entries);
     let dfd_off = HEADER_LEN + LEVEL_INDEX_LEN;
     let kvd_off = dfd_off + d.len();
@@ -146,10 +150,12 @@ pub fn write_to(pack: &Pack, writer: &str, out: &mut impl std::io::Write) -> std
     for chunk in pack.terms.chunks(1 << 14) {
         buf.clear();
         match pack.manifest.precision {
-            Precision::F32 => chunk.iter().for_each(|v| buf.extend_from_slice(&v.to_le_bytes())),
-            Precision::F16 => {
-                chunk.iter().for_each(|v| buf.extend_from_slice(&half::f16::from_f32(*v).to_le_bytes()))
-            }
+            Precision::F32 => chunk
+                .iter()
+                .for_each(|v| buf.extend_from_slice(&v.to_le_bytes())),
+            Precision::F16 => chunk
+                .iter()
+                .for_each(|v| buf.extend_from_slice(&half::f16::from_f32(*v).to_le_bytes())),
         }
         out.write_all(&buf)?;
     }
@@ -195,9 +201,15 @@ pub fn key_values(bytes: &[u8]) -> Result<Vec<(String, Vec<u8>)>> {
     if len == 0 {
         return Ok(vec![]);
     }
-    let end = off.checked_add(len).filter(|&e| e <= bytes.len()).ok_or_else(|| {
-        Error::input(format!("KTX2: key/value data {off}+{len} runs past the end of the file ({})", bytes.len()))
-    })?;
+    let end = off
+        .checked_add(len)
+        .filter(|&e| e <= bytes.len())
+        .ok_or_else(|| {
+            Error::input(format!(
+                "KTX2: key/value data {off}+{len} runs past the end of the file ({})",
+                bytes.len()
+            ))
+        })?;
     let kv = &bytes[off..end];
     let mut p = 0;
     let mut out = Vec::new();
@@ -206,8 +218,12 @@ pub fn key_values(bytes: &[u8]) -> Result<Vec<(String, Vec<u8>)>> {
         let body = kv
             .get(p + 4..p + 4 + n)
             .ok_or_else(|| Error::input("KTX2: key/value entry runs past the key/value data"))?;
-        let nul = body.iter().position(|&c| c == 0).ok_or_else(|| Error::input("KTX2: key without NUL"))?;
-        let key = String::from_utf8(body[..nul].to_vec()).map_err(|_| Error::input("KTX2: key is not UTF-8"))?;
+        let nul = body
+            .iter()
+            .position(|&c| c == 0)
+            .ok_or_else(|| Error::input("KTX2: key without NUL"))?;
+        let key = String::from_utf8(body[..nul].to_vec())
+            .map_err(|_| Error::input("KTX2: key is not UTF-8"))?;
         out.push((key, body[nul + 1..].to_vec()));
         p = align(p + 4 + n, 4);
     }
@@ -217,13 +233,19 @@ pub fn key_values(bytes: &[u8]) -> Result<Vec<(String, Vec<u8>)>> {
 /// Decode a KTX2 pack.
 pub fn decode(bytes: &[u8]) -> Result<Pack> {
     if bytes.len() < HEADER_LEN + LEVEL_INDEX_LEN || !bytes.starts_with(&IDENTIFIER) {
-        return Err(Error::input("not a KTX2 file (bad identifier or too short)"));
+        return Err(Error::input(
+            "not a KTX2 file (bad identifier or too short)",
+        ));
     }
     let vk = u32_at(bytes, 12)?;
     let precision = match vk {
         VK_R32G32_SFLOAT => Precision::F32,
         VK_R16G16_SFLOAT => Precision::F16,
-        _ => return Err(Error::input(format!("KTX2: vkFormat {vk} is not RG32F (103) or RG16F (83)"))),
+        _ => {
+            return Err(Error::input(format!(
+                "KTX2: vkFormat {vk} is not RG32F (103) or RG16F (83)"
+            )))
+        }
     };
     let width = u32_at(bytes, 20)? as usize;
     let height = u32_at(bytes, 24)? as usize;
@@ -231,13 +253,17 @@ pub fn decode(bytes: &[u8]) -> Result<Pack> {
     let levels = u32_at(bytes, 40)?;
     let scheme = u32_at(bytes, 44)?;
     if levels != 1 || scheme != 0 {
-        return Err(Error::input(format!("KTX2: levelCount {levels} / supercompression {scheme}: expected 1 / 0")));
+        return Err(Error::input(format!(
+            "KTX2: levelCount {levels} / supercompression {scheme}: expected 1 / 0"
+        )));
     }
     let manifest_bytes = key_values(bytes)?
         .into_iter()
         .find(|(k, _)| k == MANIFEST_KEY)
         .map(|(_, v)| v)
-        .ok_or_else(|| Error::input(format!("KTX2: no '{MANIFEST_KEY}' key: not a sunbeam pack")))?;
+        .ok_or_else(|| {
+            Error::input(format!("KTX2: no '{MANIFEST_KEY}' key: not a sunbeam pack"))
+        })?;
     let text = std::str::from_utf8(&manifest_bytes)
         .map_err(|_| Error::input("KTX2: manifest is not UTF-8"))?
         .trim_end_matches('\0');
@@ -249,22 +275,38 @@ pub fn decode(bytes: &[u8]) -> Result<Pack> {
         )));
     }
     if manifest.precision != precision {
-        return Err(Error::input("KTX2: vkFormat does not match the manifest's precision"));
+        return Err(Error::input(
+            "KTX2: vkFormat does not match the manifest's precision",
+        ));
     }
     let texel = if precision == Precision::F32 { 8 } else { 4 };
     let off = u64_at(bytes, 80)?;
     let len = u64_at(bytes, 88)?;
     let want = (width as u64) * (height as u64) * (layers as u64) * texel;
     if len != want {
-        return Err(Error::input(format!("KTX2: level byteLength {len}, expected {want}")));
+        return Err(Error::input(format!(
+            "KTX2: level byteLength {len}, expected {want}"
+        )));
     }
-    let end = off.checked_add(len).filter(|&e| e <= bytes.len() as u64).ok_or_else(|| {
-        Error::input(format!("KTX2: level data {off}+{len} runs past the end of the file ({} bytes)", bytes.len()))
-    })?;
+    let end = off
+        .checked_add(len)
+        .filter(|&e| e <= bytes.len() as u64)
+        .ok_or_else(|| {
+            Error::input(format!(
+                "KTX2: level data {off}+{len} runs past the end of the file ({} bytes)",
+                bytes.len()
+            ))
+        })?;
     let data = &bytes[off as usize..end as usize];
     let terms: Vec<f32> = match precision {
-        Precision::F32 => data.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect(),
-        Precision::F16 => data.chunks_exact(2).map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32()).collect(),
+        Precision::F32 => data
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect(),
+        Precision::F16 => data
+            .chunks_exact(2)
+            .map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f32())
+            .collect(),
     };
     Pack::new(manifest, terms)
 }

@@ -174,8 +174,8 @@ impl Manifest {
 
     /// Parse and validate.
     pub fn from_json(text: &str) -> Result<Manifest> {
-        let m: Manifest =
-            serde_json::from_str(text).map_err(|e| Error::input(format!("invalid manifest: {e}")))?;
+        let m: Manifest = serde_json::from_str(text)
+            .map_err(|e| Error::input(format!("invalid manifest: {e}")))?;
         m.validate()?;
         Ok(m)
     }
@@ -184,10 +184,16 @@ impl Manifest {
     pub fn validate(&self) -> Result<()> {
         let bad = |what: &str| Err(Error::input(format!("invalid manifest: {what}")));
         if self.format != FORMAT_NAME {
-            return bad(&format!("format is '{}', expected '{FORMAT_NAME}'", self.format));
+            return bad(&format!(
+                "format is '{}', expected '{FORMAT_NAME}'",
+                self.format
+            ));
         }
         if self.version != FORMAT_VERSION {
-            return bad(&format!("version {} is not supported (this reader knows {FORMAT_VERSION})", self.version));
+            return bad(&format!(
+                "version {} is not supported (this reader knows {FORMAT_VERSION})",
+                self.version
+            ));
         }
         if self.terms == 0 || self.terms > 4096 {
             return bad("terms must be 1..4096");
@@ -199,30 +205,47 @@ impl Manifest {
         if c.width as i64 != 2 * c.kx + 1 || c.height as i64 != 2 * c.ky + 1 {
             return bad("crop.width/height must be 2 kx + 1 / 2 ky + 1");
         }
-        if self.kernel.taps == 0 || self.kernel.taps % 2 != 0 || self.kernel.taps > 64 {
+        if self.kernel.taps == 0 || self.kernel.taps & 1 == 1 || self.kernel.taps > 64 {
             return bad("kernel.taps must be even, 2..64");
         }
         match (self.model, self.kernel.kind.as_str()) {
             (Model::Window, "kaiser-bessel") => {
-                if !(self.kernel.beta.is_finite() && self.kernel.beta > 0.0 && self.kernel.beta < 100.0) {
+                if !(self.kernel.beta.is_finite()
+                    && self.kernel.beta > 0.0
+                    && self.kernel.beta < 100.0)
+                {
                     return bad("kernel.beta must be in (0, 100)");
                 }
             }
             (Model::Tiled, "gaussian") => {
-                if !self.kernel.sigma_bins.iter().all(|s| s.is_finite() && *s > 0.0) {
+                if !self
+                    .kernel
+                    .sigma_bins
+                    .iter()
+                    .all(|s| s.is_finite() && *s > 0.0)
+                {
                     return bad("kernel.sigma_bins must be positive");
                 }
             }
-            _ => return bad("kernel.type must be kaiser-bessel (window model) or gaussian (tiled model)"),
+            _ => {
+                return bad(
+                    "kernel.type must be kaiser-bessel (window model) or gaussian (tiled model)",
+                )
+            }
         }
         let finite_pos = |v: f64| v.is_finite() && v > 0.0;
-        if !(finite_pos(self.lambda_min_m) && finite_pos(self.lambda_max_m) && self.lambda_max_m >= self.lambda_min_m) {
+        if !(finite_pos(self.lambda_min_m)
+            && finite_pos(self.lambda_max_m)
+            && self.lambda_max_m >= self.lambda_min_m)
+        {
             return bad("lambda range");
         }
         if !(finite_pos(self.bin_scale_m[0]) && finite_pos(self.bin_scale_m[1])) {
             return bad("bin_scale_m must be positive");
         }
-        if !(self.height_half_range_m.is_finite() && self.height_half_range_m >= 0.0 && self.height_centre_m.is_finite())
+        if !(self.height_half_range_m.is_finite()
+            && self.height_half_range_m >= 0.0
+            && self.height_centre_m.is_finite())
         {
             return bad("height centre / half range");
         }

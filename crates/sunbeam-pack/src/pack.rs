@@ -45,7 +45,10 @@ impl Pack {
     /// Checks shared by the readers: sizes and finiteness.
     pub fn new(manifest: Manifest, terms: Vec<f32>) -> Result<Pack> {
         manifest.validate()?;
-        let want = manifest.terms.checked_mul(manifest.layer_texels()).and_then(|v| v.checked_mul(2));
+        let want = manifest
+            .terms
+            .checked_mul(manifest.layer_texels())
+            .and_then(|v| v.checked_mul(2));
         if want != Some(terms.len()) {
             return Err(Error::input(format!(
                 "pack holds {} values, manifest says {} terms of {}x{}",
@@ -78,7 +81,11 @@ impl Pack {
         let m = &self.manifest;
         let taps = m.kernel.taps;
         let k0 = kernel::first_tap(kappa, taps);
-        let mut t = Taps { idx: [0; 64], w: [0.0; 64], n: 0 };
+        let mut t = Taps {
+            idx: [0; 64],
+            w: [0.0; 64],
+            n: 0,
+        };
         for j in 0..taps {
             let k = k0 + j as i64;
             if k < -k_half || k > k_half {
@@ -100,7 +107,12 @@ impl Pack {
     /// (PHYSICS.md 2), with the interpolation the player uses.
     pub fn reflectance(&self, u: f64, v: f64, w: f64, lambda_m: f64) -> f64 {
         let m = &self.manifest;
-        if !(u.is_finite() && v.is_finite() && w.is_finite() && lambda_m.is_finite() && lambda_m > 0.0) {
+        if !(u.is_finite()
+            && v.is_finite()
+            && w.is_finite()
+            && lambda_m.is_finite()
+            && lambda_m > 0.0)
+        {
             return 0.0;
         }
         let c = series::coefficients_f64(m.basis, self.t(w, lambda_m), m.terms);
@@ -145,14 +157,23 @@ impl Pack {
     /// PHYSICS.md 2: `G(wi, wr) * sum_i R(lambda_i) S(lambda_i) cmf(lambda_i) / sum_i S(lambda_i) ybar(lambda_i)`
     /// over `lambda_samples` midpoint samples of the pack's wavelength range
     /// (so a flat mirror at normal incidence gives Y = 1 exactly).
-    pub fn colour_xyz(&self, wi_local: [f64; 3], wr_local: [f64; 3], lambda_samples: usize) -> [f64; 3] {
+    pub fn colour_xyz(
+        &self,
+        wi_local: [f64; 3],
+        wr_local: [f64; 3],
+        lambda_samples: usize,
+    ) -> [f64; 3] {
         use sunbeam_optics::{cie, gain};
         let m = &self.manifest;
         let g = gain::g(wi_local, wr_local, gain::DEFAULT_IOR);
         if !(g.is_finite() && g > 0.0) || lambda_samples == 0 {
             return [0.0; 3];
         }
-        let (u, v, w) = (-wi_local[0] - wr_local[0], -wi_local[1] - wr_local[1], -wi_local[2] - wr_local[2]);
+        let (u, v, w) = (
+            -wi_local[0] - wr_local[0],
+            -wi_local[1] - wr_local[1],
+            -wi_local[2] - wr_local[2],
+        );
         let (l0, l1) = (m.lambda_min_m, m.lambda_max_m);
         let dl = (l1 - l0) / lambda_samples as f64;
         let mut xyz = [0.0; 3];

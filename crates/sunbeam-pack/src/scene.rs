@@ -42,7 +42,9 @@ fn norm(a: [f64; 3]) -> Option<[f64; 3]> {
 }
 
 fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).clamp(-1.0, 1.0).acos()
+    (a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+        .clamp(-1.0, 1.0)
+        .acos()
 }
 
 /// Triangles of a scene mesh (positions, indices).
@@ -66,7 +68,11 @@ pub fn bound(scene: &Scene, path: &Path, max_w: f64) -> Result<SceneBound> {
     let mut inputs = vec![path.to_path_buf()];
     let vp = scene.camera.view_proj(scene.size[0], scene.size[1]);
     let eye = scene.camera.eye;
-    let lights: Vec<[f64; 3]> = scene.lights.iter().filter_map(|l| norm(l.direction)).collect();
+    let lights: Vec<[f64; 3]> = scene
+        .lights
+        .iter()
+        .filter_map(|l| norm(l.direction))
+        .collect();
     let mut theta_min = vec![std::f64::consts::PI; lights.len()];
     let (mut kept, mut culled) = (0usize, 0usize);
     for mi in &scene.meshes {
@@ -76,26 +82,43 @@ pub fn bound(scene: &Scene, path: &Path, max_w: f64) -> Result<SceneBound> {
         let (pos, idx) = mesh_triangles(&mi.mesh).map_err(|e| e.context(path.display()))?;
         let clip: Vec<[f64; 4]> = pos
             .iter()
-            .map(|p| sunbeam_scene::camera::transform(&vp, [p[0] as f64, p[1] as f64, p[2] as f64, 1.0]))
+            .map(|p| {
+                sunbeam_scene::camera::transform(&vp, [p[0] as f64, p[1] as f64, p[2] as f64, 1.0])
+            })
             .collect();
-        let dirs: Vec<Option<[f64; 3]>> =
-            pos.iter().map(|p| norm([eye[0] - p[0] as f64, eye[1] - p[1] as f64, eye[2] - p[2] as f64])).collect();
+        let dirs: Vec<Option<[f64; 3]>> = pos
+            .iter()
+            .map(|p| {
+                norm([
+                    eye[0] - p[0] as f64,
+                    eye[1] - p[1] as f64,
+                    eye[2] - p[2] as f64,
+                ])
+            })
+            .collect();
         for tri in idx.chunks_exact(3) {
             let v = [tri[0] as usize, tri[1] as usize, tri[2] as usize];
             if v.iter().any(|&i| i >= pos.len()) {
-                return Err(Error::input(format!("{}: mesh index out of range", mi.mesh.display())));
+                return Err(Error::input(format!(
+                    "{}: mesh index out of range",
+                    mi.mesh.display()
+                )));
             }
             // Culled when all three vertices lie outside the same clip plane.
-            let outside = |f: &dyn Fn(&[f64; 4]) -> bool| v.iter().all(|&i| f(&clip[i]));
-            let planes: [&dyn Fn(&[f64; 4]) -> bool; 6] = [
-                &|c| c[0] < -c[3],
-                &|c| c[0] > c[3],
-                &|c| c[1] < -c[3],
-                &|c| c[1] > c[3],
-                &|c| c[2] < 0.0,
-                &|c| c[2] > c[3],
-            ];
-            if planes.iter().any(|p| outside(*p)) {
+            let outside = |plane: usize| {
+                v.iter().all(|&i| {
+                    let c = &clip[i];
+                    match plane {
+                        0 => c[0] < -c[3],
+                        1 => c[0] > c[3],
+                        2 => c[1] < -c[3],
+                        3 => c[1] > c[3],
+                        4 => c[2] < 0.0,
+                        _ => c[2] > c[3],
+                    }
+                })
+            };
+            if (0..6).any(outside) {
                 culled += 1;
                 continue;
             }
@@ -108,9 +131,15 @@ pub fn bound(scene: &Scene, path: &Path, max_w: f64) -> Result<SceneBound> {
                     continue;
                 }
             };
-            let size = angle(d[0], d[1]).max(angle(d[1], d[2])).max(angle(d[0], d[2]));
+            let size = angle(d[0], d[1])
+                .max(angle(d[1], d[2]))
+                .max(angle(d[0], d[2]));
             for (li, l) in lights.iter().enumerate() {
-                let a = d.iter().map(|x| angle(*l, *x)).fold(f64::INFINITY, f64::min) - size;
+                let a = d
+                    .iter()
+                    .map(|x| angle(*l, *x))
+                    .fold(f64::INFINITY, f64::min)
+                    - size;
                 theta_min[li] = theta_min[li].min(a.max(0.0));
             }
         }
@@ -120,7 +149,10 @@ pub fn bound(scene: &Scene, path: &Path, max_w: f64) -> Result<SceneBound> {
         notes.push("scene: no visible triangle or no light; nothing bounded".into());
         2.0
     } else {
-        theta_min.iter().map(|t| 2.0 * (t / 2.0).cos()).fold(0.0, f64::max)
+        theta_min
+            .iter()
+            .map(|t| 2.0 * (t / 2.0).cos())
+            .fold(0.0, f64::max)
     };
     let max_uv = s.min(2.0);
     let bw = max_w.min(max_uv);
@@ -136,5 +168,11 @@ pub fn bound(scene: &Scene, path: &Path, max_w: f64) -> Result<SceneBound> {
              so all directions are kept"
         ));
     }
-    Ok(SceneBound { lambda: None, max_w: bw, max_uv, inputs, notes })
+    Ok(SceneBound {
+        lambda: None,
+        max_w: bw,
+        max_uv,
+        inputs,
+        notes,
+    })
 }

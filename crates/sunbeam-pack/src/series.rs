@@ -161,7 +161,9 @@ pub fn tail_bound(basis: Basis, t: f64, n_terms: usize) -> f64 {
             let upto = n_terms.max(a.ceil() as usize) + 60;
             let mut j = vec![0.0; upto];
             bessel_j_f64(a, &mut j);
-            let s: f64 = (n_terms..upto).map(|n| if n == 0 { 1.0 } else { 2.0 } * j[n].abs()).sum();
+            let s: f64 = (n_terms..upto)
+                .map(|n| if n == 0 { 1.0 } else { 2.0 } * j[n].abs())
+                .sum();
             2.0 * s
         }
         Basis::Taylor => {
@@ -249,7 +251,11 @@ mod tests {
                 let q = bessel_quad(k, t);
                 assert!((j[k] - q).abs() < 1e-12, "J_{k}({t}) = {} vs {q}", j[k]);
                 let tol32 = if t.abs() <= 30.0 { 2e-7 } else { 1e-6 };
-                assert!((j32[k] as f64 - q).abs() < tol32, "f32 J_{k}({t}) = {} vs {q}", j32[k]);
+                assert!(
+                    (j32[k] as f64 - q).abs() < tol32,
+                    "f32 J_{k}({t}) = {} vs {q}",
+                    j32[k]
+                );
             }
         }
     }
@@ -277,7 +283,10 @@ mod tests {
                     acc[1] += ck[1] * tk;
                 }
                 let (re, im) = ((t * s).cos(), (t * s).sin());
-                assert!((acc[0] - re).abs() < 1e-11 && (acc[1] - im).abs() < 1e-11, "t={t} s={s}");
+                assert!(
+                    (acc[0] - re).abs() < 1e-11 && (acc[1] - im).abs() < 1e-11,
+                    "t={t} s={s}"
+                );
             }
         }
     }

@@ -16,7 +16,13 @@ fn u64at(b: &[u8], o: usize) -> u64 {
 
 fn sample_pack(precision: Precision) -> Pack {
     let f = rough(21, 17, 25e-9, 25e-9, 250e-9, 42);
-    build(&f, &BuildOptions { precision, ..BuildOptions::default() })
+    build(
+        &f,
+        &BuildOptions {
+            precision,
+            ..BuildOptions::default()
+        },
+    )
 }
 
 /// Check every rule a KTX2 writer gets wrong, by reading the bytes directly.
@@ -26,7 +32,10 @@ fn check_ktx2_rules(b: &[u8], p: &Pack) {
         Precision::F32 => (103u32, 4u32, 8u64, 32u32),
         Precision::F16 => (83, 2, 4, 16),
     };
-    assert_eq!(&b[..12], &[0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A]);
+    assert_eq!(
+        &b[..12],
+        &[0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A]
+    );
     assert_eq!(u32at(b, 12), vk, "vkFormat");
     assert_eq!(u32at(b, 16), ts, "typeSize");
     assert_eq!(u32at(b, 20) as usize, m.crop.width);
@@ -36,7 +45,8 @@ fn check_ktx2_rules(b: &[u8], p: &Pack) {
     assert_eq!(u32at(b, 36), 1, "faceCount");
     assert_eq!(u32at(b, 40), 1, "levelCount");
     assert_eq!(u32at(b, 44), 0, "supercompressionScheme");
-    let (dfd_off, dfd_len, kvd_off, kvd_len) = (u32at(b, 48), u32at(b, 52), u32at(b, 56), u32at(b, 60));
+    let (dfd_off, dfd_len, kvd_off, kvd_len) =
+        (u32at(b, 48), u32at(b, 52), u32at(b, 56), u32at(b, 60));
     assert_eq!(u64at(b, 64), 0, "sgdByteOffset");
     assert_eq!(u64at(b, 72), 0, "sgdByteLength");
     // Level index directly after the header, DFD directly after the level index.
@@ -76,19 +86,31 @@ fn check_ktx2_rules(b: &[u8], p: &Pack) {
         let nul = body.iter().position(|&c| c == 0).unwrap();
         let key = body[..nul].to_vec();
         if key.starts_with(b"KTX") {
-            assert!(key == b"KTXwriter" || key == b"KTXorientation", "reserved key {key:?}");
+            assert!(
+                key == b"KTXwriter" || key == b"KTXorientation",
+                "reserved key {key:?}"
+            );
         }
         if key == b"KTXwriter" {
             let v = &body[nul + 1..];
             assert_eq!(*v.last().unwrap(), 0, "KTXwriter NUL-terminated");
             let s = std::str::from_utf8(&v[..v.len() - 1]).unwrap();
-            assert!(s.starts_with("sunbeam-pack") || s == "test", "KTXwriter {s}");
-            assert!(!s.chars().any(|c| c == ':'), "no timestamp in KTXwriter: {s}");
+            assert!(
+                s.starts_with("sunbeam-pack") || s == "test",
+                "KTXwriter {s}"
+            );
+            assert!(
+                !s.chars().any(|c| c == ':'),
+                "no timestamp in KTXwriter: {s}"
+            );
         }
         keys.push(key);
         let end = pos + 4 + n;
         let padded = end.div_ceil(4) * 4;
-        assert!(kv[end..padded].iter().all(|&c| c == 0), "value padding must be zero");
+        assert!(
+            kv[end..padded].iter().all(|&c| c == 0),
+            "value padding must be zero"
+        );
         pos = padded;
     }
     assert_eq!(pos, kv.len());
@@ -102,10 +124,20 @@ fn check_ktx2_rules(b: &[u8], p: &Pack) {
     let align = if texel % 4 == 0 { texel } else { 4 * texel };
     assert_eq!(lo % align, 0, "level offset alignment");
     let kv_end = (kvd_off + kvd_len) as u64;
-    assert_eq!(lo, kv_end.div_ceil(align) * align, "smallest aligned offset");
-    assert!(b[kv_end as usize..lo as usize].iter().all(|&c| c == 0), "zero padding before level data");
+    assert_eq!(
+        lo,
+        kv_end.div_ceil(align) * align,
+        "smallest aligned offset"
+    );
+    assert!(
+        b[kv_end as usize..lo as usize].iter().all(|&c| c == 0),
+        "zero padding before level data"
+    );
     assert_eq!(ll, lu, "byteLength = uncompressedByteLength");
-    assert_eq!(ll, m.crop.width as u64 * m.crop.height as u64 * m.terms as u64 * texel);
+    assert_eq!(
+        ll,
+        m.crop.width as u64 * m.crop.height as u64 * m.terms as u64 * texel
+    );
     assert_eq!(lo + ll, b.len() as u64, "file ends with the level data");
 }
 
@@ -135,10 +167,25 @@ fn ktx2_follows_the_spec_rules_and_round_trips() {
 #[test]
 fn output_is_byte_identical_across_runs_and_thread_counts() {
     let f = rough(33, 29, 25e-9, 25e-9, 400e-9, 6);
-    let a = build(&f, &BuildOptions { threads: 1, ..BuildOptions::default() });
-    let b = build(&f, &BuildOptions { threads: 3, ..BuildOptions::default() });
+    let a = build(
+        &f,
+        &BuildOptions {
+            threads: 1,
+            ..BuildOptions::default()
+        },
+    );
+    let b = build(
+        &f,
+        &BuildOptions {
+            threads: 3,
+            ..BuildOptions::default()
+        },
+    );
     assert_eq!(ktx2::encode(&a, "x"), ktx2::encode(&b, "x"));
-    assert_eq!(exr_io::encode_layers(&a).unwrap(), exr_io::encode_layers(&b).unwrap());
+    assert_eq!(
+        exr_io::encode_layers(&a).unwrap(),
+        exr_io::encode_layers(&b).unwrap()
+    );
 }
 
 #[test]
@@ -155,9 +202,16 @@ fn exr_layouts_round_trip_with_blender_names() {
         assert_eq!(d.layout, exr_io::Layout::Layers);
         // Channel names as Blender/Nuke expect them (read back by the exr crate).
         let img = exr::prelude::read_all_data_from_file(&path).unwrap();
-        let names: Vec<String> =
-            img.layer_data[0].channel_data.list.iter().map(|c| c.name.to_string()).collect();
-        assert!(names.contains(&"Pack.n00.R".to_string()) && names.contains(&"Pack.n00.G".to_string()), "{names:?}");
+        let names: Vec<String> = img.layer_data[0]
+            .channel_data
+            .list
+            .iter()
+            .map(|c| c.name.to_string())
+            .collect();
+        assert!(
+            names.contains(&"Pack.n00.R".to_string()) && names.contains(&"Pack.n00.G".to_string()),
+            "{names:?}"
+        );
         assert_eq!(names.len(), 2 * p.manifest.terms);
         // atlas
         let path = dir.join("a.exr");

@@ -14,11 +14,23 @@ fn truth_for(f: &sunbeam_field::HeightField, model: Model) -> Truth {
         Model::Window => truth::Model::Window,
         Model::Tiled => truth::Model::Tiled,
     };
-    Truth::new(f, &Params { model, coherence_m: 65e-6 }).unwrap()
+    Truth::new(
+        f,
+        &Params {
+            model,
+            coherence_m: 65e-6,
+        },
+    )
+    .unwrap()
 }
 
 fn opts(basis: Basis, model: Model) -> BuildOptions {
-    BuildOptions { basis, model, threads: 2, ..BuildOptions::default() }
+    BuildOptions {
+        basis,
+        model,
+        threads: 2,
+        ..BuildOptions::default()
+    }
 }
 
 /// (max |dR|, max relative error where R_truth >= floor) over queries.
@@ -50,7 +62,10 @@ fn target1_flat_patch_gives_one_at_specular_and_d65_white() {
                         let r = p.reflectance(0.0, 0.0, w, l);
                         // Kaiser-Bessel (6 taps, 2x padding) interpolation error is ~1e-5 (docs/PACK_FORMAT.md).
                         let tol = if model == Model::Window { 5e-5 } else { 1e-6 };
-                        assert!((r - 1.0).abs() < tol, "{basis:?} {model:?} offset {offset}: R = {r}");
+                        assert!(
+                            (r - 1.0).abs() < tol,
+                            "{basis:?} {model:?} offset {offset}: R = {r}"
+                        );
                         assert!((t.reflectance(0.0, 0.0, w, l) - 1.0).abs() < 1e-9);
                     }
                 }
@@ -102,8 +117,14 @@ fn target2_parseval_over_the_full_dft() {
                 sum_t += t.reflectance(-l * fx, -l * fy, w, l);
             }
         }
-        assert!((sum_t / expect - 1.0).abs() < 1e-9, "truth Parseval {sum_t} vs {expect}");
-        assert!((sum_p / expect - 1.0).abs() < 1e-4, "{basis:?} Parseval {sum_p} vs {expect}");
+        assert!(
+            (sum_t / expect - 1.0).abs() < 1e-9,
+            "truth Parseval {sum_t} vs {expect}"
+        );
+        assert!(
+            (sum_p / expect - 1.0).abs() < 1e-4,
+            "{basis:?} Parseval {sum_p} vs {expect}"
+        );
     }
 }
 
@@ -128,12 +149,21 @@ fn target3_symmetry_r_of_minus_t_is_r_of_minus_f() {
 
 /// Exact transforms of the basis terms at one frequency (float64 direct sums, T_n by cos(n acos s)):
 /// F_n(f) = sum_j g_j B_n(s_j) e^{-2 pi i f.(x_j - x_c)} / sum g.
-fn exact_terms(f: &sunbeam_field::HeightField, basis: Basis, n: usize, fx: f64, fy: f64) -> Vec<[f64; 2]> {
+fn exact_terms(
+    f: &sunbeam_field::HeightField,
+    basis: Basis,
+    n: usize,
+    fx: f64,
+    fy: f64,
+) -> Vec<[f64; 2]> {
     let (mx, my) = (f.width, f.height);
     let (lo, hi) = f.finite_range().unwrap();
     let (hc, hh) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
     let sigma = (65e-6f64 / 4.0).min((mx as f64 * f.dx).min(my as f64 * f.dy) / 6.0);
-    let (cx, cy) = ((mx as f64 - 1.0) / 2.0 * f.dx, (my as f64 - 1.0) / 2.0 * f.dy);
+    let (cx, cy) = (
+        (mx as f64 - 1.0) / 2.0 * f.dx,
+        (my as f64 - 1.0) / 2.0 * f.dy,
+    );
     let mut out = vec![[0.0; 2]; n];
     let mut sg = 0.0;
     for r in 0..my {
@@ -141,7 +171,11 @@ fn exact_terms(f: &sunbeam_field::HeightField, basis: Basis, n: usize, fx: f64, 
             let (x, y) = (c as f64 * f.dx - cx, (my - 1 - r) as f64 * f.dy - cy);
             let g = (-(x * x + y * y) / (2.0 * sigma * sigma)).exp();
             sg += g;
-            let s = if hh > 0.0 { ((f.at(r, c) - hc) / hh).clamp(-1.0, 1.0) } else { 0.0 };
+            let s = if hh > 0.0 {
+                ((f.at(r, c) - hc) / hh).clamp(-1.0, 1.0)
+            } else {
+                0.0
+            };
             let ph = -2.0 * std::f64::consts::PI * (fx * x + fy * y);
             let (sn, cs) = ph.sin_cos();
             for (k, o) in out.iter_mut().enumerate() {
@@ -186,7 +220,11 @@ fn target4_series_alone_float64_meets_the_bound_up_to_t60() {
     let mut rng = Rng(4);
     for basis in BASES {
         // Taylor in float64 cancels catastrophically beyond |t| ~ 25 (terms e^|t|): PHYSICS.md 3.
-        let t_top = if basis == Basis::Chebyshev { 60.0 } else { 20.0 };
+        let t_top = if basis == Basis::Chebyshev {
+            60.0
+        } else {
+            20.0
+        };
         for &t_target in &[0.1, 1.0, 5.0, 9.0, 16.5, 30.0, 45.0, 60.0] {
             if t_target > t_top {
                 continue;
@@ -206,8 +244,14 @@ fn target4_series_alone_float64_meets_the_bound_up_to_t60() {
                     rel = rel.max((a - b).abs() / b);
                 }
             }
-            assert!(abs <= 1e-4, "{basis:?} |t| = {t_target}, N = {n}: max|dR| = {abs:e}");
-            assert!(rel <= 1e-3, "{basis:?} |t| = {t_target}, N = {n}: peak-relative {rel:e}");
+            assert!(
+                abs <= 1e-4,
+                "{basis:?} |t| = {t_target}, N = {n}: max|dR| = {abs:e}"
+            );
+            assert!(
+                rel <= 1e-3,
+                "{basis:?} |t| = {t_target}, N = {n}: peak-relative {rel:e}"
+            );
         }
     }
 }
@@ -221,7 +265,8 @@ fn target5_chebyshev_float32_matches_float64_and_taylor_float32_fails_at_t12() {
     let hh = (hi - lo) / 2.0;
     let mut rng = Rng(17);
     // Peak-relative error at |t| = 12: max |dR| / max R over the queries.
-    let (mut taylor_dr, mut taylor_peak, mut cheb_dr, mut cheb_peak) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut taylor_dr, mut taylor_peak, mut cheb_dr, mut cheb_peak) =
+        (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for &t_target in &[1.0, 5.0, 9.0, 12.0, 20.0, 30.0] {
         for basis in BASES {
             let n = series::terms_for_tolerance(basis, t_target, 1e-6);
@@ -229,13 +274,20 @@ fn target5_chebyshev_float32_matches_float64_and_taylor_float32_fails_at_t12() {
                 let l = rng.range(380e-9, 780e-9);
                 let w = -t_target * l / (2.0 * std::f64::consts::PI * hh);
                 let tt = 2.0 * std::f64::consts::PI / l * w * hh;
-                let (u, v) = if q == 0 { (0.0, 0.0) } else { (rng.range(-0.1, 0.1), rng.range(-0.1, 0.1)) };
+                let (u, v) = if q == 0 {
+                    (0.0, 0.0)
+                } else {
+                    (rng.range(-0.1, 0.1), rng.range(-0.1, 0.1))
+                };
                 let fnv = exact_terms(&f, basis, n, -u / l, -v / l);
                 let r64 = series_r(&series::coefficients_f64(basis, tt, n), &fnv);
                 let f32v: Vec<[f32; 2]> = fnv.iter().map(|v| [v[0] as f32, v[1] as f32]).collect();
                 let r32 = series_r32(&series::coefficients_f32(basis, tt as f32, n), &f32v) as f64;
                 if basis == Basis::Chebyshev {
-                    assert!((r32 - r64).abs() <= 1e-6, "Chebyshev f32 |t|={t_target}: {r32} vs {r64}");
+                    assert!(
+                        (r32 - r64).abs() <= 1e-6,
+                        "Chebyshev f32 |t|={t_target}: {r32} vs {r64}"
+                    );
                 }
                 if t_target == 12.0 {
                     let b = t.reflectance(u, v, w, l);
@@ -257,7 +309,10 @@ fn target5_chebyshev_float32_matches_float64_and_taylor_float32_fails_at_t12() {
     // (PHYSICS.md 3), where Chebyshev in float32 stays two orders of magnitude inside it.
     let (tr, cr) = (taylor_dr / taylor_peak, cheb_dr / cheb_peak);
     eprintln!("|t| = 12 float32 peak-relative: Taylor {tr:e}, Chebyshev {cr:e}");
-    assert!(tr > 1e-3, "Taylor float32 at |t| = 12 unexpectedly accurate: {tr:e}");
+    assert!(
+        tr > 1e-3,
+        "Taylor float32 at |t| = 12 unexpectedly accurate: {tr:e}"
+    );
     assert!(cr < 1e-5, "Chebyshev float32 at |t| = 12: {cr:e}");
 }
 
@@ -284,7 +339,10 @@ fn target6_end_to_end_at_random_off_grid_frequencies() {
             if b >= 1e-2 {
                 strong += 1;
                 let a = p.reflectance(u, v, w, l);
-                assert!((a - b).abs() / b <= 0.01, "{basis:?}: strong lobe {a} vs {b}");
+                assert!(
+                    (a - b).abs() / b <= 0.01,
+                    "{basis:?}: strong lobe {a} vs {b}"
+                );
             }
         }
         for &(w, l) in &[(-2.0, 380e-9), (-1.5, 550e-9), (-1.0, 700e-9)] {
@@ -293,7 +351,10 @@ fn target6_end_to_end_at_random_off_grid_frequencies() {
                 let (a, b) = (p.reflectance(u, 0.0, w, l), t.reflectance(u, 0.0, w, l));
                 if b >= 1e-2 {
                     strong += 1;
-                    assert!((a - b).abs() / b <= 0.01, "{basis:?}: near-specular {a} vs {b}");
+                    assert!(
+                        (a - b).abs() / b <= 0.01,
+                        "{basis:?}: near-specular {a} vs {b}"
+                    );
                 }
             }
         }
@@ -312,7 +373,9 @@ fn target6_end_to_end_at_random_off_grid_frequencies() {
 /// A sinusoidal grating along x with `periods` periods across the patch.
 fn grating(m: usize, dx: f64, periods: usize, amp: f64) -> (sunbeam_field::HeightField, f64) {
     let d = m as f64 * dx / periods as f64;
-    let f = field(m, m, dx, dx, |x, _| amp * (2.0 * std::f64::consts::PI * x / d).sin());
+    let f = field(m, m, dx, dx, |x, _| {
+        amp * (2.0 * std::f64::consts::PI * x / d).sin()
+    });
     (f, d)
 }
 
@@ -336,14 +399,17 @@ fn golden_max(mut a: f64, mut b: f64, g: impl Fn(f64) -> f64) -> f64 {
 fn peak_angle(pred: f64, win: f64, g: impl Fn(f64) -> f64) -> f64 {
     let step = 0.01f64.to_radians();
     let n = (2.0 * win / step) as usize;
-    let best = (0..=n).map(|i| pred - win + i as f64 * step).fold((pred, f64::NEG_INFINITY), |b, a| {
-        let v = g(a);
-        if v > b.1 {
-            (a, v)
-        } else {
-            b
-        }
-    });
+    let best =
+        (0..=n)
+            .map(|i| pred - win + i as f64 * step)
+            .fold((pred, f64::NEG_INFINITY), |b, a| {
+                let v = g(a);
+                if v > b.1 {
+                    (a, v)
+                } else {
+                    b
+                }
+            });
     golden_max(best.0 - step, best.0 + step, g)
 }
 
@@ -358,8 +424,14 @@ fn target7_grating_orders_angles_and_period() {
             let (w, l) = (-1.5, 500e-9);
             for m in [1i32, 2, -1] {
                 let f0 = m as f64 / d;
-                let fpk = golden_max(f0 - 0.3 / d, f0 + 0.3 / d, |fx| p.reflectance(-l * fx, 0.0, w, l));
-                assert!((fpk * d - m as f64).abs() < 0.01, "{basis:?} {model:?} order {m}: f d = {}", fpk * d);
+                let fpk = golden_max(f0 - 0.3 / d, f0 + 0.3 / d, |fx| {
+                    p.reflectance(-l * fx, 0.0, w, l)
+                });
+                assert!(
+                    (fpk * d - m as f64).abs() < 0.01,
+                    "{basis:?} {model:?} order {m}: f d = {}",
+                    fpk * d
+                );
             }
             // (b) thesis evaluation: incidence 75 deg in x-z, peak viewing angle of order 1 per wavelength.
             let th_i = 75f64.to_radians();
@@ -391,7 +463,10 @@ fn target7_grating_orders_angles_and_period() {
             // (c) the period from the peaks, as the thesis estimates it (its tiled model: sharp orders).
             if model == Model::Tiled {
                 let d_est = est.iter().sum::<f64>() / est.len() as f64;
-                assert!((d_est / d - 1.0).abs() < 0.005, "{basis:?}: period {d_est:e} vs {d:e}");
+                assert!(
+                    (d_est / d - 1.0).abs() < 0.005,
+                    "{basis:?}: period {d_est:e} vs {d:e}"
+                );
             }
         }
     }
@@ -427,8 +502,15 @@ fn target8_blazed_grating_sends_light_to_the_facets_side() {
                 best_t = (order, b);
             }
         }
-        assert!(best.0 < 0, "{basis:?}: brightest order {} should be on the -x side", best.0);
-        assert_eq!(best.0, best_t.0, "pack and truth disagree on the brightest order");
+        assert!(
+            best.0 < 0,
+            "{basis:?}: brightest order {} should be on the -x side",
+            best.0
+        );
+        assert_eq!(
+            best.0, best_t.0,
+            "pack and truth disagree on the brightest order"
+        );
     }
 }
 
@@ -455,8 +537,15 @@ fn target10_non_square_pixels_and_patches() {
     let (abs_sq, _) = compare(&p, &t_sq, &q, 1e-2);
     let mut resample = 0.0f64;
     for &(u, v, w, l) in &q {
-        resample = resample.max((t_ns.reflectance(u, v, w, l) - t_sq.reflectance(u, v, w, l)).abs());
+        resample =
+            resample.max((t_ns.reflectance(u, v, w, l) - t_sq.reflectance(u, v, w, l)).abs());
     }
-    assert!(abs_sq <= resample + 1e-3, "non-square vs square: {abs_sq:e} (resampling {resample:e})");
-    assert!(resample < 2e-2, "resampling error unexpectedly large: {resample:e}");
+    assert!(
+        abs_sq <= resample + 1e-3,
+        "non-square vs square: {abs_sq:e} (resampling {resample:e})"
+    );
+    assert!(
+        resample < 2e-2,
+        "resampling error unexpectedly large: {resample:e}"
+    );
 }

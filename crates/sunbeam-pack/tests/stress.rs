@@ -29,7 +29,11 @@ fn t_from_0_1_to_60() {
         assert!((p.manifest.t_max - t_max).abs() < 1e-6 * t_max.max(1.0));
         assert!(p.terms.iter().all(|v| v.is_finite()));
         let worst = check_vs_truth(&f, &p, 60, 5);
-        assert!(worst <= 1e-3, "|t| = {t_max}: N = {}, max|dR| = {worst:e}", p.manifest.terms);
+        assert!(
+            worst <= 1e-3,
+            "|t| = {t_max}: N = {}, max|dR| = {worst:e}",
+            p.manifest.terms
+        );
     }
 }
 
@@ -67,7 +71,13 @@ fn thin_fields_3x1000_and_1000x3() {
 fn non_square_pixels_both_bases() {
     let f = rough(30, 24, 15e-9, 27e-9, 300e-9, 31);
     for basis in [Basis::Chebyshev, Basis::Taylor] {
-        let p = build(&f, &BuildOptions { basis, ..BuildOptions::default() });
+        let p = build(
+            &f,
+            &BuildOptions {
+                basis,
+                ..BuildOptions::default()
+            },
+        );
         let worst = check_vs_truth(&f, &p, 80, 2);
         assert!(worst <= 1e-3, "{basis:?}: {worst:e}");
     }
@@ -77,7 +87,13 @@ fn non_square_pixels_both_bases() {
 fn nan_heights_are_refused_with_a_fix() {
     let mut f = rough(8, 8, 25e-9, 25e-9, 100e-9, 1);
     f.data[10] = f64::NAN;
-    let fr = FieldRef { width: 8, height: 8, dx: f.dx, dy: f.dy, data: &f.data };
+    let fr = FieldRef {
+        width: 8,
+        height: 8,
+        dx: f.dx,
+        dy: f.dy,
+        data: &f.data,
+    };
     let e = sunbeam_pack::build(fr, &BuildOptions::default(), &mut |_, _| {}).unwrap_err();
     assert_eq!(e.exit_code(), 2);
     assert!(e.message.contains("--fill-nonfinite"), "{}", e.message);
@@ -125,4 +141,26 @@ fn hostile_headers_are_refused_without_allocating() {
     let mut e = vec![0x76, 0x2f, 0x31, 0x01];
     e.extend(std::iter::repeat_n(0xffu8, 64));
     assert!(Pack::from_bytes(&e).is_err());
+}
+
+#[test]
+fn tiled_model_on_a_large_patch_with_a_wide_gaussian() {
+    // L = 61 um: sigma_f L ~ 0.6 bins, so the Gaussian spans several bins (more taps).
+    let f = rough(244, 244, 250e-9, 250e-9, 150e-9, 77);
+    let o = BuildOptions { model: sunbeam_pack::Model::Tiled, ..BuildOptions::default() };
+    let p = build(&f, &o);
+    assert!(p.manifest.kernel.taps >= 8, "taps {}", p.manifest.kernel.taps);
+    let t = Truth::new(&f, &Params { model: sunbeam_optics::truth::Model::Tiled, coherence_m: 65e-6 }).unwrap();
+    let mut rng = Rng(12);
+    let mut worst = 0.0f64;
+    for i in 0..60 {
+        let (u, v, w, l) = if i < 20 {
+            // near specular, where the strong low orders are
+            (rng.range(-0.02, 0.02), rng.range(-0.02, 0.02), -1.8, rng.range(380e-9, 780e-9))
+        } else {
+            random_query(&mut rng, 80.0)
+        };
+        worst = worst.max((p.reflectance(u, v, w, l) - t.reflectance(u, v, w, l)).abs());
+    }
+    assert!(worst <= 1e-3, "tiled large patch: {worst:e}");
 }

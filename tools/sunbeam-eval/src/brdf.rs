@@ -50,8 +50,14 @@ pub fn run(pack: &Pack, o: &Options, out: &Path) -> Result<Outcome> {
             0.0
         }
     });
-    let tm = ToneMap { exposure_ev: ev, curve: o.tone.curve };
-    let img: Vec<Option<[u8; 3]>> = px.iter().map(|c| c.map(|xyz| colour::xyz_to_srgb8(xyz, &tm))).collect();
+    let tm = ToneMap {
+        exposure_ev: ev,
+        curve: o.tone.curve,
+    };
+    let img: Vec<Option<[u8; 3]>> = px
+        .iter()
+        .map(|c| c.map(|xyz| colour::xyz_to_srgb8(xyz, &tm)))
+        .collect();
 
     // Right panel: R over (theta_r, lambda) in the plane of incidence.
     let (lt, lp) = (o.light[2].acos(), o.light[1].atan2(o.light[0]));
@@ -72,7 +78,10 @@ pub fn run(pack: &Pack, o: &Options, out: &Path) -> Result<Outcome> {
     png(out, 1300, 640, |root| {
         let (left, right) = root.split_horizontally(620);
         let mut c1 = ChartBuilder::on(&left)
-            .caption(format!("{}: colour over view directions", o.title), ("sans-serif", 18))
+            .caption(
+                format!("{}: colour over view directions", o.title),
+                ("sans-serif", 18),
+            )
             .margin(12)
             .x_label_area_size(44)
             .y_label_area_size(54)
@@ -90,17 +99,27 @@ pub fn run(pack: &Pack, o: &Options, out: &Path) -> Result<Outcome> {
             let (i, j) = (k % n, k / n);
             let x = -1.0 + i as f64 * d;
             let y = 1.0 - (j + 1) as f64 * d;
-            let col = c.map(|c| RGBColor(c[0], c[1], c[2])).unwrap_or(RGBColor(40, 40, 40));
+            let col = c
+                .map(|c| RGBColor(c[0], c[1], c[2]))
+                .unwrap_or(RGBColor(40, 40, 40));
             Rectangle::new([(x, y), (x + d, y + d)], col.filled())
         }))
         .map_err(perr)?;
         // Light's mirror direction.
-        c1.draw_series(std::iter::once(Circle::new((-o.light[0], -o.light[1]), 6, WHITE.stroke_width(2))))
-            .map_err(perr)?
-            .label(format!("specular direction (light {:.0} deg, exposure {:+.2} EV)", lt.to_degrees(), ev))
-            .legend(|(x, y)| Circle::new((x + 8, y), 5, BLACK.stroke_width(2)));
+        c1.draw_series(std::iter::once(Circle::new(
+            (-o.light[0], -o.light[1]),
+            6,
+            WHITE.stroke_width(2),
+        )))
+        .map_err(perr)?
+        .label(format!(
+            "specular direction (light {:.0} deg, exposure {:+.2} EV)",
+            lt.to_degrees(),
+            ev
+        ))
+        .legend(|(x, y)| Circle::new((x + 8, y), 5, BLACK.stroke_width(2)));
         c1.configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
+            .position(SeriesLabelPosition::UpperLeft)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 13))
@@ -145,5 +164,8 @@ pub fn run(pack: &Pack, o: &Options, out: &Path) -> Result<Outcome> {
             .map_err(perr)?;
         Ok(())
     })?;
-    Ok(Outcome { exposure_ev: ev, max_y })
+    Ok(Outcome {
+        exposure_ev: ev,
+        max_y,
+    })
 }

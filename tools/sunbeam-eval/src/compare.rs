@@ -41,9 +41,18 @@ pub fn spectral(pack: &Pack, truth: &Truth, n: usize, seed: u64) -> SpectralErro
 pub fn spectral_at(pack: &Pack, truth: &Truth, pts: &[[f64; 4]]) -> SpectralError {
     let res = par_map(pts.len(), |i| {
         let p = pts[i];
-        (pack.reflectance(p[0], p[1], p[2], p[3]), truth.reflectance(p[0], p[1], p[2], p[3]))
+        (
+            pack.reflectance(p[0], p[1], p[2], p[3]),
+            truth.reflectance(p[0], p[1], p[2], p[3]),
+        )
     });
-    let mut e = SpectralError { points: pts.len(), max_abs: 0.0, peak_relative: 0.0, strong_relative: 0.0, worst: [0.0; 4] };
+    let mut e = SpectralError {
+        points: pts.len(),
+        max_abs: 0.0,
+        peak_relative: 0.0,
+        strong_relative: 0.0,
+        worst: [0.0; 4],
+    };
     for (p, (a, t)) in pts.iter().zip(res) {
         let d = (a - t).abs();
         if d > e.max_abs || !d.is_finite() {
@@ -61,6 +70,7 @@ pub fn spectral_at(pack: &Pack, truth: &Truth, pts: &[[f64; 4]]) -> SpectralErro
 }
 
 #[derive(Debug, Clone)]
+#[allow(dead_code)]
 pub struct ColourError {
     pub light: [f64; 3],
     pub views: usize,
@@ -73,9 +83,24 @@ pub struct ColourError {
 /// What a viewer sees: XYZ scaled by the exposure, through the display
 /// transform's clamp (linear sRGB clipped to [0, 1]), back to XYZ.
 pub fn displayed_xyz(xyz: [f64; 3], scale: f64) -> [f64; 3] {
-    let tm = ToneMap { exposure_ev: 0.0, curve: ToneCurve::Clamp };
+    let tm = ToneMap {
+        exposure_ev: 0.0,
+        curve: ToneCurve::Clamp,
+    };
     let rgb = colour::xyz_to_linear_srgb(xyz.map(|c| c * scale)).map(|c| tm.apply(c));
     colour::linear_srgb_to_xyz(rgb)
+}
+
+/// The true colours (1 nm, with G) for `views` view directions and one light.
+pub fn truth_colours(truth: &Truth, pack: &Pack, light: [f64; 3], views: usize) -> Vec<[f64; 3]> {
+    let dirs = fibonacci_hemisphere(views, 0.05);
+    let range = (
+        (pack.manifest.lambda_min_m * 1e9).round() as u32,
+        (pack.manifest.lambda_max_m * 1e9).round() as u32,
+    );
+    par_map(dirs.len(), |i| {
+        truth.colour_xyz_with(light, dirs[i], range, sunbeam_optics::gain::DEFAULT_IOR)
+    })
 }
 
 /// CIEDE2000 between the pack's colour (`lambda_samples` samples) and the 1 nm
@@ -89,18 +114,24 @@ pub fn colour(
     lambda_samples: usize,
     exposure_scale: Option<f64>,
 ) -> ColourError {
+    let t = truth_colours(truth, pack, light, views);
+    colour_vs(pack, &t, light, lambda_samples, exposure_scale)
+}
+
+/// [`colour`] against precomputed true colours (from [`truth_colours`], same light and view count).
+pub fn colour_vs(
+    pack: &Pack,
+    truth_xyz: &[[f64; 3]],
+    light: [f64; 3],
+    lambda_samples: usize,
+    exposure_scale: Option<f64>,
+) -> ColourError {
+    let views = truth_xyz.len();
     let dirs = fibonacci_hemisphere(views, 0.05);
-    let pairs = par_map(dirs.len(), |i| {
-        let wr = dirs[i];
-        let t = truth.colour_xyz_with(
-            light,
-            wr,
-            ((pack.manifest.lambda_min_m * 1e9).round() as u32, (pack.manifest.lambda_max_m * 1e9).round() as u32),
-            sunbeam_optics::gain::DEFAULT_IOR,
-        );
-        (pack.colour_xyz(light, wr, lambda_samples), t)
+    let approx = par_map(dirs.len(), |i| {
+        pack.colour_xyz(light, dirs[i], lambda_samples)
     });
-    let ys: Vec<f64> = pairs.iter().map(|p| p.1[1]).collect();
+    let ys: Vec<f64> = truth_xyz.iter().map(|c| c[1]).collect();
     let scale = exposure_scale.unwrap_or_else(|| {
         let p = percentile(&ys, 95.0);
         if p > 0.0 && p.is_finite() {
@@ -109,8 +140,9 @@ pub fn colour(
             1.0
         }
     });
-    let des: Vec<f64> = pairs
+    let des: Vec<f64> = approx
         .iter()
+        .zip(truth_xyz)
         .map(|(a, t)| colour::ciede2000_xyz(displayed_xyz(*a, scale), displayed_xyz(*t, scale)))
         .collect();
     ColourError {

@@ -63,19 +63,27 @@ fn r_at(src: &Source, o: &Options, lambda: f64, theta_r: f64) -> f64 {
 
 pub fn run(src: &Source, o: &Options) -> Result<Outcome> {
     if !(o.theta_i.abs() < 89.9f64.to_radians()) {
-        return Err(Error::usage("--theta-i must be within (-89.9, 89.9) degrees"));
+        return Err(Error::usage(
+            "--theta-i must be within (-89.9, 89.9) degrees",
+        ));
     }
     if !(o.lambda_step > 0.0 && o.angle_step > 0.0 && o.angle_step <= 5f64.to_radians()) {
-        return Err(Error::usage("--lambda-step must be positive and --angle-step in (0, 5] degrees"));
+        return Err(Error::usage(
+            "--lambda-step must be positive and --angle-step in (0, 5] degrees",
+        ));
     }
     if o.order == 0 {
-        return Err(Error::usage("--order must not be 0 (the specular order has no period)"));
+        return Err(Error::usage(
+            "--order must not be 0 (the specular order has no period)",
+        ));
     }
     let nl = ((o.lambda_max - o.lambda_min) / o.lambda_step + 1e-9).floor() as usize + 1;
     if nl > 100_000 {
         return Err(Error::usage("too many wavelengths (check --lambda-step)"));
     }
-    let lambdas: Vec<f64> = (0..nl).map(|i| o.lambda_min + i as f64 * o.lambda_step).collect();
+    let lambdas: Vec<f64> = (0..nl)
+        .map(|i| o.lambda_min + i as f64 * o.lambda_step)
+        .collect();
     let lim = 89.5f64.to_radians();
     let na = ((2.0 * lim) / o.angle_step).floor() as usize + 1;
     let angles: Vec<f64> = (0..na).map(|j| -lim + j as f64 * o.angle_step).collect();
@@ -129,8 +137,17 @@ pub fn run(src: &Source, o: &Options) -> Result<Outcome> {
         }
         let th = 0.5 * (a + b);
         let r = r_at(src, o, l, th);
-        let (th, r) = if r >= row[j] { (th, r) } else { (angles[j], row[j]) };
-        Some(Peak { lambda_m: l, theta_r_deg: th.to_degrees(), r, f: (si + th.sin()) / l })
+        let (th, r) = if r >= row[j] {
+            (th, r)
+        } else {
+            (angles[j], row[j])
+        };
+        Some(Peak {
+            lambda_m: l,
+            theta_r_deg: th.to_degrees(),
+            r,
+            f: (si + th.sin()) / l,
+        })
     });
     let peaks: Vec<Peak> = peaks.into_iter().flatten().collect();
     if peaks.is_empty() {

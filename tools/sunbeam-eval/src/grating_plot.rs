@@ -7,10 +7,21 @@ use plotters::prelude::*;
 use std::path::Path;
 use sunbeam_common::Result;
 
-pub fn draw(path: &Path, out: &Outcome, theta_i: f64, order: i32, title: &str, true_period: Option<f64>) -> Result<()> {
+pub fn draw(
+    path: &Path,
+    out: &Outcome,
+    theta_i: f64,
+    order: i32,
+    title: &str,
+    true_period: Option<f64>,
+) -> Result<()> {
     let lmin = out.lambdas[0] * 1e9;
     let lmax = *out.lambdas.last().unwrap_or(&out.lambdas[0]) * 1e9;
-    let dl = if out.lambdas.len() > 1 { (out.lambdas[1] - out.lambdas[0]) * 1e9 } else { 10.0 };
+    let dl = if out.lambdas.len() > 1 {
+        (out.lambdas[1] - out.lambdas[0]) * 1e9
+    } else {
+        10.0
+    };
     let (y0, y1) = (lmin - 0.5 * dl, lmax + 0.5 * dl);
     // Angle range: around the peaks and the specular direction, rounded to 5 degrees.
     let spec = -theta_i.to_degrees();
@@ -41,12 +52,21 @@ pub fn draw(path: &Path, out: &Outcome, theta_i: f64, order: i32, title: &str, t
             .draw()
             .map_err(perr)?;
         // Heat map: R per wavelength normalised by the peak R of that row (square-root scale).
-        let da = if out.angles_deg.len() > 1 { out.angles_deg[1] - out.angles_deg[0] } else { 0.1 };
+        let da = if out.angles_deg.len() > 1 {
+            out.angles_deg[1] - out.angles_deg[0]
+        } else {
+            0.1
+        };
         let bin = (0.25f64).max(da);
         let mut cells = Vec::new();
         for (li, row) in out.response.iter().enumerate() {
             let lam = out.lambdas[li] * 1e9;
-            let norm = out.peaks.iter().find(|p| (p.lambda_m * 1e9 - lam).abs() < 1e-6).map(|p| p.r).unwrap_or(0.0);
+            let norm = out
+                .peaks
+                .iter()
+                .find(|p| (p.lambda_m * 1e9 - lam).abs() < 1e-6)
+                .map(|p| p.r)
+                .unwrap_or(0.0);
             if norm <= 0.0 {
                 continue;
             }
@@ -84,18 +104,25 @@ pub fn draw(path: &Path, out: &Outcome, theta_i: f64, order: i32, title: &str, t
         chart
             .draw_series(LineSeries::new(curve(est), RED.stroke_width(3)))
             .map_err(perr)?
-            .label(format!("grating equation, m = {order}, d = {:.2} nm (estimated)", est * 1e9))
+            .label(format!(
+                "grating equation, m = {order}, d = {:.2} nm (estimated)",
+                est * 1e9
+            ))
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], RED.stroke_width(3)));
         if let Some(d) = true_period {
             chart
                 .draw_series(DashedLineSeries::new(curve(d), 8, 6, WHITE.stroke_width(2)))
                 .map_err(perr)?
                 .label(format!("grating equation, d = {:.2} nm (true)", d * 1e9))
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(2)));
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(2))
+                });
         }
         chart
             .draw_series(
-                out.peaks.iter().map(|p| Cross::new((p.theta_r_deg, p.lambda_m * 1e9), 6, WHITE.stroke_width(2))),
+                out.peaks.iter().map(|p| {
+                    Cross::new((p.theta_r_deg, p.lambda_m * 1e9), 6, WHITE.stroke_width(2))
+                }),
             )
             .map_err(perr)?
             .label("peak of R per wavelength")

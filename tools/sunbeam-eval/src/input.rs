@@ -25,7 +25,10 @@ impl HeightArgs {
         let mut o = sunbeam_afm::ReadOptions::default();
         if let Some(s) = &self.pixel_size {
             let (a, b) = match s.split_once(',') {
-                Some((a, b)) => (units::parse_positive_length(a)?, units::parse_positive_length(b)?),
+                Some((a, b)) => (
+                    units::parse_positive_length(a)?,
+                    units::parse_positive_length(b)?,
+                ),
                 None => {
                     let a = units::parse_positive_length(s)?;
                     (a, a)
@@ -43,7 +46,8 @@ impl HeightArgs {
 /// A KTX2 file, or an EXR whose header carries the `sunbeam.manifest` attribute.
 pub fn is_pack(path: &Path) -> Result<bool> {
     use std::io::Read;
-    let mut f = std::fs::File::open(path).map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
+    let mut f = std::fs::File::open(path)
+        .map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
     let mut head = Vec::with_capacity(1 << 16);
     f.by_ref()
         .take(1 << 16)
@@ -62,13 +66,15 @@ pub fn is_pack(path: &Path) -> Result<bool> {
 /// Read a height field in metres: EXR height fields through sunbeam-field,
 /// everything else through sunbeam-afm.
 pub fn read_height(path: &Path, args: &HeightArgs) -> Result<HeightField> {
-    let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
     if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
         return sunbeam_field::io::read(path);
     }
     let opts = args.read_options()?;
     let chans = sunbeam_afm::read_bytes(&bytes, &opts).map_err(|e| e.context(path.display()))?;
-    let ch = sunbeam_afm::select_channel(&chans, args.channel.as_deref()).map_err(|e| e.context(path.display()))?;
+    let ch = sunbeam_afm::select_channel(&chans, args.channel.as_deref())
+        .map_err(|e| e.context(path.display()))?;
     if ch.z_unit != "m" {
         return Err(Error::input_file(
             path,
@@ -81,11 +87,17 @@ pub fn read_height(path: &Path, args: &HeightArgs) -> Result<HeightField> {
     if ch.xy_unit != "m" {
         return Err(Error::input_file(
             path,
-            format!("channel '{}' has no lateral calibration (give --pixel-size)", ch.name),
+            format!(
+                "channel '{}' has no lateral calibration (give --pixel-size)",
+                ch.name
+            ),
         ));
     }
     let mut f = ch.field.clone();
-    f.provenance.source_file = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    f.provenance.source_file = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     Ok(f)
 }
 

@@ -21,7 +21,11 @@ use std::path::PathBuf;
 use sunbeam_common::{units, Error, Result};
 
 #[derive(Parser)]
-#[command(name = "sunbeam-eval", version, about = "Ground truth, errors, grating check and BRDF pictures for Sunbeam packs")]
+#[command(
+    name = "sunbeam-eval",
+    version,
+    about = "Ground truth, errors, grating check and BRDF pictures for Sunbeam packs"
+)]
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
@@ -221,9 +225,16 @@ fn main() {
             Cmd::Brdf(a) => brdf_cmd(a),
             Cmd::Bench(a) => {
                 let snake = a.snake.clone().or_else(|| {
-                    sunbeam_common::testdata::shared_data().map(|d| d.join("snake")).filter(|d| d.is_dir())
+                    sunbeam_common::testdata::shared_data()
+                        .map(|d| d.join("snake"))
+                        .filter(|d| d.is_dir())
                 });
-                bench::run(&bench::Options { snake_dir: snake, out_dir: a.output, points: a.points.max(10), quick: a.quick })
+                bench::run(&bench::Options {
+                    snake_dir: snake,
+                    out_dir: a.output,
+                    points: a.points.max(10),
+                    quick: a.quick,
+                })
             }
             Cmd::Render(a) => render::run(&a),
         }
@@ -236,8 +247,16 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
     let (lmin, lmax) = units::parse_length_range(&a.lambda)?;
     let lstep = units::parse_positive_length(&a.lambda_step)?;
     let astep = units::parse_angle(&a.angle_step)?;
-    let max_period = a.max_period.as_deref().map(units::parse_positive_length).transpose()?;
-    let true_period = a.true_period.as_deref().map(units::parse_positive_length).transpose()?;
+    let max_period = a
+        .max_period
+        .as_deref()
+        .map(units::parse_positive_length)
+        .transpose()?;
+    let true_period = a
+        .true_period
+        .as_deref()
+        .map(units::parse_positive_length)
+        .transpose()?;
     let params = a.model.params()?;
     let src = if input::is_pack(&a.input)? {
         if a.tile.is_some() {
@@ -267,12 +286,19 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
         let mut s = String::from("lambda_m,theta_r_deg,R\n");
         for (li, row) in out.response.iter().enumerate() {
             for (j, r) in row.iter().enumerate() {
-                s.push_str(&format!("{:e},{},{:e}\n", out.lambdas[li], out.angles_deg[j], r));
+                s.push_str(&format!(
+                    "{:e},{},{:e}\n",
+                    out.lambdas[li], out.angles_deg[j], r
+                ));
             }
         }
         sunbeam_common::output::write_atomic(p, s.as_bytes())?;
     }
-    let name = a.input.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = a
+        .input
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     if let Some(p) = &a.plot {
         let title = format!(
             "{name}: {} {} model, theta_i = {:.1} deg: d = {:.2} nm",
@@ -320,14 +346,22 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
 fn compare_cmd(a: CompareArgs) -> Result<()> {
     use sunbeam_optics::truth::{Model, Params, Truth};
     if a.points == 0 || a.views == 0 || a.lambda_samples == 0 {
-        return Err(Error::usage("--points, --views and --lambda-samples must be positive"));
+        return Err(Error::usage(
+            "--points, --views and --lambda-samples must be positive",
+        ));
     }
     let mut lights = Vec::new();
     for l in &a.light {
         lights.push(sample::parse_light(l)?);
     }
     if lights.is_empty() {
-        for (t, p) in [(0.0, 0.0), (30.0, 0.0), (60.0, 0.0), (75.0, 0.0), (60.0, 90.0)] {
+        for (t, p) in [
+            (0.0, 0.0),
+            (30.0, 0.0),
+            (60.0, 0.0),
+            (75.0, 0.0),
+            (60.0, 90.0),
+        ] {
             lights.push(sample::dir(f64::to_radians(t), f64::to_radians(p)));
         }
     }
@@ -347,10 +381,19 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         sunbeam_pack::Model::Window => Model::Window,
         sunbeam_pack::Model::Tiled => Model::Tiled,
     };
-    let truth = Truth::new(&field, &Params { model, coherence_m: m.coherence_m }).map_err(|e| e.context(a.height.display()))?;
+    let truth = Truth::new(
+        &field,
+        &Params {
+            model,
+            coherence_m: m.coherence_m,
+        },
+    )
+    .map_err(|e| e.context(a.height.display()))?;
     let spec = compare::spectral(&pack, &truth, a.points, 1);
-    let cols: Vec<compare::ColourError> =
-        lights.iter().map(|l| compare::colour(&pack, &truth, *l, a.views, a.lambda_samples, None)).collect();
+    let cols: Vec<compare::ColourError> = lights
+        .iter()
+        .map(|l| compare::colour(&pack, &truth, *l, a.views, a.lambda_samples, None))
+        .collect();
     let mean = cols.iter().map(|c| c.mean).sum::<f64>() / cols.len() as f64;
     let p99 = cols.iter().map(|c| c.p99).fold(0.0, f64::max);
     let pass = spec.max_abs <= a.tolerance && p99 <= a.de_tolerance;
@@ -414,22 +457,34 @@ fn brdf_cmd(a: BrdfArgs) -> Result<()> {
     use sunbeam_optics::colour::{ToneCurve, ToneMap};
     let light = sample::parse_light(&a.light)?;
     if !(16..=2048).contains(&a.size) || a.lambda_samples == 0 {
-        return Err(Error::usage("--size must be 16..2048 and --lambda-samples positive"));
+        return Err(Error::usage(
+            "--size must be 16..2048 and --lambda-samples positive",
+        ));
     }
     let curve: ToneCurve = a.tone.parse()?;
     let pack = sunbeam_pack::Pack::read(&a.pack)?;
-    let title = a.pack.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let title = a
+        .pack
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let o = brdf::Options {
         light,
         size: a.size,
         lambda_samples: a.lambda_samples,
         exposure_ev: a.exposure,
-        tone: ToneMap { exposure_ev: 0.0, curve },
+        tone: ToneMap {
+            exposure_ev: 0.0,
+            curve,
+        },
         title,
     };
     let out = brdf::run(&pack, &o, &a.output)?;
     if a.json {
-        println!("{}", json!({"output": a.output.display().to_string(), "exposure_ev": out.exposure_ev, "max_y": out.max_y}));
+        println!(
+            "{}",
+            json!({"output": a.output.display().to_string(), "exposure_ev": out.exposure_ev, "max_y": out.max_y})
+        );
     }
     Ok(())
 }

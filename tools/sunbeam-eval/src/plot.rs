@@ -11,7 +11,12 @@ static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
-        for style in [FontStyle::Normal, FontStyle::Bold, FontStyle::Italic, FontStyle::Oblique] {
+        for style in [
+            FontStyle::Normal,
+            FontStyle::Bold,
+            FontStyle::Italic,
+            FontStyle::Oblique,
+        ] {
             let _ = plotters::style::register_font("sans-serif", style, FONT);
         }
     });
@@ -44,8 +49,11 @@ pub fn write_rgb_png(path: &Path, w: u32, h: u32, rgb: &[u8]) -> Result<()> {
         let mut enc = png::Encoder::new(&mut bytes, w, h);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
-        let mut wr = enc.write_header().map_err(|e| Error::output_file(path, e))?;
-        wr.write_image_data(rgb).map_err(|e| Error::output_file(path, e))?;
+        let mut wr = enc
+            .write_header()
+            .map_err(|e| Error::output_file(path, e))?;
+        wr.write_image_data(rgb)
+            .map_err(|e| Error::output_file(path, e))?;
     }
     output::write_atomic(path, &bytes)
 }
@@ -59,7 +67,11 @@ pub fn viridis(t: f64) -> RGBColor {
         (94.0, 201.0, 98.0),
         (253.0, 231.0, 37.0),
     ];
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 } * 4.0;
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    } * 4.0;
     let i = (t.floor() as usize).min(3);
     let f = t - i as f64;
     let (a, b) = (S[i], S[i + 1]);

@@ -16,8 +16,10 @@ pub fn parse_points(path: &Path, text: &str) -> Result<Vec<[f64; 4]>> {
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let fields: Vec<&str> =
-            line.split(|c: char| c == ',' || c.is_whitespace()).filter(|s| !s.is_empty()).collect();
+        let fields: Vec<&str> = line
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty())
+            .collect();
         let was_first = first;
         first = false;
         if was_first && fields.first().is_some_and(|s| s.parse::<f64>().is_err()) {
@@ -26,23 +28,37 @@ pub fn parse_points(path: &Path, text: &str) -> Result<Vec<[f64; 4]>> {
         if fields.len() != 4 {
             return Err(Error::input_file(
                 path,
-                format!("line {}: expected 4 values u,v,w,lambda_m, found {}", ln + 1, fields.len()),
+                format!(
+                    "line {}: expected 4 values u,v,w,lambda_m, found {}",
+                    ln + 1,
+                    fields.len()
+                ),
             ));
         }
         let mut p = [0.0; 4];
         for (i, (s, name)) in fields.iter().zip(["u", "v", "w", "lambda_m"]).enumerate() {
-            let v: f64 = s
-                .parse()
-                .map_err(|_| Error::input_file(path, format!("line {}: {name} '{s}' is not a number", ln + 1)))?;
+            let v: f64 = s.parse().map_err(|_| {
+                Error::input_file(
+                    path,
+                    format!("line {}: {name} '{s}' is not a number", ln + 1),
+                )
+            })?;
             if !v.is_finite() {
-                return Err(Error::input_file(path, format!("line {}: {name} is not finite", ln + 1)));
+                return Err(Error::input_file(
+                    path,
+                    format!("line {}: {name} is not finite", ln + 1),
+                ));
             }
             p[i] = v;
         }
         if p[3] <= 0.0 || p[3] > 1e-3 {
             return Err(Error::input_file(
                 path,
-                format!("line {}: lambda_m = {} is not a wavelength in metres", ln + 1, p[3]),
+                format!(
+                    "line {}: lambda_m = {} is not a wavelength in metres",
+                    ln + 1,
+                    p[3]
+                ),
             ));
         }
         pts.push(p);
@@ -64,6 +80,7 @@ pub fn run(src: &Source, points_path: &Path) -> Result<()> {
     }
     let stdout = std::io::stdout();
     let mut lock = stdout.lock();
-    lock.write_all(out.as_bytes()).map_err(|e| Error::output(format!("stdout: {e}")))?;
+    lock.write_all(out.as_bytes())
+        .map_err(|e| Error::output(format!("stdout: {e}")))?;
     Ok(())
 }

@@ -38,7 +38,11 @@ pub fn fibonacci_hemisphere(n: usize, min_cos: f64) -> Vec<[f64; 3]> {
 
 /// A light direction from polar angle and azimuth (radians).
 pub fn dir(theta: f64, phi: f64) -> [f64; 3] {
-    [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
+    [
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+        theta.cos(),
+    ]
 }
 
 /// Parse `THETA[,PHI]` (angles with units, e.g. `60deg,90deg`).
@@ -48,7 +52,9 @@ pub fn parse_light(s: &str) -> sunbeam_common::Result<[f64; 3]> {
     let th = units::parse_angle(a)?;
     let ph = units::parse_angle(b)?;
     if !(0.0..89.9f64.to_radians()).contains(&th.abs()) {
-        return Err(Error::usage(format!("--light '{s}': polar angle must be in [0, 89.9) degrees")));
+        return Err(Error::usage(format!(
+            "--light '{s}': polar angle must be in [0, 89.9) degrees"
+        )));
     }
     Ok(dir(th.abs(), ph))
 }

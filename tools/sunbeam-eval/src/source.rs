@@ -35,7 +35,12 @@ pub enum Source {
 impl Source {
     /// Open `path` as a pack (KTX2, or EXR with a manifest) unless `force_truth`,
     /// else as a height field with its ground truth.
-    pub fn open(path: &Path, heights: &HeightArgs, truth: &TruthArgs, force_truth: bool) -> Result<Source> {
+    pub fn open(
+        path: &Path,
+        heights: &HeightArgs,
+        truth: &TruthArgs,
+        force_truth: bool,
+    ) -> Result<Source> {
         let params = truth.params()?;
         if input::is_pack(path)? {
             if force_truth {
@@ -103,7 +108,10 @@ impl Source {
 
 /// Evaluate `f(i)` for `i in 0..n` on all cores, in order (deterministic).
 pub fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).clamp(1, 64);
+    let threads = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .clamp(1, 64);
     if threads == 1 || n < 2 {
         return (0..n).map(f).collect();
     }
@@ -126,7 +134,10 @@ pub fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
                 })
             })
             .collect();
-        handles.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_default())
+            .collect()
     });
     parts.sort_by_key(|p| p.0);
     parts.into_iter().flat_map(|p| p.1).collect()

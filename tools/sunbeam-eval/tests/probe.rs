@@ -48,7 +48,10 @@ fn reference(
                         let (x, y) = pos(r, c);
                         // DFT over sample indices (x/dx, y/dy).
                         let a = k * ww * z[r * w + c]
-                            - 2.0 * PI * (bx as f64 * (x / dx).round() / w as f64 + by as f64 * (y / dy).round() / h as f64);
+                            - 2.0
+                                * PI
+                                * (bx as f64 * (x / dx).round() / w as f64
+                                    + by as f64 * (y / dy).round() / h as f64);
                         re += a.cos();
                         im += a.sin();
                     }
@@ -66,14 +69,21 @@ fn probe_truth_matches_independent_sum() {
     let dir = tmpdir("probe");
     let (w, h, dx, dy) = (7usize, 5usize, 60e-9, 80e-9);
     // Deterministic rough heights, 0..450 nm.
-    let z: Vec<f64> = (0..w * h).map(|i| 450e-9 * (((i * 7919 + 13) % 97) as f64 / 96.0)).collect();
+    let z: Vec<f64> = (0..w * h)
+        .map(|i| 450e-9 * (((i * 7919 + 13) % 97) as f64 / 96.0))
+        .collect();
     let field = dir.join("tiny.txt");
     write_ascii(&field, w, h, &z);
     let mut pts = String::from("# probe points\nu,v,w,lambda_m\n");
     let mut q = Vec::new();
     for i in 0..40 {
         let t = i as f64 * 0.37;
-        let p = [0.9 * t.sin(), 0.7 * (1.3 * t).cos(), -0.1 - 1.8 * (0.5 + 0.5 * (0.7 * t).sin()), 380e-9 + 10e-9 * i as f64];
+        let p = [
+            0.9 * t.sin(),
+            0.7 * (1.3 * t).cos(),
+            -0.1 - 1.8 * (0.5 + 0.5 * (0.7 * t).sin()),
+            380e-9 + 10e-9 * i as f64,
+        ];
         pts.push_str(&format!("{:e},{:e},{:e},{:e}\n", p[0], p[1], p[2], p[3]));
         q.push(p);
     }
@@ -116,14 +126,28 @@ fn probe_bad_points_exit_2() {
     write_ascii(&field, 2, 2, &[0.0, 1e-7, 2e-7, 0.0]);
     let pts = dir.join("p.csv");
     std::fs::write(&pts, "0,0,-1,5e-7\n0,0,-1\n").unwrap();
-    let o = run(&["probe", field.to_str().unwrap(), "--points", pts.to_str().unwrap(), "--pixel-size", "50nm"]);
+    let o = run(&[
+        "probe",
+        field.to_str().unwrap(),
+        "--points",
+        pts.to_str().unwrap(),
+        "--pixel-size",
+        "50nm",
+    ]);
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("p.csv") && e.contains("line 2"), "{e}");
     assert!(o.stdout.is_empty());
     // A missing pixel size for an uncalibrated matrix is refused clearly.
     std::fs::write(&pts, "0,0,-1,5e-7\n").unwrap();
-    let o = run(&["probe", field.to_str().unwrap(), "--points", pts.to_str().unwrap(), "--model", "bogus"]);
+    let o = run(&[
+        "probe",
+        field.to_str().unwrap(),
+        "--points",
+        pts.to_str().unwrap(),
+        "--model",
+        "bogus",
+    ]);
     assert_eq!(o.status.code(), Some(1));
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -4,7 +4,7 @@
 
 use clap::Parser;
 use std::path::{Path, PathBuf};
-use sunbeam_afm::{Channel, Format, ReadOptions};
+use sunbeam_afm::{Channel, ChannelInfo, Format, ReadOptions};
 use sunbeam_common::units::{format_length, parse_positive_length, parse_size};
 use sunbeam_common::{Error, Result};
 use sunbeam_field::align::AlignRows;
@@ -282,17 +282,52 @@ fn read_channels(bytes: &[u8], plan: &Plan) -> Result<(Vec<Channel>, Format, boo
     }
 }
 
-fn list(cli: &Cli, chans: &[Channel], fmt: Format) {
+/// The channels of the input without processing them. Nanoscope files list
+/// from the header alone (so files with damaged data still list).
+fn list_infos(bytes: &[u8], plan: &Plan) -> Result<(Vec<ChannelInfo>, Format)> {
+    let format = plan.read.format.or_else(|| sunbeam_afm::detect(bytes));
+    if format == Some(Format::Exr) {
+        let (chans, _) = read_exr(bytes, plan.pixel_size)?;
+        let infos = chans
+            .iter()
+            .enumerate()
+            .map(|(index, c)| ChannelInfo {
+                index,
+                name: c.name.clone(),
+                z_unit: c.z_unit.clone(),
+                xy_unit: c.xy_unit.clone(),
+                is_height: c.is_height,
+                width: c.field.width,
+                height: c.field.height,
+                size: (c.field.size_x(), c.field.size_y()),
+                format: Format::Exr,
+            })
+            .collect();
+        return Ok((infos, Format::Exr));
+    }
+    let opts = ReadOptions {
+        pixel_size: plan.pixel_size,
+        ..plan.read.clone()
+    };
+    let infos = sunbeam_afm::list_channels_bytes(bytes, &opts)?;
+    let fmt = infos
+        .first()
+        .map(|i| i.format)
+        .or(format)
+        .unwrap_or(Format::Ascii);
+    Ok((infos, fmt))
+}
+
+fn list(cli: &Cli, chans: &[ChannelInfo], fmt: Format) {
     if cli.json {
         let v: Vec<serde_json::Value> = chans
             .iter()
-            .enumerate()
-            .map(|(i, c)| {
+            .map(|c| {
                 serde_json::json!({
-                    "index": i, "name": c.name, "is_height": c.is_height,
-                    "width": c.field.width, "height": c.field.height,
-                    "size_x": c.field.size_x(), "size_y": c.field.size_y(),
-                    "dx": c.field.dx, "dy": c.field.dy,
+                    "index": c.index, "name": c.name, "is_height": c.is_height,
+                    "width": c.width, "height": c.height,
+                    "size_x": c.size.0, "size_y": c.size.1,
+                    "dx": c.size.0 / c.width as f64, "dy": c.size.1 / c.height as f64,
                     "xy_unit": c.xy_unit, "z_unit": c.z_unit, "format": fmt.name(),
                 })
             })
@@ -304,7 +339,7 @@ fn list(cli: &Cli, chans: &[Channel], fmt: Format) {
         );
     } else {
         println!("{} ({}):", cli.input.display(), fmt.name());
-        for (i, c) in chans.iter().enumerate() {
+        for c in chans {
             let size = |v: f64| {
                 if c.xy_unit == "m" {
                     format_length(v)
@@ -313,12 +348,13 @@ fn list(cli: &Cli, chans: &[Channel], fmt: Format) {
                 }
             };
             println!(
-                "  {i}: {:<24} {}x{} px, {} x {}, z unit {}{}",
+                "  {}: {:<24} {}x{} px, {} x {}, z unit {}{}",
+                c.index,
                 format!("\"{}\"", c.name),
-                c.field.width,
-                c.field.height,
-                size(c.field.size_x()),
-                size(c.field.size_y()),
+                c.width,
+                c.height,
+                size(c.size.0),
+                size(c.size.1),
                 if c.z_unit.is_empty() {
                     "(none)"
                 } else {
@@ -336,11 +372,12 @@ fn run(cli: Cli) -> Result<()> {
     let bytes =
         std::fs::read(input).map_err(|e| Error::input_file(input, format!("cannot read: {e}")))?;
     let in_file = |e: Error| e.context(input.display());
-    let (chans, fmt, calibrated_by_user) = read_channels(&bytes, &plan).map_err(in_file)?;
     if cli.list {
-        list(&cli, &chans, fmt);
+        let (infos, fmt) = list_infos(&bytes, &plan).map_err(in_file)?;
+        list(&cli, &infos, fmt);
         return Ok(());
     }
+    let (chans, fmt, calibrated_by_user) = read_channels(&bytes, &plan).map_err(in_file)?;
     let ch = sunbeam_afm::select_channel(&chans, cli.channel.as_deref()).map_err(in_file)?;
     // A channel without a z unit: --z-scale (metres per unit) calibrates it.
     let unitless_scale = match (ch.z_unit.is_empty(), plan.read.z_scale) {

@@ -320,3 +320,29 @@ fn pixel_size_calibrates_uncalibrated_images_and_resamples_calibrated_ones() {
     );
     assert_eq!(rep["dx_m"], rep["dy_m"]);
 }
+
+#[test]
+fn list_reads_headers_even_when_the_data_are_damaged() {
+    let Some(p) = testdata::shared_file("afm/samples/header_only/pySPM_bruker_data_header.002")
+    else {
+        return;
+    };
+    let o = run(args!(&p, "--list", "--json"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let ch = v["channels"].as_array().unwrap();
+    assert_eq!(ch.len(), 8);
+    assert_eq!(ch[0]["name"], "Height Sensor");
+    assert_eq!(
+        (ch[0]["width"].as_u64(), ch[0]["height"].as_u64()),
+        (Some(512), Some(358))
+    );
+    // 300 x 300 nm declared, 358 of 512 lines: yreal = 209.77 nm (Gwyddion's reading).
+    assert!((ch[0]["size_y"].as_f64().unwrap() - 209.765625e-9).abs() < 1e-15);
+    // Importing it is still an input error.
+    let d = tmpdir("list");
+    let out = d.join("x.exr");
+    let o = run(args!(&p, "-o", &out));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!out.exists());
+}

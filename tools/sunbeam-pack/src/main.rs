@@ -106,7 +106,10 @@ struct Cli {
 
 fn parse_pixel_size(s: &str) -> Result<(f64, f64)> {
     match s.split_once(',') {
-        Some((a, b)) => Ok((units::parse_positive_length(a)?, units::parse_positive_length(b)?)),
+        Some((a, b)) => Ok((
+            units::parse_positive_length(a)?,
+            units::parse_positive_length(b)?,
+        )),
         None => {
             let v = units::parse_positive_length(s)?;
             Ok((v, v))
@@ -136,13 +139,34 @@ fn run(cli: Cli) -> Result<()> {
     let kind = OutputKind::from_path(&cli.output, cli.split, cli.atlas)?;
     let coherence = units::parse_positive_length(&cli.coherence)?;
     let (mut lmin, mut lmax) = units::parse_length_range(&cli.lambda)?;
-    let pixel_size = cli.pixel_size.as_deref().map(parse_pixel_size).transpose()?;
-    let z_range = cli.z_range.as_deref().map(units::parse_positive_length).transpose()?;
+    let pixel_size = cli
+        .pixel_size
+        .as_deref()
+        .map(parse_pixel_size)
+        .transpose()?;
+    let z_range = cli
+        .z_range
+        .as_deref()
+        .map(units::parse_positive_length)
+        .transpose()?;
     let mut warnings: Vec<String> = vec![];
     let mut notes: Vec<String> = vec![];
 
-    let field = read_height(&cli.height, &InputOptions { pixel_size, z_range, channel: cli.channel.clone() })?;
-    let fr = FieldRef { width: field.width, height: field.height, dx: field.dx, dy: field.dy, data: &field.data };
+    let field = read_height(
+        &cli.height,
+        &InputOptions {
+            pixel_size,
+            z_range,
+            channel: cli.channel.clone(),
+        },
+    )?;
+    let fr = FieldRef {
+        width: field.width,
+        height: field.height,
+        dx: field.dx,
+        dy: field.dy,
+        data: &field.data,
+    };
 
     let mut max_w = cli.max_w;
     let mut freq_limit = None;
@@ -240,7 +264,11 @@ fn run(cli: Cli) -> Result<()> {
         if progress_on {
             let w = 30;
             let f = done * w / total.max(1);
-            eprint!("\r{TOOL}: [{}{}] {done}/{total} terms", "#".repeat(f), " ".repeat(w - f));
+            eprint!(
+                "\r{TOOL}: [{}{}] {done}/{total} terms",
+                "#".repeat(f),
+                " ".repeat(w - f)
+            );
             if done == total {
                 eprintln!();
             }
@@ -287,7 +315,12 @@ fn run(cli: Cli) -> Result<()> {
         });
         println!("{}", serde_json::to_string_pretty(&report).expect("json"));
     } else if !cli.quiet && cli.verbose {
-        eprintln!("{TOOL}: wrote {} ({} bytes) in {:.2} s", cli.output.display(), bytes, secs);
+        eprintln!(
+            "{TOOL}: wrote {} ({} bytes) in {:.2} s",
+            cli.output.display(),
+            bytes,
+            secs
+        );
     }
     Ok(())
 }

@@ -34,7 +34,14 @@ pub fn field(w: usize, h: usize, dx: f64, dy: f64, f: impl Fn(f64, f64) -> f64) 
 pub fn rough(w: usize, h: usize, dx: f64, dy: f64, amp: f64, seed: u64) -> HeightField {
     let mut rng = Rng(seed);
     let bumps: Vec<(f64, f64, f64, f64)> = (0..12)
-        .map(|_| (rng.range(0.0, w as f64 * dx), rng.range(0.0, h as f64 * dy), rng.range(0.1e-6, 0.5e-6), rng.range(-1.0, 1.0)))
+        .map(|_| {
+            (
+                rng.range(0.0, w as f64 * dx),
+                rng.range(0.0, h as f64 * dy),
+                rng.range(0.1e-6, 0.5e-6),
+                rng.range(-1.0, 1.0),
+            )
+        })
         .collect();
     let period = 1.1e-6;
     let mut f = field(w, h, dx, dy, |x, y| {
@@ -54,7 +61,13 @@ pub fn rough(w: usize, h: usize, dx: f64, dy: f64, amp: f64, seed: u64) -> Heigh
 }
 
 pub fn fref(f: &HeightField) -> FieldRef<'_> {
-    FieldRef { width: f.width, height: f.height, dx: f.dx, dy: f.dy, data: &f.data }
+    FieldRef {
+        width: f.width,
+        height: f.height,
+        dx: f.dx,
+        dy: f.dy,
+        data: &f.data,
+    }
 }
 
 pub fn build(f: &HeightField, o: &BuildOptions) -> Pack {

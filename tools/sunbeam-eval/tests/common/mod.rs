@@ -24,7 +24,10 @@ pub fn write_ascii(path: &Path, w: usize, h: usize, data: &[f64]) {
 }
 
 pub fn run(args: &[&str]) -> Output {
-    Command::new(bin()).args(args).output().expect("run sunbeam-eval")
+    Command::new(bin())
+        .args(args)
+        .output()
+        .expect("run sunbeam-eval")
 }
 
 pub fn ok(args: &[&str]) -> String {
