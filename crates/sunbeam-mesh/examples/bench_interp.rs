@@ -59,7 +59,11 @@ fn main() {
     let mut rep = serde_json::Map::new();
     rep.insert("vertices".into(), uv.len().into());
     rep.insert("samples".into(), nsamp.into());
-    for (name, interp) in [("natural", Interp::Natural), ("linear", Interp::Linear)] {
+    for (name, interp) in [
+        ("natural", Interp::Natural),
+        ("sibson", Interp::SibsonC1),
+        ("linear", Interp::Linear),
+    ] {
         let mut best_build = f64::INFINITY;
         let mut best_eval = f64::INFINITY;
         let mut res = Vec::new();

@@ -337,6 +337,7 @@ fn samples(
         interpolation: match opts.interp {
             Interp::Natural => "natural-neighbour".into(),
             Interp::Linear => "linear".into(),
+            Interp::SibsonC1 => "sibson-c1".into(),
         },
         ..Default::default()
     };

@@ -30,6 +30,11 @@ pub enum Interp {
     /// the samples, exact at them.
     #[default]
     Natural,
+    /// Sibson's C1 natural-neighbour interpolant (Sibson 1981, as in spade's
+    /// `interpolate_gradient`, flatness 1), with per-sample gradients from a
+    /// weighted least-squares plane fit over the Delaunay neighbours: smooth
+    /// through the samples, more accurate on smooth fields.
+    SibsonC1,
     /// Piecewise-linear (barycentric) on the Delaunay triangulation: what
     /// scipy's `LinearNDInterpolator` / `griddata(method="linear")` computes.
     Linear,
@@ -409,6 +414,8 @@ pub struct AxialField {
     /// clearly outside skip spade's point location, which walks far outside
     /// thin hulls.
     hull: Option<(Vec<[f64; 2]>, f64)>,
+    /// For [`Interp::SibsonC1`]: gradients of (c, s) per vertex index: [dc/du, dc/dv, ds/du, ds/dv].
+    grads: Vec<[f64; 4]>,
 }
 
 impl AxialField {
@@ -464,6 +471,7 @@ impl AxialField {
         let used = nodes.len();
         let mut near = None;
         let mut hull = None;
+        let mut grads = Vec::new();
         let layout = match nodes.len() {
             0 => return None,
             1 => Layout::Constant(nodes[0].c, nodes[0].s),
@@ -492,6 +500,9 @@ impl AxialField {
                         let diag2 = (hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2);
                         if h.len() >= 3 && diag2 > 0.0 {
                             hull = Some((h, 1e-9 * diag2));
+                        }
+                        if interp == Interp::SibsonC1 {
+                            grads = gradients(&t);
                         }
                         Layout::Tri(t)
                     }
@@ -530,13 +541,16 @@ impl AxialField {
             used,
             near,
             hull,
+            grads,
         })
     }
 
     /// A reusable evaluator (holds spade's scratch buffers; one per thread).
     pub fn evaluator(&self) -> Evaluator<'_> {
         let (nn, bc) = match (&self.layout, self.interp) {
-            (Layout::Tri(t), Interp::Natural) => (Some(t.natural_neighbor()), None),
+            (Layout::Tri(t), Interp::Natural | Interp::SibsonC1) => {
+                (Some(t.natural_neighbor()), None)
+            }
             (Layout::Tri(t), Interp::Linear) => (None, Some(t.barycentric())),
             _ => (None, None),
         };
@@ -599,7 +613,84 @@ fn finish(c: f64, s: f64, extrapolated: bool) -> AxialValue {
     }
 }
 
+/// Per-vertex gradients of the doubled-angle components: weighted least-squares
+/// plane through each vertex and its Delaunay neighbours (weights 1/r^2).
+fn gradients(t: &Tri) -> Vec<[f64; 4]> {
+    t.vertices()
+        .map(|v| {
+            let p = v.position();
+            let d0 = *v.data();
+            let (mut a11, mut a12, mut a22) = (0.0, 0.0, 0.0);
+            let (mut bc, mut bs) = ([0.0; 2], [0.0; 2]);
+            for e in v.out_edges() {
+                let q = e.to();
+                let dq = *q.data();
+                let (dx, dy) = (q.position().x - p.x, q.position().y - p.y);
+                let r2 = dx * dx + dy * dy;
+                if r2 <= 0.0 {
+                    continue;
+                }
+                let w = 1.0 / r2;
+                a11 += w * dx * dx;
+                a12 += w * dx * dy;
+                a22 += w * dy * dy;
+                bc[0] += w * dx * (dq.c - d0.c);
+                bc[1] += w * dy * (dq.c - d0.c);
+                bs[0] += w * dx * (dq.s - d0.s);
+                bs[1] += w * dy * (dq.s - d0.s);
+            }
+            let det = a11 * a22 - a12 * a12;
+            if det.abs() <= 1e-12 * (a11 * a22).abs().max(1e-300) {
+                return [0.0; 4];
+            }
+            let solve = |b: [f64; 2]| {
+                [
+                    (a22 * b[0] - a12 * b[1]) / det,
+                    (a11 * b[1] - a12 * b[0]) / det,
+                ]
+            };
+            let (gc, gs) = (solve(bc), solve(bs));
+            [gc[0], gc[1], gs[0], gs[1]]
+        })
+        .collect()
+}
+
 impl Evaluator<'_> {
+    /// Sibson's C1 blend on the natural-neighbour weights in `self.w` (non-empty).
+    fn sibson(&self, t: &Tri, uv: [f64; 2]) -> AxialValue {
+        let (mut c0, mut s0, mut c1, mut s1) = (0.0, 0.0, 0.0, 0.0);
+        let (mut sum_w1, mut alpha, mut beta) = (0.0, 0.0, 0.0);
+        for &(h, w) in &self.w {
+            let v = t.vertex(h);
+            let d = *v.data();
+            let (dx, dy) = (uv[0] - v.position().x, uv[1] - v.position().y);
+            let r2 = dx * dx + dy * dy;
+            if r2 == 0.0 {
+                return finish(d.c, d.s, false);
+            }
+            let g = self.f.grads.get(h.index()).copied().unwrap_or([0.0; 4]);
+            let w1 = w / r2;
+            alpha += w1 * r2;
+            beta += w * r2;
+            sum_w1 += w1;
+            c1 += (d.c + dx * g[0] + dy * g[1]) * w1;
+            s1 += (d.s + dx * g[2] + dy * g[3]) * w1;
+            c0 += d.c * w;
+            s0 += d.s * w;
+        }
+        if sum_w1 <= 0.0 || alpha + beta <= 0.0 {
+            return finish(c0, s0, false);
+        }
+        alpha /= sum_w1;
+        c1 /= sum_w1;
+        s1 /= sum_w1;
+        finish(
+            (alpha * c0 + beta * c1) / (alpha + beta),
+            (alpha * s0 + beta * s1) / (alpha + beta),
+            false,
+        )
+    }
+
     pub fn eval(&mut self, uv: [f64; 2]) -> AxialValue {
         match &self.f.layout {
             Layout::Constant(c, s) => finish(*c, *s, false),
@@ -630,11 +721,6 @@ impl Evaluator<'_> {
                     .hull
                     .as_ref()
                     .is_some_and(|(h, eps)| clearly_outside(h, uv, *eps));
-                if std::env::var_os("SB_DEBUG").is_some() {
-                    static A: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-                    let n = A.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    if n % 100000 == 0 { eprintln!("q{n} {uv:?} outside={outside} hull={}", self.f.hull.as_ref().map_or(0, |h| h.0.len())); }
-                }
                 if outside {
                     self.w.clear();
                 } else if let Some(nn) = &self.nn {
@@ -654,6 +740,9 @@ impl Evaluator<'_> {
                         Some((c, s)) => finish(c, s, true),
                         None => AxialValue::Cancelled,
                     };
+                }
+                if self.f.interp == Interp::SibsonC1 {
+                    return self.sibson(t, uv);
                 }
                 let (mut c, mut s) = (0.0, 0.0);
                 for &(h, w) in &self.w {

@@ -76,11 +76,7 @@ fn spline(c: &[V3], s: f64) -> V3 {
     let t = x - i as f64;
     let p = |k: isize| -> V3 {
         let k = k.clamp(0, segs as isize) as usize;
-        if k == 0 && i == 0 && t < 0.0 {
-            c[0]
-        } else {
-            c[k]
-        }
+        c[k]
     };
     let (p0, p1, p2, p3) = (
         if i == 0 {

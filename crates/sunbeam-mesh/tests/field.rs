@@ -249,7 +249,7 @@ pub fn convergence_error(n: usize, interp: Interp) -> (f64, f64) {
 
 #[test]
 fn analytic_field_error_falls_with_sample_density() {
-    for interp in [Interp::Natural, Interp::Linear] {
+    for interp in [Interp::Natural, Interp::SibsonC1, Interp::Linear] {
         let mut prev = (f64::INFINITY, f64::INFINITY);
         for n in [100, 400, 1600, 6400] {
             let (mx, rms) = convergence_error(n, interp);
@@ -265,6 +265,15 @@ fn analytic_field_error_falls_with_sample_density() {
                 prev.0
             );
             prev = (mx, rms);
+        }
+        if interp == Interp::SibsonC1 {
+            // The C1 interpolant must beat plain natural neighbour on a smooth field.
+            let (_, rms_nn) = convergence_error(6400, Interp::Natural);
+            assert!(
+                prev.1 < 0.5 * rms_nn,
+                "Sibson C1 rms {} vs natural {rms_nn}",
+                prev.1
+            );
         }
         // Stated bound (docs/BAKE.md): with 6400 samples on the unit square, max error < 2e-3 rad.
         assert!(
@@ -436,7 +445,7 @@ fn degenerate_triangles_and_axis_along_the_normal() {
     );
     assert_eq!(b.report.arbitrary, pos.len());
     check_stored(&mut b.doc);
-    // Tilted axis: only the isolated vertex lacks nothing... every vertex gets the projection.
+    // A tilted axis: every vertex, the unused one included, gets the projection.
     let d = doc_from(&pos, None, Some(&uv), &idx, json!({}));
     let b = bake(d, &BakeOptions::new(Source::Axis([1.0, 0.0, 1.0]))).unwrap();
     assert_eq!(b.report.arbitrary, 0);

@@ -193,4 +193,91 @@ impl Pack {
         }
         xyz.map(|c| c * g / norm)
     }
+
+    /// The evaluator in float32 arithmetic only, step for step as docs/PACK_FORMAT.md
+    /// writes it (and as a WGSL port computes it): Miller's recurrence in f32, the
+    /// Kaiser-Bessel weight with I0 by its power series in f32, complex sums per tap.
+    /// For testing shader ports; [`Pack::reflectance`] is the float64 reference.
+    pub fn reflectance_f32(&self, u: f32, v: f32, w: f32, lambda_m: f32) -> f32 {
+        let m = &self.manifest;
+        let n = m.terms;
+        let t = 2.0 * std::f32::consts::PI / lambda_m * w * m.height_half_range_m as f32;
+        let c = series::coefficients_f32(m.basis, t, n);
+        let kappa = [
+            -u / lambda_m * m.bin_scale_m[0] as f32,
+            -v / lambda_m * m.bin_scale_m[1] as f32,
+        ];
+        if !(kappa[0].is_finite() && kappa[1].is_finite())
+            || kappa[0].abs() > 1e7
+            || kappa[1].abs() > 1e7
+        {
+            return 0.0;
+        }
+        let taps = m.kernel.taps as i32;
+        let beta = m.kernel.beta as f32;
+        let kb_scale = beta / (taps as f32 * beta.sinh());
+        let weight = |d: f32, axis: usize| -> f32 {
+            match m.model {
+                Model::Window => {
+                    let r = 2.0 * d / taps as f32;
+                    if r.abs() >= 1.0 {
+                        return 0.0;
+                    }
+                    let z = beta * (1.0 - r * r).sqrt();
+                    let q = z * z / 4.0;
+                    let (mut term, mut sum, mut k) = (1.0f32, 1.0f32, 1.0f32);
+                    while term > 1e-7 * sum && k < 100.0 {
+                        term *= q / (k * k);
+                        sum += term;
+                        k += 1.0;
+                    }
+                    kb_scale * sum
+                }
+                Model::Tiled => {
+                    let sg = m.kernel.sigma_bins[axis] as f32;
+                    (-d * d / (2.0 * sg * sg)).exp()
+                }
+            }
+        };
+        let (kx, ky) = (m.crop.kx as i32, m.crop.ky as i32);
+        let k0 = [
+            kappa[0].floor() as i32 - taps / 2 + 1,
+            kappa[1].floor() as i32 - taps / 2 + 1,
+        ];
+        let layer = m.layer_texels();
+        let (mut are, mut aim, mut power) = (0.0f32, 0.0f32, 0.0f32);
+        for jy in 0..taps {
+            let by = k0[1] + jy;
+            if by < -ky || by > ky {
+                continue;
+            }
+            let wy = weight(kappa[1] - by as f32, 1);
+            for jx in 0..taps {
+                let bx = k0[0] + jx;
+                if bx < -kx || bx > kx {
+                    continue;
+                }
+                let wt = wy * weight(kappa[0] - bx as f32, 0);
+                let base = 2 * ((by + ky) as usize * m.crop.width + (bx + kx) as usize);
+                let (mut re, mut im) = (0.0f32, 0.0f32);
+                for (k, ck) in c.iter().enumerate() {
+                    let i = base + 2 * k * layer;
+                    let (dr, di) = (self.terms[i], self.terms[i + 1]);
+                    re += ck[0] * dr - ck[1] * di;
+                    im += ck[0] * di + ck[1] * dr;
+                }
+                match m.model {
+                    Model::Window => {
+                        are += wt * re;
+                        aim += wt * im;
+                    }
+                    Model::Tiled => power += wt * (re * re + im * im),
+                }
+            }
+        }
+        match m.model {
+            Model::Window => are * are + aim * aim,
+            Model::Tiled => power,
+        }
+    }
 }

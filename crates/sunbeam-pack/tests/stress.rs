@@ -147,20 +147,66 @@ fn hostile_headers_are_refused_without_allocating() {
 fn tiled_model_on_a_large_patch_with_a_wide_gaussian() {
     // L = 61 um: sigma_f L ~ 0.6 bins, so the Gaussian spans several bins (more taps).
     let f = rough(244, 244, 250e-9, 250e-9, 150e-9, 77);
-    let o = BuildOptions { model: sunbeam_pack::Model::Tiled, ..BuildOptions::default() };
+    let o = BuildOptions {
+        model: sunbeam_pack::Model::Tiled,
+        ..BuildOptions::default()
+    };
     let p = build(&f, &o);
-    assert!(p.manifest.kernel.taps >= 8, "taps {}", p.manifest.kernel.taps);
-    let t = Truth::new(&f, &Params { model: sunbeam_optics::truth::Model::Tiled, coherence_m: 65e-6 }).unwrap();
+    assert!(
+        p.manifest.kernel.taps >= 8,
+        "taps {}",
+        p.manifest.kernel.taps
+    );
+    let t = Truth::new(
+        &f,
+        &Params {
+            model: sunbeam_optics::truth::Model::Tiled,
+            coherence_m: 65e-6,
+        },
+    )
+    .unwrap();
     let mut rng = Rng(12);
     let mut worst = 0.0f64;
     for i in 0..60 {
         let (u, v, w, l) = if i < 20 {
             // near specular, where the strong low orders are
-            (rng.range(-0.02, 0.02), rng.range(-0.02, 0.02), -1.8, rng.range(380e-9, 780e-9))
+            (
+                rng.range(-0.02, 0.02),
+                rng.range(-0.02, 0.02),
+                -1.8,
+                rng.range(380e-9, 780e-9),
+            )
         } else {
             random_query(&mut rng, 80.0)
         };
         worst = worst.max((p.reflectance(u, v, w, l) - t.reflectance(u, v, w, l)).abs());
     }
     assert!(worst <= 1e-3, "tiled large patch: {worst:e}");
+}
+
+#[test]
+fn float32_evaluator_matches_the_float64_one() {
+    // The shader-style f32 path (docs/PACK_FORMAT.md step by step) against the f64 reference.
+    for model in [sunbeam_pack::Model::Window, sunbeam_pack::Model::Tiled] {
+        let f = rough(40, 36, 25e-9, 25e-9, 800e-9, 5);
+        let p = build(
+            &f,
+            &BuildOptions {
+                model,
+                ..BuildOptions::default()
+            },
+        );
+        let mut rng = Rng(31);
+        let mut worst = 0.0f64;
+        for _ in 0..300 {
+            let (u, v, w, l) = random_query(&mut rng, 85.0);
+            let a = p.reflectance(u, v, w, l);
+            let b = p.reflectance_f32(u as f32, v as f32, w as f32, l as f32) as f64;
+            worst = worst.max((a - b).abs());
+        }
+        assert!(
+            worst < 1e-5,
+            "{model:?}: f32 evaluator differs by {worst:e}"
+        );
+    }
 }

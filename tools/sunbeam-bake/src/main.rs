@@ -18,6 +18,7 @@ enum UvDir {
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum InterpArg {
     Natural,
+    Sibson,
     Linear,
 }
 
@@ -132,8 +133,8 @@ fn run(cli: Cli) -> Result<()> {
     if !cli.rotate_deg.is_finite() {
         return Err(Error::usage("--rotate-deg must be a finite number"));
     }
-    if cli.texture.is_some() && !(1..=16384).contains(&cli.texture_size) {
-        return Err(Error::usage("--texture-size must be 1..16384"));
+    if cli.texture.is_some() && !(1..=8192).contains(&cli.texture_size) {
+        return Err(Error::usage("--texture-size must be 1..8192"));
     }
     let mut inputs: Vec<PathBuf> = Vec::new();
     let (doc, snake_spine) = match (&cli.mesh, cli.generate_snake) {
@@ -186,6 +187,7 @@ fn run(cli: Cli) -> Result<()> {
         interp: match cli.interpolation {
             InterpArg::Natural => Interp::Natural,
             InterpArg::Linear => Interp::Linear,
+            InterpArg::Sibson => Interp::SibsonC1,
         },
         max_snap: cli.max_snap,
     };

@@ -235,7 +235,7 @@ pub fn run(o: &Options) -> Result<()> {
         let (p, _) = build(f, Basis::Chebyshev, 1e-4, Precision::F32, 6)?;
         for light in [
             crate::sample::dir(60f64.to_radians(), 0.0),
-            crate::sample::dir(30f64.to_radians(), 1.5708),
+            crate::sample::dir(30f64.to_radians(), std::f64::consts::FRAC_PI_2),
         ] {
             let tc = truth_colours(&truth, &p, light, if o.quick { 16 } else { 32 });
             for samples in [8usize, 16, 32, 40, 64] {
@@ -422,10 +422,7 @@ fn pareto_plot(path: &Path, rows: &[Row]) -> Result<()> {
     if xs.is_empty() {
         return Ok(());
     }
-    let (x0, x1) = (
-        0.0,
-        xs.iter().copied().fold(0.0, f64::max) * 1.1,
-    );
+    let (x0, x1) = (0.0, xs.iter().copied().fold(0.0, f64::max) * 1.1);
     let (y0, y1) = (
         ys.iter().copied().fold(f64::INFINITY, f64::min) / 3.0,
         ys.iter().copied().fold(0.0, f64::max) * 3.0,

@@ -62,7 +62,7 @@ fn r_at(src: &Source, o: &Options, lambda: f64, theta_r: f64) -> f64 {
 }
 
 pub fn run(src: &Source, o: &Options) -> Result<Outcome> {
-    if !(o.theta_i.abs() < 89.9f64.to_radians()) {
+    if o.theta_i.is_nan() || o.theta_i.abs() >= 89.9f64.to_radians() {
         return Err(Error::usage(
             "--theta-i must be within (-89.9, 89.9) degrees",
         ));

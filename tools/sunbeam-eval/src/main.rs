@@ -190,16 +190,23 @@ struct GratingArgs {
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Scene JSON.
+    /// Scene JSON (docs/SCENE.md); or give --mesh and --pack for the default scene.
     scene: Option<PathBuf>,
+    /// Output PNG.
     #[arg(short, long)]
-    output: Option<PathBuf>,
+    output: PathBuf,
+    /// Mesh (GLB/glTF/OBJ) for the default scene of sunbeam-play --mesh --pack.
     #[arg(long)]
     mesh: Option<PathBuf>,
+    /// Pack for the default scene.
     #[arg(long)]
     pack: Option<PathBuf>,
+    /// Frame size WxH (default: the scene's).
     #[arg(long)]
     size: Option<String>,
+    /// Exposure in stops (default: the scene's).
+    #[arg(long, allow_hyphen_values = true)]
+    exposure: Option<f64>,
 }
 
 fn main() {

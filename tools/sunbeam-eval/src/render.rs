@@ -1,11 +1,44 @@
 //! `sunbeam-eval render`: the CPU reference image of a scene, through
-//! `sunbeam_raster::render` (written with the player). Until that crate is
-//! wired in, the subcommand says so.
+//! `sunbeam_raster::render` (the same scene loading and defaults as
+//! `sunbeam-play`: a scene file, or `--mesh M --pack P` for
+//! `Scene::default_for`).
 
-use sunbeam_common::{Error, Result};
+use sunbeam_common::{units, Error, Result};
+use sunbeam_scene::Scene;
 
-pub fn run(_args: &crate::RenderArgs) -> Result<()> {
-    Err(Error::internal(
-        "render is not built yet: it calls sunbeam_raster::render, which this build of sunbeam-eval does not link",
-    ))
+pub fn run(a: &crate::RenderArgs) -> Result<()> {
+    let mut scene = match (&a.scene, &a.mesh) {
+        (Some(_), Some(_)) => {
+            return Err(Error::usage(
+                "give either SCENE.json or --mesh/--pack, not both",
+            ))
+        }
+        (Some(s), None) => {
+            if a.pack.is_some() {
+                return Err(Error::usage(
+                    "--pack goes with --mesh (a scene file names its own packs)",
+                ));
+            }
+            Scene::load(s)?
+        }
+        (None, Some(m)) => sunbeam_raster::default_scene(m, a.pack.as_deref())?,
+        (None, None) => {
+            return Err(Error::usage(
+                "nothing to render: give SCENE.json or --mesh M.glb --pack P.ktx2",
+            ))
+        }
+    };
+    if let Some(ev) = a.exposure {
+        if !ev.is_finite() {
+            return Err(Error::usage("--exposure must be finite"));
+        }
+        scene.exposure = ev;
+    }
+    if let Some(s) = &a.size {
+        let (w, h) = units::parse_size(s)?;
+        scene.size = [w as u32, h as u32];
+        scene.validate()?;
+    }
+    let img = sunbeam_raster::render(&scene)?;
+    img.write_png(&a.output)
 }

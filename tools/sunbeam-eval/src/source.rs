@@ -28,7 +28,10 @@ impl TruthArgs {
 }
 
 pub enum Source {
-    Truth { truth: Truth, field: HeightField },
+    Truth {
+        truth: Box<Truth>,
+        field: Box<HeightField>,
+    },
     Pack(Box<sunbeam_pack::Pack>),
 }
 
@@ -58,7 +61,10 @@ impl Source {
 
     pub fn from_field(field: HeightField, p: &Params) -> Result<Source> {
         let truth = Truth::new(&field, p)?;
-        Ok(Source::Truth { truth, field })
+        Ok(Source::Truth {
+            truth: Box::new(truth),
+            field: Box::new(field),
+        })
     }
 
     pub fn reflectance(&self, u: f64, v: f64, w: f64, lambda_m: f64) -> f64 {

@@ -5,6 +5,7 @@ use common::*;
 use std::f64::consts::PI;
 
 /// PHYSICS.md 2 written out directly: window model and tiled model.
+#[allow(clippy::too_many_arguments)]
 fn reference(
     w: usize,
     h: usize,

@@ -25,7 +25,8 @@ use sunbeam_field::HeightField;
                   See docs/IMPORT.md."
 )]
 struct Cli {
-    /// The scan (format detected from content).
+    /// The scan (format detected from content), or `synthetic:NAME` for a built-in
+    /// synthetic field (elaphe, xenopeltis, sine, blazed).
     input: PathBuf,
     /// Output height field: .exr (float32, metres) or .gsf.
     #[arg(short, long, required_unless_present = "list")]
@@ -81,6 +82,12 @@ struct Cli {
     /// Calibration for uncalibrated data: metres per grey level / per number.
     #[arg(long, value_name = "LEN")]
     z_scale: Option<String>,
+    /// `synthetic:NAME` inputs: the field's size in pixels (square).
+    #[arg(long, value_name = "N", default_value_t = 256)]
+    synthetic_size: usize,
+    /// `synthetic:NAME` inputs: the pixel size.
+    #[arg(long, value_name = "LEN", default_value = "25nm")]
+    synthetic_pixel: String,
     /// Also write a false-colour PNG preview with a scale bar.
     #[arg(long, value_name = "PNG")]
     preview: Option<PathBuf>,
@@ -366,18 +373,72 @@ fn list(cli: &Cli, chans: &[ChannelInfo], fmt: Format) {
     }
 }
 
+/// `synthetic:NAME` -> the preset name, for the built-in synthetic fields.
+fn synthetic_name(input: &Path) -> Option<&str> {
+    input.to_str()?.strip_prefix("synthetic:")
+}
+
+/// A built-in synthetic field (crates/sunbeam-synth) as a one-channel "scan".
+fn synthetic(cli: &Cli, name: &str) -> Result<Vec<Channel>> {
+    if cli.synthetic_size < 2 || cli.synthetic_size > 8192 {
+        return Err(Error::usage(format!(
+            "--synthetic-size {}: use 2..8192 pixels",
+            cli.synthetic_size
+        )));
+    }
+    let pixel = parse_positive_length(&cli.synthetic_pixel)
+        .map_err(|e| e.context("--synthetic-pixel"))?;
+    let field = sunbeam_synth::preset(name, cli.synthetic_size, pixel)?;
+    Ok(vec![Channel {
+        name: "Height".into(),
+        z_unit: "m".into(),
+        is_height: true,
+        field,
+        xy_unit: "m".into(),
+        offset: (0.0, 0.0),
+    }])
+}
+
 fn run(cli: Cli) -> Result<()> {
     let plan = plan(&cli)?;
     let input = &cli.input;
-    let bytes =
-        std::fs::read(input).map_err(|e| Error::input_file(input, format!("cannot read: {e}")))?;
+    let synth = synthetic_name(input);
     let in_file = |e: Error| e.context(input.display());
-    if cli.list {
-        let (infos, fmt) = list_infos(&bytes, &plan).map_err(in_file)?;
-        list(&cli, &infos, fmt);
-        return Ok(());
-    }
-    let (chans, fmt, calibrated_by_user) = read_channels(&bytes, &plan).map_err(in_file)?;
+    let (chans, fmt, calibrated_by_user) = if let Some(name) = synth {
+        if plan.read.format.is_some() || plan.read.z_range.is_some() || plan.read.z_scale.is_some() {
+            return Err(Error::usage(format!(
+                "{}: --format, --z-range and --z-scale do not apply to synthetic fields",
+                input.display()
+            )));
+        }
+        let chans = synthetic(&cli, name)?;
+        if cli.list {
+            let c = &chans[0];
+            let info = ChannelInfo {
+                index: 0,
+                name: c.name.clone(),
+                z_unit: c.z_unit.clone(),
+                xy_unit: c.xy_unit.clone(),
+                is_height: true,
+                width: c.field.width,
+                height: c.field.height,
+                size: (c.field.size_x(), c.field.size_y()),
+                format: Format::Exr,
+            };
+            list(&cli, &[info], Format::Exr);
+            return Ok(());
+        }
+        (chans, Format::Exr, false)
+    } else {
+        let bytes = std::fs::read(input)
+            .map_err(|e| Error::input_file(input, format!("cannot read: {e}")))?;
+        if cli.list {
+            let (infos, fmt) = list_infos(&bytes, &plan).map_err(in_file)?;
+            list(&cli, &infos, fmt);
+            return Ok(());
+        }
+        read_channels(&bytes, &plan).map_err(in_file)?
+    };
     let ch = sunbeam_afm::select_channel(&chans, cli.channel.as_deref()).map_err(in_file)?;
     // A channel without a z unit: --z-scale (metres per unit) calibrates it.
     let unitless_scale = match (ch.z_unit.is_empty(), plan.read.z_scale) {
@@ -445,17 +506,22 @@ fn run(cli: Cli) -> Result<()> {
         field.provenance.processing.push(d.clone());
         processing.push(d);
     }
-    field.provenance.source_file = input
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    field.provenance.source_format = fmt.name().to_string();
+    let source_format = if synth.is_some() {
+        "synthetic"
+    } else {
+        field.provenance.source_file = input
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        fmt.name()
+    };
+    field.provenance.source_format = source_format.to_string();
     field.provenance.channel = ch.name.clone();
     if cli.verbose {
         eprintln!(
             "sunbeam-import: {}: {} channel '{}', {}x{} px of {} x {}",
             input.display(),
-            fmt.name(),
+            source_format,
             ch.name,
             field.width,
             field.height,
@@ -490,7 +556,13 @@ fn run(cli: Cli) -> Result<()> {
         if let Some(p) = &cli.preview {
             outs.push(p.as_path());
         }
-        sunbeam_common::depfile::write(d, &outs, &[input.as_path()])?;
+        // A synthetic field depends on no file (only on the tool and its flags).
+        let ins: Vec<&Path> = if synth.is_some() {
+            vec![]
+        } else {
+            vec![input.as_path()]
+        };
+        sunbeam_common::depfile::write(d, &outs, &ins)?;
     }
     let st = Stats::of(&field);
     if cli.json {
@@ -503,7 +575,7 @@ fn run(cli: Cli) -> Result<()> {
         };
         let report = serde_json::json!({
             "input": input, "output": output, "preview": cli.preview,
-            "source_format": fmt.name(), "channel": ch.name,
+            "source_format": source_format, "channel": ch.name,
             "width": field.width, "height": field.height, "dx_m": field.dx, "dy_m": field.dy,
             "size_x_m": field.size_x(), "size_y_m": field.size_y(),
             "z_min_m": num(st.min), "z_max_m": num(st.max), "z_mean_m": num(st.mean), "z_rms_m": num(st.rms),
