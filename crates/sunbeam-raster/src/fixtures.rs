@@ -21,11 +21,23 @@ pub struct Patch {
 }
 
 /// Blazed grating: one 2.5 um period over 100 px, 246.23 nm.
-pub const BLAZED: Patch = Patch { file: "BlazingBump.bmp", pixel_m: 25e-9, range_m: 246.23e-9 };
+pub const BLAZED: Patch = Patch {
+    file: "BlazingBump.bmp",
+    pixel_m: 25e-9,
+    range_m: 246.23e-9,
+};
 /// Elaphe guttata: 65 nm pixels, 375 nm.
-pub const ELAPHE: Patch = Patch { file: "Elaph100x100.png", pixel_m: 65e-9, range_m: 375e-9 };
+pub const ELAPHE: Patch = Patch {
+    file: "Elaph100x100.png",
+    pixel_m: 65e-9,
+    range_m: 375e-9,
+};
 /// Xenopeltis unicolor: 65 nm pixels, 443.45 nm.
-pub const XENO: Patch = Patch { file: "Xeno100x100.png", pixel_m: 65e-9, range_m: 443.45e-9 };
+pub const XENO: Patch = Patch {
+    file: "Xeno100x100.png",
+    pixel_m: 65e-9,
+    range_m: 443.45e-9,
+};
 
 /// Read an 8-bit grey image (BMP with a palette or 24-bit, PNG grey/RGB/RGBA) as
 /// values in [0, 1], row 0 at the top. Colour images use their first channel.
@@ -35,16 +47,24 @@ pub fn read_grey(path: &Path) -> Result<(usize, usize, Vec<f64>)> {
         return read_bmp(&bytes).map_err(|e| Error::input_file(path, e));
     }
     let img = crate::Image::read_png(path)?;
-    let v = img.rgb.iter().map(|p| (p[0] as f64 * 255.0).round() / 255.0).collect();
+    let v = img
+        .rgb
+        .iter()
+        .map(|p| (p[0] as f64 * 255.0).round() / 255.0)
+        .collect();
     Ok((img.width as usize, img.height as usize, v))
 }
 
 fn read_bmp(b: &[u8]) -> std::result::Result<(usize, usize, Vec<f64>), String> {
     let u32_at = |o: usize| -> std::result::Result<u32, String> {
-        b.get(o..o + 4).map(|s| u32::from_le_bytes([s[0], s[1], s[2], s[3]])).ok_or_else(|| "truncated BMP".to_string())
+        b.get(o..o + 4)
+            .map(|s| u32::from_le_bytes([s[0], s[1], s[2], s[3]]))
+            .ok_or_else(|| "truncated BMP".to_string())
     };
     let u16_at = |o: usize| -> std::result::Result<u16, String> {
-        b.get(o..o + 2).map(|s| u16::from_le_bytes([s[0], s[1]])).ok_or_else(|| "truncated BMP".to_string())
+        b.get(o..o + 2)
+            .map(|s| u16::from_le_bytes([s[0], s[1]]))
+            .ok_or_else(|| "truncated BMP".to_string())
     };
     let off = u32_at(10)? as usize;
     let hdr = u32_at(14)? as usize;
@@ -69,7 +89,8 @@ fn read_bmp(b: &[u8]) -> std::result::Result<(usize, usize, Vec<f64>), String> {
             let g = match bpp {
                 8 => {
                     let i = line[c] as usize;
-                    *b.get(palette + 4 * i + 2).ok_or("palette index out of range")? // red of BGRA
+                    *b.get(palette + 4 * i + 2)
+                        .ok_or("palette index out of range")? // red of BGRA
                 }
                 24 => line[3 * c + 2],
                 32 => line[4 * c + 2],
@@ -90,15 +111,28 @@ pub fn heights(p: &Patch, dir: &Path) -> Result<(usize, usize, Vec<f64>)> {
 /// Build a pack of a patch with `opts` (basis, model, terms ...).
 pub fn pack(p: &Patch, dir: &Path, opts: &BuildOptions) -> Result<Pack> {
     let (w, h, data) = heights(p, dir)?;
-    let f = FieldRef { width: w, height: h, dx: p.pixel_m, dy: p.pixel_m, data: &data };
+    let f = FieldRef {
+        width: w,
+        height: h,
+        dx: p.pixel_m,
+        dy: p.pixel_m,
+        data: &data,
+    };
     sunbeam_pack::build::build(f, opts, &mut |_, _| {})
 }
 
 /// A scene of one mesh with its material, ready to render (no files needed).
 pub fn prepared(scene: Scene, mesh: Mesh, pack: Option<Arc<Pack>>) -> Prepared {
     let mi = &scene.meshes[0];
-    let mat = Material { pack, base_color: mi.base_color, diffuse_weight: mi.diffuse_weight };
-    Prepared { meshes: vec![(Arc::new(mesh), mat)], scene }
+    let mat = Material {
+        pack,
+        base_color: mi.base_color,
+        diffuse_weight: mi.diffuse_weight,
+    };
+    Prepared {
+        meshes: vec![(Arc::new(mesh), mat)],
+        scene,
+    }
 }
 
 fn scene_for(mesh_name: &str, mesh: &Mesh, size: [u32; 2]) -> Scene {
@@ -114,7 +148,11 @@ pub fn quad_scene(size: [u32; 2]) -> (Scene, Mesh) {
     let mut s = scene_for("builtin:quad", &mesh, size);
     // close enough that the quad fills the frame
     s.camera.eye = [0.0, 0.0, 1.5];
-    s.lights = vec![Light { direction: [-0.5, 0.0, 0.866], intensity: 1.0, spectrum: "D65".into() }];
+    s.lights = vec![Light {
+        direction: [-0.5, 0.0, 0.866],
+        intensity: 1.0,
+        spectrum: "D65".into(),
+    }];
     (s, mesh)
 }
 
@@ -129,10 +167,24 @@ pub fn sphere_scene(size: [u32; 2]) -> (Scene, Mesh) {
 pub fn snake_scene(size: [u32; 2]) -> Result<(Scene, Mesh)> {
     let doc = sunbeam_mesh::snake::generate(&sunbeam_mesh::snake::SnakeParams::with_detail(0.25));
     let tm = sunbeam_mesh::scene_mesh(&doc)?;
-    let tangents = tm.orientation.iter().map(|o| [o[0], o[1], o[2], 1.0]).collect();
-    let mesh = Mesh { positions: tm.positions, normals: tm.normals, uvs: tm.uvs, tangents, indices: tm.indices };
+    let tangents = tm
+        .orientation
+        .iter()
+        .map(|o| [o[0], o[1], o[2], 1.0])
+        .collect();
+    let mesh = Mesh {
+        positions: tm.positions,
+        normals: tm.normals,
+        uvs: tm.uvs,
+        tangents,
+        indices: tm.indices,
+    };
     mesh.check().map_err(Error::internal)?;
     let mut s = scene_for("snake.glb", &mesh, size);
-    s.lights = vec![Light { direction: [-0.4, 0.5, 0.77], intensity: 1.0, spectrum: "D65".into() }];
+    s.lights = vec![Light {
+        direction: [-0.4, 0.5, 0.77],
+        intensity: 1.0,
+        spectrum: "D65".into(),
+    }];
     Ok((s, mesh))
 }

@@ -15,7 +15,11 @@ pub struct Image {
 
 impl Image {
     pub fn new(width: u32, height: u32) -> Image {
-        Image { width, height, rgb: vec![[0.0; 3]; width as usize * height as usize] }
+        Image {
+            width,
+            height,
+            rgb: vec![[0.0; 3]; width as usize * height as usize],
+        }
     }
 
     pub fn pixel(&self, x: u32, y: u32) -> [f32; 3] {
@@ -36,7 +40,10 @@ impl Image {
 
     /// From 8-bit RGBA.
     pub fn from_rgba8(width: u32, height: u32, rgba: &[u8]) -> Image {
-        let rgb = rgba.chunks_exact(4).map(|p| [0, 1, 2].map(|k| p[k] as f32 / 255.0)).collect();
+        let rgb = rgba
+            .chunks_exact(4)
+            .map(|p| [0, 1, 2].map(|k| p[k] as f32 / 255.0))
+            .collect();
         Image { width, height, rgb }
     }
 
@@ -48,9 +55,16 @@ impl Image {
             enc.set_color(png::ColorType::Rgb);
             enc.set_depth(png::BitDepth::Eight);
             enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-            let mut wr = enc.write_header().map_err(|e| Error::internal(format!("png: {e}")))?;
-            let data: Vec<u8> = self.to_rgba8().chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
-            wr.write_image_data(&data).map_err(|e| Error::internal(format!("png: {e}")))?;
+            let mut wr = enc
+                .write_header()
+                .map_err(|e| Error::internal(format!("png: {e}")))?;
+            let data: Vec<u8> = self
+                .to_rgba8()
+                .chunks_exact(4)
+                .flat_map(|p| [p[0], p[1], p[2]])
+                .collect();
+            wr.write_image_data(&data)
+                .map_err(|e| Error::internal(format!("png: {e}")))?;
         }
         Ok(out)
     }
@@ -67,13 +81,20 @@ impl Image {
         dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
         let mut reader = dec.read_info().map_err(|e| Error::input_file(path, e))?;
         let mut buf = vec![0; reader.output_buffer_size()];
-        let info = reader.next_frame(&mut buf).map_err(|e| Error::input_file(path, e))?;
+        let info = reader
+            .next_frame(&mut buf)
+            .map_err(|e| Error::input_file(path, e))?;
         let ch = match info.color_type {
             png::ColorType::Rgb => 3,
             png::ColorType::Rgba => 4,
             png::ColorType::Grayscale => 1,
             png::ColorType::GrayscaleAlpha => 2,
-            other => return Err(Error::input_file(path, format!("unsupported PNG colour type {other:?}"))),
+            other => {
+                return Err(Error::input_file(
+                    path,
+                    format!("unsupported PNG colour type {other:?}"),
+                ))
+            }
         };
         let rgb = buf[..info.buffer_size()]
             .chunks_exact(ch)
@@ -82,14 +103,24 @@ impl Image {
                 [g(0), g(1), g(2)]
             })
             .collect();
-        Ok(Image { width: info.width, height: info.height, rgb })
+        Ok(Image {
+            width: info.width,
+            height: info.height,
+            rgb,
+        })
     }
 
     /// Mean and standard deviation of all channels (a blank-image check).
     pub fn mean_sd(&self) -> (f64, f64) {
         let n = (self.rgb.len() * 3).max(1) as f64;
         let mean = self.rgb.iter().flatten().map(|&v| v as f64).sum::<f64>() / n;
-        let var = self.rgb.iter().flatten().map(|&v| (v as f64 - mean).powi(2)).sum::<f64>() / n;
+        let var = self
+            .rgb
+            .iter()
+            .flatten()
+            .map(|&v| (v as f64 - mean).powi(2))
+            .sum::<f64>()
+            / n;
         (mean, var.sqrt())
     }
 }
@@ -105,7 +136,11 @@ pub struct ColourDiff {
 
 impl std::fmt::Display for ColourDiff {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "CIEDE2000 mean {:.3} p99 {:.3} max {:.3} over {} px", self.mean, self.p99, self.max, self.pixels)
+        write!(
+            f,
+            "CIEDE2000 mean {:.3} p99 {:.3} max {:.3} over {} px",
+            self.mean, self.p99, self.max, self.pixels
+        )
     }
 }
 
@@ -122,14 +157,28 @@ pub fn compare(a: &Image, b: &Image) -> Result<ColourDiff> {
             a.width, a.height, b.width, b.height
         )));
     }
-    let mut d: Vec<f64> =
-        a.rgb.iter().zip(&b.rgb).map(|(p, q)| colour::ciede2000_xyz(display_to_xyz(*p), display_to_xyz(*q))).collect();
+    let mut d: Vec<f64> = a
+        .rgb
+        .iter()
+        .zip(&b.rgb)
+        .map(|(p, q)| colour::ciede2000_xyz(display_to_xyz(*p), display_to_xyz(*q)))
+        .collect();
     let n = d.len();
     if n == 0 {
-        return Ok(ColourDiff { mean: 0.0, p99: 0.0, max: 0.0, pixels: 0 });
+        return Ok(ColourDiff {
+            mean: 0.0,
+            p99: 0.0,
+            max: 0.0,
+            pixels: 0,
+        });
     }
     let mean = d.iter().sum::<f64>() / n as f64;
     d.sort_by(|x, y| x.total_cmp(y));
     let p99 = d[((n as f64 * 0.99).ceil() as usize).clamp(1, n) - 1];
-    Ok(ColourDiff { mean, p99, max: d[n - 1], pixels: n })
+    Ok(ColourDiff {
+        mean,
+        p99,
+        max: d[n - 1],
+        pixels: n,
+    })
 }

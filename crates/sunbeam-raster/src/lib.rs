@@ -47,7 +47,12 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Options { lambda_samples: None, curve: ToneCurve::default(), threads: 0, size: None }
+        Options {
+            lambda_samples: None,
+            curve: ToneCurve::default(),
+            threads: 0,
+            size: None,
+        }
     }
 }
 
@@ -80,7 +85,13 @@ pub fn load_mesh(path: &Path) -> Result<Mesh> {
         .zip(&tm.tangents)
         .map(|(o, t)| [o[0], o[1], o[2], if t[3] < 0.0 { -1.0 } else { 1.0 }])
         .collect();
-    let m = Mesh { positions: tm.positions, normals: tm.normals, uvs: tm.uvs, tangents, indices: tm.indices };
+    let m = Mesh {
+        positions: tm.positions,
+        normals: tm.normals,
+        uvs: tm.uvs,
+        tangents,
+        indices: tm.indices,
+    };
     m.check().map_err(|e| Error::input_file(path, e))?;
     Ok(m)
 }
@@ -107,7 +118,9 @@ pub fn prepare(scene: &Scene) -> Result<Prepared> {
         let mesh = match mesh_cache.iter().find(|(p, _)| *p == mi.mesh) {
             Some((_, m)) => m.clone(),
             None => {
-                let m = Arc::new(load_mesh(&mi.mesh).map_err(|e| e.context(format!("meshes[{i}].mesh")))?);
+                let m = Arc::new(
+                    load_mesh(&mi.mesh).map_err(|e| e.context(format!("meshes[{i}].mesh")))?,
+                );
                 mesh_cache.push((mi.mesh.clone(), m.clone()));
                 m
             }
@@ -117,18 +130,32 @@ pub fn prepare(scene: &Scene) -> Result<Prepared> {
             Some(pp) => Some(match pack_cache.iter().find(|(p, _)| p == pp) {
                 Some((_, k)) => k.clone(),
                 None => {
-                    let k = Arc::new(Pack::read(pp).map_err(|e| e.context(format!("meshes[{i}].pack")))?);
+                    let k = Arc::new(
+                        Pack::read(pp).map_err(|e| e.context(format!("meshes[{i}].pack")))?,
+                    );
                     pack_cache.push((pp.clone(), k.clone()));
                     k
                 }
             }),
         };
         if !(mi.diffuse_weight.is_finite() && (0.0..=1.0).contains(&mi.diffuse_weight)) {
-            return Err(Error::input(format!("meshes[{i}].diffuse_weight must be in [0, 1]")));
+            return Err(Error::input(format!(
+                "meshes[{i}].diffuse_weight must be in [0, 1]"
+            )));
         }
-        meshes.push((mesh, Material { pack, base_color: mi.base_color, diffuse_weight: mi.diffuse_weight }));
+        meshes.push((
+            mesh,
+            Material {
+                pack,
+                base_color: mi.base_color,
+                diffuse_weight: mi.diffuse_weight,
+            },
+        ));
     }
-    Ok(Prepared { scene: scene.clone(), meshes })
+    Ok(Prepared {
+        scene: scene.clone(),
+        meshes,
+    })
 }
 
 /// Render a scene with the reference settings (`Options::default()`).
@@ -154,7 +181,8 @@ pub fn render_prepared(p: &Prepared, opts: &Options) -> Image {
     };
     let mut rgb = vec![[0.0f32; 3]; (w as usize) * (h as usize)];
     let rows: Vec<&mut [[f32; 3]]> = rgb.chunks_mut(w as usize).collect();
-    let mut per_thread: Vec<Vec<(usize, &mut [[f32; 3]])>> = (0..threads).map(|_| Vec::new()).collect();
+    let mut per_thread: Vec<Vec<(usize, &mut [[f32; 3]])>> =
+        (0..threads).map(|_| Vec::new()).collect();
     for (j, row) in rows.into_iter().enumerate() {
         per_thread[j % threads].push((j, row));
     }
@@ -172,5 +200,9 @@ pub fn render_prepared(p: &Prepared, opts: &Options) -> Image {
             });
         }
     });
-    Image { width: w, height: h, rgb }
+    Image {
+        width: w,
+        height: h,
+        rgb,
+    }
 }

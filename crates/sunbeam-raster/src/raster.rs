@@ -58,13 +58,21 @@ fn clip_near(tri: [ClipVert; 3]) -> Vec<[ClipVert; 3]> {
             poly.push(lerp_cv(a, b, s));
         }
     }
-    (1..poly.len().saturating_sub(1)).map(|k| [poly[0], poly[k], poly[k + 1]]).collect()
+    (1..poly.len().saturating_sub(1))
+        .map(|k| [poly[0], poly[k], poly[k + 1]])
+        .collect()
 }
 
 /// Rasterise every mesh of a prepared scene into a `w x h` G-buffer (row 0 at the top).
 pub fn rasterise(p: &Prepared, w: u32, h: u32) -> Vec<Fragment> {
     let vp = p.scene.camera.view_proj(w, h);
-    let mut buf = vec![Fragment { depth: f64::INFINITY, ..Default::default() }; (w as usize) * (h as usize)];
+    let mut buf = vec![
+        Fragment {
+            depth: f64::INFINITY,
+            ..Default::default()
+        };
+        (w as usize) * (h as usize)
+    ];
     for (mi, (mesh, _)) in p.meshes.iter().enumerate() {
         let clip: Vec<[f64; 4]> = mesh
             .positions
@@ -76,7 +84,10 @@ pub fn rasterise(p: &Prepared, w: u32, h: u32) -> Vec<Fragment> {
             let cv = [0, 1, 2].map(|k| {
                 let mut bary = [0.0; 3];
                 bary[k] = 1.0;
-                ClipVert { c: clip[idx[k]], bary }
+                ClipVert {
+                    c: clip[idx[k]],
+                    bary,
+                }
             });
             for t in clip_near(cv) {
                 raster_triangle(&mut buf, w, h, mi as u32, mesh, idx, &t, &vp);
@@ -102,19 +113,26 @@ fn raster_triangle(
     t: &[ClipVert; 3],
     _vp: &Mat4,
 ) {
-    if t.iter().any(|v| !(v.c[3] > 0.0) || v.c.iter().any(|x| !x.is_finite())) {
+    if t.iter()
+        .any(|v| !(v.c[3] > 0.0) || v.c.iter().any(|x| !x.is_finite()))
+    {
         return;
     }
     // Screen position (y down), snapped to 1/256 pixel.
     let scr: [[i64; 2]; 3] = t.map(|v| {
         let x = (v.c[0] / v.c[3] * 0.5 + 0.5) * w as f64;
         let y = (0.5 - v.c[1] / v.c[3] * 0.5) * h as f64;
-        [(x * ONE as f64).round() as i64, (y * ONE as f64).round() as i64]
+        [
+            (x * ONE as f64).round() as i64,
+            (y * ONE as f64).round() as i64,
+        ]
     });
     let zs: [f64; 3] = t.map(|v| v.c[2] / v.c[3]);
     let inv_w: [f64; 3] = t.map(|v| 1.0 / v.c[3]);
     // Signed area in y-down coordinates: front faces (counter-clockwise in NDC) are negative.
-    let area = |a: [i64; 2], b: [i64; 2], c: [i64; 2]| (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+    let area = |a: [i64; 2], b: [i64; 2], c: [i64; 2]| {
+        (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+    };
     let a = area(scr[0], scr[1], scr[2]);
     if a >= 0 {
         return; // back face or degenerate: culled
@@ -123,7 +141,9 @@ fn raster_triangle(
     let order = [0usize, 2, 1];
     let s = order.map(|k| scr[k]);
     let area2 = -a;
-    let edge = |p: [i64; 2], q: [i64; 2], x: i64, y: i64| (q[0] - p[0]) * (y - p[1]) - (q[1] - p[1]) * (x - p[0]);
+    let edge = |p: [i64; 2], q: [i64; 2], x: i64, y: i64| {
+        (q[0] - p[0]) * (y - p[1]) - (q[1] - p[1]) * (x - p[0])
+    };
     // Top-left rule: an edge p->q owns its own pixels when it is a top edge
     // (horizontal, interior below) or a left edge (interior to the right).
     let owns = |p: [i64; 2], q: [i64; 2]| {
@@ -150,7 +170,11 @@ fn raster_triangle(
                 continue;
             }
             // Screen-space barycentrics of s[0], s[1], s[2] -> original order t[0], t[2], t[1].
-            let l_s = [e[0] as f64 / area2 as f64, e[1] as f64 / area2 as f64, e[2] as f64 / area2 as f64];
+            let l_s = [
+                e[0] as f64 / area2 as f64,
+                e[1] as f64 / area2 as f64,
+                e[2] as f64 / area2 as f64,
+            ];
             let mut l = [0.0; 3];
             for k in 0..3 {
                 l[order[k]] = l_s[k];
@@ -175,7 +199,11 @@ fn raster_triangle(
             let attr = |v: &Vec<[f32; 3]>| -> [f64; 3] {
                 [0, 1, 2].map(|c| (0..3).map(|o| bo[o] * v[idx[o]][c] as f64).sum())
             };
-            let tang: [f64; 3] = [0, 1, 2].map(|c| (0..3).map(|o| bo[o] * mesh.tangents[idx[o]][c] as f64).sum());
+            let tang: [f64; 3] = [0, 1, 2].map(|c| {
+                (0..3)
+                    .map(|o| bo[o] * mesh.tangents[idx[o]][c] as f64)
+                    .sum()
+            });
             *pix = Fragment {
                 mesh: Some(mi),
                 pos: attr(&mesh.positions),

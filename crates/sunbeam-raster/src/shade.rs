@@ -21,7 +21,11 @@ pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 pub(crate) fn normalize(a: [f64; 3]) -> Option<[f64; 3]> {
     let l = dot(a, a).sqrt();
@@ -32,9 +36,18 @@ pub(crate) fn normalize(a: [f64; 3]) -> Option<[f64; 3]> {
 pub fn frame(normal: [f64; 3], tangent: [f64; 3]) -> Option<([f64; 3], [f64; 3], [f64; 3])> {
     let n = normalize(normal)?;
     let d = dot(n, tangent);
-    let t = normalize([tangent[0] - d * n[0], tangent[1] - d * n[1], tangent[2] - d * n[2]]).or_else(|| {
+    let t = normalize([
+        tangent[0] - d * n[0],
+        tangent[1] - d * n[1],
+        tangent[2] - d * n[2],
+    ])
+    .or_else(|| {
         // no usable orientation: any perpendicular (the mesh loader never gives this)
-        let a = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+        let a = if n[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
         let d = dot(n, a);
         normalize([a[0] - d * n[0], a[1] - d * n[1], a[2] - d * n[2]])
     })?;
@@ -52,14 +65,21 @@ impl<'a> Shader<'a> {
     pub fn new(p: &'a Prepared, opts: &Options) -> Shader<'a> {
         Shader {
             p,
-            samples: opts.lambda_samples.map(|n| Samples::uniform(n, cie::DEFAULT_RANGE_NM)),
-            tone: ToneMap { exposure_ev: p.scene.exposure, curve: opts.curve },
+            samples: opts
+                .lambda_samples
+                .map(|n| Samples::uniform(n, cie::DEFAULT_RANGE_NM)),
+            tone: ToneMap {
+                exposure_ev: p.scene.exposure,
+                curve: opts.curve,
+            },
         }
     }
 
     /// Diffraction XYZ of mesh `mi` for local directions (before the light's intensity).
     pub fn diffraction_xyz(&self, mi: usize, wi: [f64; 3], wr: [f64; 3]) -> [f64; 3] {
-        let Some(pack) = &self.p.meshes[mi].1.pack else { return [0.0; 3] };
+        let Some(pack) = &self.p.meshes[mi].1.pack else {
+            return [0.0; 3];
+        };
         if !(wi[2] > 0.0 && wr[2] > 0.0) {
             return [0.0; 3];
         }
@@ -75,20 +95,30 @@ impl<'a> Shader<'a> {
 
     /// Linear sRGB radiance of a fragment (the background colour for none).
     pub fn linear(&self, f: &Fragment) -> [f64; 3] {
-        let Some(mi) = f.mesh else { return self.p.scene.background };
+        let Some(mi) = f.mesh else {
+            return self.p.scene.background;
+        };
         let mi = mi as usize;
         let mat = &self.p.meshes[mi].1;
-        let Some((t, b, n)) = frame(f.normal, f.tangent) else { return [0.0; 3] };
+        let Some((t, b, n)) = frame(f.normal, f.tangent) else {
+            return [0.0; 3];
+        };
         let eye = self.p.scene.camera.eye;
         let Some(wr) = normalize([eye[0] - f.pos[0], eye[1] - f.pos[1], eye[2] - f.pos[2]]) else {
             return [0.0; 3];
         };
         let local = |d: [f64; 3]| [dot(d, t), dot(d, b), dot(d, n)];
         let wr_l = local(wr);
-        let dw = if mat.pack.is_some() { mat.diffuse_weight } else { 1.0 };
+        let dw = if mat.pack.is_some() {
+            mat.diffuse_weight
+        } else {
+            1.0
+        };
         let mut rgb = [0.0; 3];
         for light in &self.p.scene.lights {
-            let Some(wi) = normalize(light.direction) else { continue };
+            let Some(wi) = normalize(light.direction) else {
+                continue;
+            };
             let wi_l = local(wi);
             let cos_i = wi_l[2].max(0.0);
             let diff = if dw < 1.0 {

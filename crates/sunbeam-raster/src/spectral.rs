@@ -47,7 +47,14 @@ impl Samples {
             .collect();
         let norm: f64 = raw.iter().map(|r| r.1[1]).sum();
         let inv = if norm > 0.0 { 1.0 / norm } else { 0.0 };
-        Samples(raw.into_iter().map(|(l, w)| Sample { lambda_m: l, weight: w.map(|v| v * inv) }).collect())
+        Samples(
+            raw.into_iter()
+                .map(|(l, w)| Sample {
+                    lambda_m: l,
+                    weight: w.map(|v| v * inv),
+                })
+                .collect(),
+        )
     }
 
     /// `sum_j R(l_j) weight_j`.

@@ -20,7 +20,10 @@ fn lambert_quad_centre_and_coverage() {
     let want = [0.5 * cos_i, 0.25 * cos_i, 0.125 * cos_i].map(colour::srgb_oetf);
     let got = img.pixel(32, 32);
     for k in 0..3 {
-        assert!((got[k] as f64 - want[k]).abs() < 1e-6, "{got:?} vs {want:?}");
+        assert!(
+            (got[k] as f64 - want[k]).abs() < 1e-6,
+            "{got:?} vs {want:?}"
+        );
     }
     // Coverage: the quad's projected area in pixels (square, centred) within one pixel row/column.
     let mut p = p;
@@ -30,12 +33,22 @@ fn lambert_quad_centre_and_coverage() {
     let d = (p.scene.camera.eye[2] - 0.0).abs();
     let half = 0.5 / d / (scene.camera.fov_y_deg.to_radians() / 2.0).tan() * 32.0; // half side in pixels
     let side = 2.0 * half;
-    assert!((covered - side * side).abs() <= 2.0 * side + 2.0, "{covered} px vs {}", side * side);
+    assert!(
+        (covered - side * side).abs() <= 2.0 * side + 2.0,
+        "{covered} px vs {}",
+        side * side
+    );
     // Symmetric about the centre lines.
     for j in 0..64 {
         for i in 0..64 {
-            assert_eq!(g[j * 64 + i].mesh.is_some(), g[j * 64 + 63 - i].mesh.is_some());
-            assert_eq!(g[j * 64 + i].mesh.is_some(), g[(63 - j) * 64 + i].mesh.is_some());
+            assert_eq!(
+                g[j * 64 + i].mesh.is_some(),
+                g[j * 64 + 63 - i].mesh.is_some()
+            );
+            assert_eq!(
+                g[j * 64 + i].mesh.is_some(),
+                g[(63 - j) * 64 + i].mesh.is_some()
+            );
         }
     }
 }
@@ -49,7 +62,11 @@ fn sphere_back_faces_are_hidden_and_depth_is_front_most() {
     for f in g.iter().filter(|f| f.mesh.is_some()) {
         // every visible point faces the camera (front hemisphere)
         let v = [eye[0] - f.pos[0], eye[1] - f.pos[1], eye[2] - f.pos[2]];
-        assert!(v[0] * f.pos[0] + v[1] * f.pos[1] + v[2] * f.pos[2] > -1e-3, "{:?}", f.pos);
+        assert!(
+            v[0] * f.pos[0] + v[1] * f.pos[1] + v[2] * f.pos[2] > -1e-3,
+            "{:?}",
+            f.pos
+        );
         let r = (f.pos[0].powi(2) + f.pos[1].powi(2) + f.pos[2].powi(2)).sqrt();
         assert!((r - 0.5).abs() < 2e-3);
     }
@@ -60,7 +77,9 @@ fn sphere_back_faces_are_hidden_and_depth_is_front_most() {
 /// the gain must all agree for this to hold.
 #[test]
 fn blazed_quad_pixels_match_ground_truth() {
-    let Some(dir) = sunbeam_common::testdata::shared_file("snake/BlazingBump.bmp") else { return };
+    let Some(dir) = sunbeam_common::testdata::shared_file("snake/BlazingBump.bmp") else {
+        return;
+    };
     let dir = dir.parent().unwrap().to_path_buf();
     let opts = sunbeam_pack::build::BuildOptions::default();
     let pack = Arc::new(fixtures::pack(&fixtures::BLAZED, &dir, &opts).unwrap());
@@ -73,7 +92,15 @@ fn blazed_quad_pixels_match_ground_truth() {
     let truth = Truth::new(&field, &Params::default()).unwrap();
     let mut worst: f64 = 0.0;
     let mut bright = 0;
-    for &(i, j) in &[(20usize, 20usize), (5, 20), (35, 20), (12, 19), (28, 21), (20, 8), (8, 30)] {
+    for &(i, j) in &[
+        (20usize, 20usize),
+        (5, 20),
+        (35, 20),
+        (12, 19),
+        (28, 21),
+        (20, 8),
+        (8, 30),
+    ] {
         let f = &g[j * 40 + i];
         assert!(f.mesh.is_some());
         let (t, b, n) = shade::frame(f.normal, f.tangent).unwrap();
@@ -87,11 +114,21 @@ fn blazed_quad_pixels_match_ground_truth() {
             bright += 1;
         }
         let de = colour::ciede2000_xyz(ours, want);
-        eprintln!("({i},{j}) wi {:?} wr {:?}: ours {ours:?} truth {want:?} dE {de:.3}", loc(wi), loc(wr));
+        eprintln!(
+            "({i},{j}) wi {:?} wr {:?}: ours {ours:?} truth {want:?} dE {de:.3}",
+            loc(wi),
+            loc(wr)
+        );
         worst = worst.max(de);
-        assert!(de < 1.0 || want[1] < 1e-4, "pixel ({i},{j}): {ours:?} vs truth {want:?}, dE {de}");
+        assert!(
+            de < 1.0 || want[1] < 1e-4,
+            "pixel ({i},{j}): {ours:?} vs truth {want:?}, dE {de}"
+        );
     }
-    assert!(bright >= 3, "the test scene should show the grating's orders");
+    assert!(
+        bright >= 3,
+        "the test scene should show the grating's orders"
+    );
     eprintln!("worst CIEDE2000 against the ground truth: {worst:.3}");
 }
 

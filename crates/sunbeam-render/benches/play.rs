@@ -12,7 +12,10 @@ use sunbeam_raster::{fixtures, Options, Prepared};
 use sunbeam_render::{Gpu, Mode, Settings};
 
 fn env_u32(k: &str, d: u32) -> u32 {
-    std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d)
+    std::env::var(k)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(d)
 }
 
 fn main() {
@@ -23,8 +26,11 @@ fn main() {
     let err_size = env_u32("PLAY_BENCH_ERR_SIZE", 256);
     let frames = env_u32("PLAY_BENCH_FRAMES", 5);
     let scenes = std::env::var("PLAY_BENCH_SCENES").unwrap_or_else(|_| "sphere,snake,quad".into());
-    let modes = std::env::var("PLAY_BENCH_MODES").unwrap_or_else(|_| "default,thesis,lambert,direct".into());
-    let Some(data) = sunbeam_common::testdata::shared_file("snake/BlazingBump.bmp") else { return };
+    let modes = std::env::var("PLAY_BENCH_MODES")
+        .unwrap_or_else(|_| "default,thesis,lambert,direct".into());
+    let Some(data) = sunbeam_common::testdata::shared_file("snake/BlazingBump.bmp") else {
+        return;
+    };
     let dir = data.parent().unwrap().to_path_buf();
     let gpu = Gpu::headless(Default::default()).expect("GPU adapter");
     println!("adapter: {}", gpu.describe());
@@ -38,21 +44,45 @@ fn main() {
             other => panic!("unknown scene {other}"),
         };
         let cheb = Arc::new(fixtures::pack(&patch, &dir, &BuildOptions::default()).unwrap());
-        let thesis_opts = BuildOptions { basis: Basis::Taylor, model: Model::Tiled, terms: Some(39), ..Default::default() };
+        let thesis_opts = BuildOptions {
+            basis: Basis::Taylor,
+            model: Model::Tiled,
+            terms: Some(39),
+            ..Default::default()
+        };
         let taylor = Arc::new(fixtures::pack(&patch, &dir, &thesis_opts).unwrap());
         let p_main = fixtures::prepared(scene.clone(), mesh.clone(), Some(cheb.clone()));
         let p_thesis = fixtures::prepared(scene.clone(), mesh.clone(), Some(taylor.clone()));
         let t = Instant::now();
-        let reference = sunbeam_raster::render_prepared(&p_main, &Options { size: Some([err_size, err_size]), ..Default::default() });
-        eprintln!("{sc}: CPU reference {err_size}x{err_size} in {:.1?}", t.elapsed());
+        let reference = sunbeam_raster::render_prepared(
+            &p_main,
+            &Options {
+                size: Some([err_size, err_size]),
+                ..Default::default()
+            },
+        );
+        eprintln!(
+            "{sc}: CPU reference {err_size}x{err_size} in {:.1?}",
+            t.elapsed()
+        );
         let mut thesis_ms = None;
         let mut rows = Vec::new();
         for m in modes.split(',') {
             let mode: Mode = m.parse().unwrap();
-            let p: &Prepared = if mode == Mode::Thesis { &p_thesis } else { &p_main };
-            let st = Settings { mode, ..Default::default() };
-            let (times, _) = sunbeam_render::bench_headless(&gpu, p, &st, [size, size], frames).unwrap();
-            let small = sunbeam_render::render_headless(&gpu, p, &st, Some([err_size, err_size]), 1).unwrap();
+            let p: &Prepared = if mode == Mode::Thesis {
+                &p_thesis
+            } else {
+                &p_main
+            };
+            let st = Settings {
+                mode,
+                ..Default::default()
+            };
+            let (times, _) =
+                sunbeam_render::bench_headless(&gpu, p, &st, [size, size], frames).unwrap();
+            let small =
+                sunbeam_render::render_headless(&gpu, p, &st, Some([err_size, err_size]), 1)
+                    .unwrap();
             let d = sunbeam_raster::compare(&small, &reference).unwrap();
             let med = times.median_ms();
             if mode == Mode::Thesis {
@@ -65,11 +95,21 @@ fn main() {
             } else {
                 format!("chebyshev/window {} terms", cheb.manifest.terms)
             };
-            rows.push((sc.to_string(), m.to_string(), pk, times.setup_ms, times.first_ms, med, d));
+            rows.push((
+                sc.to_string(),
+                m.to_string(),
+                pk,
+                times.setup_ms,
+                times.first_ms,
+                med,
+                d,
+            ));
             eprintln!("{sc} {m}: median {med:.1} ms, {d}");
         }
         for (sc, m, pk, setup, first, med, d) in rows {
-            let ratio = thesis_ms.map(|t| format!("{:.1}x", t / med)).unwrap_or_else(|| "-".into());
+            let ratio = thesis_ms
+                .map(|t| format!("{:.1}x", t / med))
+                .unwrap_or_else(|| "-".into());
             println!(
                 "| {sc} | {m} | {pk} | {setup:.0} | {first:.1} | {med:.1} | {ratio} | {:.3} / {:.3} |",
                 d.mean, d.p99

@@ -21,7 +21,9 @@ impl std::str::FromStr for Backend {
             "auto" => Ok(Backend::Auto),
             "vulkan" | "vk" => Ok(Backend::Vulkan),
             "gl" | "gles" | "opengl" => Ok(Backend::Gl),
-            _ => Err(Error::usage(format!("unknown backend '{s}' (vulkan, gl, auto)"))),
+            _ => Err(Error::usage(format!(
+                "unknown backend '{s}' (vulkan, gl, auto)"
+            ))),
         }
     }
 }
@@ -82,18 +84,31 @@ impl Gpu {
                 v.push(e.to_string());
             }
         }));
-        Ok(Gpu { instance, adapter, device, queue, errors })
+        Ok(Gpu {
+            instance,
+            adapter,
+            device,
+            queue,
+            errors,
+        })
     }
 
     /// One line naming the adapter, driver and backend.
     pub fn describe(&self) -> String {
         let i = self.adapter.get_info();
-        format!("{} ({:?}, {} {}, {:?})", i.name, i.backend, i.driver, i.driver_info, i.device_type)
+        format!(
+            "{} ({:?}, {} {}, {:?})",
+            i.name, i.backend, i.driver, i.driver_info, i.device_type
+        )
     }
 
     /// Errors wgpu reported since the last call (validation errors are bugs: exit 4).
     pub fn take_errors(&self) -> Result<()> {
-        let v: Vec<String> = self.errors.lock().map(|mut v| std::mem::take(&mut *v)).unwrap_or_default();
+        let v: Vec<String> = self
+            .errors
+            .lock()
+            .map(|mut v| std::mem::take(&mut *v))
+            .unwrap_or_default();
         if v.is_empty() {
             Ok(())
         } else {

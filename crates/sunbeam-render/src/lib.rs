@@ -98,5 +98,12 @@ pub fn bench_headless(
     }
     let img = target.render(gpu, &r, &state)?;
     let first_ms = times[0];
-    Ok((FrameTimes { setup_ms, first_ms, rest_ms: times[1..].to_vec() }, img))
+    Ok((
+        FrameTimes {
+            setup_ms,
+            first_ms,
+            rest_ms: times[1..].to_vec(),
+        },
+        img,
+    ))
 }

@@ -48,7 +48,9 @@ impl std::str::FromStr for Mode {
             "direct" => Ok(Mode::Direct),
             "thesis" => Ok(Mode::Thesis),
             "lambert" => Ok(Mode::Lambert),
-            _ => Err(Error::usage(format!("unknown mode '{s}' (default, direct, thesis, lambert)"))),
+            _ => Err(Error::usage(format!(
+                "unknown mode '{s}' (default, direct, thesis, lambert)"
+            ))),
         }
     }
 }
@@ -210,7 +212,12 @@ pub struct Renderer {
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 impl Renderer {
-    pub fn new(gpu: &Gpu, p: &Prepared, settings: &Settings, format: wgpu::TextureFormat) -> Result<Renderer> {
+    pub fn new(
+        gpu: &Gpu,
+        p: &Prepared,
+        settings: &Settings,
+        format: wgpu::TextureFormat,
+    ) -> Result<Renderer> {
         let device = &gpu.device;
         let mut warnings = Vec::new();
         let samples = match settings.mode {
@@ -220,9 +227,20 @@ impl Renderer {
         let spec: Vec<[f32; 4]> = samples
             .0
             .iter()
-            .map(|s| [s.weight[0] as f32, s.weight[1] as f32, s.weight[2] as f32, (1e-6 / s.lambda_m) as f32])
+            .map(|s| {
+                [
+                    s.weight[0] as f32,
+                    s.weight[1] as f32,
+                    s.weight[2] as f32,
+                    (1e-6 / s.lambda_m) as f32,
+                ]
+            })
             .collect();
-        let lambda_min = samples.0.iter().map(|s| s.lambda_m).fold(f64::INFINITY, f64::min);
+        let lambda_min = samples
+            .0
+            .iter()
+            .map(|s| s.lambda_m)
+            .fold(f64::INFINITY, f64::min);
         let spectrum = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("spectrum"),
             contents: bytemuck::cast_slice(&spec),
@@ -260,14 +278,25 @@ impl Renderer {
         });
         let gl1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("material"),
-            entries: &[uniform_entry(0), storage_entry(1), storage_entry(2), storage_entry(3)],
+            entries: &[
+                uniform_entry(0),
+                storage_entry(1),
+                storage_entry(2),
+                storage_entry(3),
+            ],
         });
         let global_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("globals"),
             layout: &gl0,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: spectrum.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: globals.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: spectrum.as_entire_binding(),
+                },
             ],
         });
 
@@ -277,16 +306,28 @@ impl Renderer {
         let mut meshes = Vec::new();
         for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
             let verts: Vec<Vertex> = (0..mesh.positions.len())
-                .map(|i| Vertex { pos: mesh.positions[i], normal: mesh.normals[i], tangent: mesh.tangents[i] })
+                .map(|i| Vertex {
+                    pos: mesh.positions[i],
+                    normal: mesh.normals[i],
+                    tangent: mesh.tangents[i],
+                })
                 .collect();
             let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("vertices"),
-                contents: bytemuck::cast_slice(if verts.is_empty() { &[Vertex::zeroed()][..] } else { &verts }),
+                contents: bytemuck::cast_slice(if verts.is_empty() {
+                    &[Vertex::zeroed()][..]
+                } else {
+                    &verts
+                }),
                 usage: wgpu::BufferUsages::VERTEX,
             });
             let ibuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("indices"),
-                contents: bytemuck::cast_slice(if mesh.indices.is_empty() { &[0u32][..] } else { &mesh.indices }),
+                contents: bytemuck::cast_slice(if mesh.indices.is_empty() {
+                    &[0u32][..]
+                } else {
+                    &mesh.indices
+                }),
                 usage: wgpu::BufferUsages::INDEX,
             });
             let mut mu = MaterialU {
@@ -333,11 +374,13 @@ impl Renderer {
                                     max_binding >> 20
                                 )));
                             }
-                            let b = Arc::new(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                                label: Some("terms"),
-                                contents: bytemuck::cast_slice(&pack.terms[..n]),
-                                usage: wgpu::BufferUsages::STORAGE,
-                            }));
+                            let b = Arc::new(device.create_buffer_init(
+                                &wgpu::util::BufferInitDescriptor {
+                                    label: Some("terms"),
+                                    contents: bytemuck::cast_slice(&pack.terms[..n]),
+                                    usage: wgpu::BufferUsages::STORAGE,
+                                },
+                            ));
                             pack_bufs.push((key, b.clone(), used));
                             b
                         }
@@ -346,7 +389,9 @@ impl Renderer {
                     let t_max = 4.0 * std::f64::consts::PI * h / lambda_min;
                     let tol = settings
                         .term_tolerance
-                        .unwrap_or_else(|| m.error.tolerance.unwrap_or(0.0).max(m.error.series_bound))
+                        .unwrap_or_else(|| {
+                            m.error.tolerance.unwrap_or(0.0).max(m.error.series_bound)
+                        })
                         .max(1e-12);
                     let (table, dt) = term_table(pack, t_max, tol);
                     let w = m.kernel.taps as f64;
@@ -365,14 +410,24 @@ impl Renderer {
                     mu.kx = m.crop.kx as i32;
                     mu.ky = m.crop.ky as i32;
                     mu.terms = used as u32;
-                    mu.fixed_terms = if settings.mode == Mode::Thesis { THESIS_TERMS } else { 0 };
+                    mu.fixed_terms = if settings.mode == Mode::Thesis {
+                        THESIS_TERMS
+                    } else {
+                        0
+                    };
                     mu.n_table = table.len() as u32;
-                    mu.bin_scale_um = [(m.bin_scale_m[0] * 1e-6) as f32, (m.bin_scale_m[1] * 1e-6) as f32];
+                    mu.bin_scale_um = [
+                        (m.bin_scale_m[0] * 1e-6) as f32,
+                        (m.bin_scale_m[1] * 1e-6) as f32,
+                    ];
                     mu.half_range_um = (h * 1e6) as f32;
                     mu.beta = m.kernel.beta as f32;
                     mu.sigma_bins = [m.kernel.sigma_bins[0] as f32, m.kernel.sigma_bins[1] as f32];
-                    mu.kb_norm =
-                        if m.kernel.beta > 0.0 { (m.kernel.beta / (w * m.kernel.beta.sinh())) as f32 } else { 0.0 };
+                    mu.kb_norm = if m.kernel.beta > 0.0 {
+                        (m.kernel.beta / (w * m.kernel.beta.sinh())) as f32
+                    } else {
+                        0.0
+                    };
                     mu.table_dt = dt as f32;
                     if settings.mode == Mode::Default {
                         let t0 = std::time::Instant::now();
@@ -382,7 +437,8 @@ impl Renderer {
                             tt[i] as usize
                         };
                         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-                        let rt = crate::table::build(pack, &samples, settings.table, &terms_at, threads);
+                        let rt =
+                            crate::table::build(pack, &samples, settings.table, &terms_at, threads);
                         let bytes = (rt.data.len() * 16) as u64;
                         if bytes > max_binding {
                             return Err(Error::input(format!(
@@ -406,11 +462,13 @@ impl Renderer {
                     (buf, table)
                 }
                 _ => (
-                    Arc::new(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("no terms"),
-                        contents: bytemuck::cast_slice(&[0.0f32; 4]),
-                        usage: wgpu::BufferUsages::STORAGE,
-                    })),
+                    Arc::new(
+                        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                            label: Some("no terms"),
+                            contents: bytemuck::cast_slice(&[0.0f32; 4]),
+                            usage: wgpu::BufferUsages::STORAGE,
+                        }),
+                    ),
                     vec![1u32],
                 ),
             };
@@ -434,13 +492,30 @@ impl Renderer {
                 label: Some("material"),
                 layout: &gl1,
                 entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: mbuf.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: terms_buf.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: tbuf.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: rbuf.as_entire_binding() },
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: mbuf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: terms_buf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: tbuf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: rbuf.as_entire_binding(),
+                    },
                 ],
             });
-            meshes.push(GpuMesh { vbuf, ibuf, count: mesh.indices.len() as u32, bind });
+            meshes.push(GpuMesh {
+                vbuf,
+                ibuf,
+                count: mesh.indices.len() as u32,
+                bind,
+            });
         }
 
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -484,13 +559,19 @@ impl Renderer {
                 module: &module,
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+                targets: &[Some(wgpu::ColorTargetState {
+                    format,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
             }),
             multiview_mask: None,
             cache: None,
         });
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(Error::internal(format!("shader/pipeline creation failed: {e}")));
+            return Err(Error::internal(format!(
+                "shader/pipeline creation failed: {e}"
+            )));
         }
         Ok(Renderer {
             pipeline,
@@ -515,17 +596,32 @@ impl Renderer {
             if !(len > 0.0 && len.is_finite()) {
                 continue;
             }
-            lights[n] = [(d[0] / len) as f32, (d[1] / len) as f32, (d[2] / len) as f32, l.intensity as f32];
+            lights[n] = [
+                (d[0] / len) as f32,
+                (d[1] / len) as f32,
+                (d[2] / len) as f32,
+                l.intensity as f32,
+            ];
             n += 1;
         }
         let m = colour::XYZ_TO_SRGB;
         let row = |r: usize| [m[r][0] as f32, m[r][1] as f32, m[r][2] as f32, 0.0];
         let g = Globals {
             view_proj: vp,
-            eye: [state.camera.eye[0] as f32, state.camera.eye[1] as f32, state.camera.eye[2] as f32, 1.0],
+            eye: [
+                state.camera.eye[0] as f32,
+                state.camera.eye[1] as f32,
+                state.camera.eye[2] as f32,
+                1.0,
+            ],
             lights,
             xyz_to_rgb: [row(0), row(1), row(2)],
-            background: [state.background[0] as f32, state.background[1] as f32, state.background[2] as f32, 1.0],
+            background: [
+                state.background[0] as f32,
+                state.background[1] as f32,
+                state.background[2] as f32,
+                1.0,
+            ],
             n_lights: n as u32,
             mode: match self.settings.mode {
                 Mode::Default => 0,
@@ -543,17 +639,26 @@ impl Renderer {
             f0: gain::f0(gain::DEFAULT_IOR) as f32,
             _pad: 0.0,
         };
-        gpu.queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
+        gpu.queue
+            .write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
     }
 
     /// The clear colour: the background through the display transform (linear for an sRGB target).
     pub fn clear_colour(&self, state: &FrameState) -> wgpu::Color {
-        let tm = ToneMap { exposure_ev: state.exposure, curve: self.settings.curve };
+        let tm = ToneMap {
+            exposure_ev: state.exposure,
+            curve: self.settings.curve,
+        };
         let mut e = colour::display_encode(state.background, &tm);
         if self.format.is_srgb() {
             e = e.map(colour::srgb_eotf);
         }
-        wgpu::Color { r: e[0], g: e[1], b: e[2], a: 1.0 }
+        wgpu::Color {
+            r: e[0],
+            g: e[1],
+            b: e[2],
+            a: 1.0,
+        }
     }
 
     /// Record a frame into `colour` (with `depth` of the same size).
@@ -570,11 +675,17 @@ impl Renderer {
                 view: colour,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(self.clear_colour(state)), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(self.clear_colour(state)),
+                    store: wgpu::StoreOp::Store,
+                },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: depth,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
                 stencil_ops: None,
             }),
             timestamp_writes: None,
@@ -600,7 +711,11 @@ pub fn depth_view(gpu: &Gpu, w: u32, h: u32) -> wgpu::TextureView {
     gpu.device
         .create_texture(&wgpu::TextureDescriptor {
             label: Some("depth"),
-            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -629,11 +744,17 @@ impl Offscreen {
     pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Offscreen> {
         let lim = gpu.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > lim || height > lim {
-            return Err(Error::usage(format!("size {width}x{height}: each side must be 1..{lim} on this GPU")));
+            return Err(Error::usage(format!(
+                "size {width}x{height}: each side must be 1..{lim} on this GPU"
+            )));
         }
         let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("frame"),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -649,7 +770,15 @@ impl Offscreen {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Ok(Offscreen { width, height, tex, view, depth: depth_view(gpu, width, height), readback, padded_row })
+        Ok(Offscreen {
+            width,
+            height,
+            tex,
+            view,
+            depth: depth_view(gpu, width, height),
+            readback,
+            padded_row,
+        })
     }
 
     /// Render one frame and wait for it (no readback).
@@ -677,13 +806,18 @@ impl Offscreen {
                     rows_per_image: None,
                 },
             },
-            wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
+            wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: 1,
+            },
         );
         gpu.queue.submit([enc.finish()]);
         let (tx, rx) = std::sync::mpsc::channel();
-        self.readback.map_async(wgpu::MapMode::Read, .., move |res| {
-            let _ = tx.send(res);
-        });
+        self.readback
+            .map_async(wgpu::MapMode::Read, .., move |res| {
+                let _ = tx.send(res);
+            });
         gpu.wait()?;
         rx.recv()
             .map_err(|e| Error::internal(format!("readback: {e}")))?
@@ -691,7 +825,10 @@ impl Offscreen {
         gpu.take_errors()?;
         let mut img = Image::new(self.width, self.height);
         {
-            let data = self.readback.get_mapped_range(..).map_err(|e| Error::internal(format!("readback: {e}")))?;
+            let data = self
+                .readback
+                .get_mapped_range(..)
+                .map_err(|e| Error::internal(format!("readback: {e}")))?;
             let px: &[f32] = bytemuck::cast_slice(&data);
             let stride = (self.padded_row / 4) as usize;
             for y in 0..self.height as usize {

@@ -24,7 +24,11 @@ pub struct Dims {
 
 impl Default for Dims {
     fn default() -> Self {
-        Dims { nu: 256, nv: 256, nw: 32 }
+        Dims {
+            nu: 256,
+            nv: 256,
+            nw: 32,
+        }
     }
 }
 
@@ -49,7 +53,13 @@ struct C {
 }
 
 /// Taps of one axis at `kappa`: first texel index and weights (0 outside the crop).
-fn taps(m: &sunbeam_pack::Manifest, kappa: f64, k_half: i64, axis: usize, w: &mut [f64]) -> (i64, bool) {
+fn taps(
+    m: &sunbeam_pack::Manifest,
+    kappa: f64,
+    k_half: i64,
+    axis: usize,
+    w: &mut [f64],
+) -> (i64, bool) {
     let n = m.kernel.taps;
     let k0 = kernel::first_tap(kappa, n);
     let mut any = false;
@@ -123,7 +133,10 @@ pub fn build(
                             }
                             *ai = match m.model {
                                 Model::Window => C { re, im },
-                                Model::Tiled => C { re: re * re + im * im, im: 0.0 },
+                                Model::Tiled => C {
+                                    re: re * re + im * im,
+                                    im: 0.0,
+                                },
                             };
                         }
                         // x pass
@@ -134,7 +147,13 @@ pub fn build(
                                 xok[iu] = false;
                                 continue;
                             }
-                            let (k0, any) = taps(m, kappa, m.crop.kx, 0, &mut wx[iu * ntaps..(iu + 1) * ntaps]);
+                            let (k0, any) = taps(
+                                m,
+                                kappa,
+                                m.crop.kx,
+                                0,
+                                &mut wx[iu * ntaps..(iu + 1) * ntaps],
+                            );
                             kx0[iu] = k0;
                             xok[iu] = any;
                         }
@@ -199,7 +218,13 @@ pub fn build(
             });
         }
     });
-    ResponseTable { dims: Dims { nu, nv, nw }, du, dv, dw, data }
+    ResponseTable {
+        dims: Dims { nu, nv, nw },
+        du,
+        dv,
+        dw,
+        data,
+    }
 }
 
 impl ResponseTable {

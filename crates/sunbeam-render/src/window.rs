@@ -46,9 +46,18 @@ struct Orbit {
 
 impl Orbit {
     fn from_camera(c: &sunbeam_scene::Camera) -> Orbit {
-        let d = [c.eye[0] - c.target[0], c.eye[1] - c.target[1], c.eye[2] - c.target[2]];
+        let d = [
+            c.eye[0] - c.target[0],
+            c.eye[1] - c.target[1],
+            c.eye[2] - c.target[2],
+        ];
         let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-9);
-        Orbit { yaw: d[0].atan2(d[2]), pitch: (d[1] / dist).clamp(-1.0, 1.0).asin(), dist, target: c.target }
+        Orbit {
+            yaw: d[0].atan2(d[2]),
+            pitch: (d[1] / dist).clamp(-1.0, 1.0).asin(),
+            dist,
+            target: c.target,
+        }
     }
     fn eye(&self) -> [f64; 3] {
         let (cp, sp) = (self.pitch.cos(), self.pitch.sin());
@@ -104,11 +113,16 @@ impl App {
             el.create_window(
                 Window::default_attributes()
                     .with_title(self.opts.title.clone())
-                    .with_inner_size(winit::dpi::PhysicalSize::new(self.opts.size[0], self.opts.size[1])),
+                    .with_inner_size(winit::dpi::PhysicalSize::new(
+                        self.opts.size[0],
+                        self.opts.size[1],
+                    )),
             )
             .map_err(|e| Error::internal(format!("cannot create a window: {e}")))?,
         );
-        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(el.owned_display_handle()));
+        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
+            el.owned_display_handle(),
+        ));
         desc.backends = self.opts.backend.backends();
         let instance = wgpu::Instance::new(desc);
         let surface = instance
@@ -128,7 +142,13 @@ impl App {
             .get_default_config(&gpu.adapter, size.width.max(1), size.height.max(1))
             .ok_or_else(|| Error::internal("the window surface is not supported by the adapter"))?;
         // Prefer a UNORM format: the shader writes display values itself.
-        if let Some(f) = caps.formats.iter().find(|f| !f.is_srgb() && matches!(f, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm)) {
+        if let Some(f) = caps.formats.iter().find(|f| {
+            !f.is_srgb()
+                && matches!(
+                    f,
+                    wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm
+                )
+        }) {
             config.format = *f;
         }
         config.present_mode = wgpu::PresentMode::Fifo;
@@ -141,18 +161,35 @@ impl App {
         for w in &renderer.warnings {
             eprintln!("sunbeam-play: warning: {w}");
         }
-        eprintln!("sunbeam-play: {} | surface {:?} {}x{}", gpu.describe(), config.format, config.width, config.height);
+        eprintln!(
+            "sunbeam-play: {} | surface {:?} {}x{}",
+            gpu.describe(),
+            config.format,
+            config.width,
+            config.height
+        );
         let depth = depth_view(&gpu, config.width, config.height);
         window.request_redraw();
-        self.gfx = Some(Gfx { window, surface, gpu, config, renderer, depth, can_copy });
+        self.gfx = Some(Gfx {
+            window,
+            surface,
+            gpu,
+            config,
+            renderer,
+            depth,
+            can_copy,
+        });
         Ok(())
     }
 
     fn redraw(&mut self, el: &ActiveEventLoop) -> Result<()> {
-        let Some(g) = self.gfx.as_mut() else { return Ok(()) };
+        let Some(g) = self.gfx.as_mut() else {
+            return Ok(());
+        };
         let t = Instant::now();
         let frame = match g.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
             _ => {
                 g.surface.configure(&g.gpu.device, &g.config);
                 g.window.request_redraw();
@@ -161,11 +198,16 @@ impl App {
         };
         let view = frame.texture.create_view(&Default::default());
         self.state.camera.eye = self.orbit.eye();
-        g.renderer.update(&g.gpu, &self.state, g.config.width, g.config.height);
+        g.renderer
+            .update(&g.gpu, &self.state, g.config.width, g.config.height);
         let mut enc = g.gpu.device.create_command_encoder(&Default::default());
         g.renderer.encode(&mut enc, &view, &g.depth, &self.state);
         let counted = self.opts.frames.is_some_and(|n| self.frame + 1 == n);
-        let shot = if counted && g.can_copy { self.opts.screenshot.as_ref() } else { None };
+        let shot = if counted && g.can_copy {
+            self.opts.screenshot.as_ref()
+        } else {
+            None
+        };
         let readback = shot.map(|_| {
             let (w, h) = (g.config.width, g.config.height);
             let row = (w * 4).div_ceil(256) * 256;
@@ -179,9 +221,17 @@ impl App {
                 frame.texture.as_image_copy(),
                 wgpu::TexelCopyBufferInfo {
                     buffer: &buf,
-                    layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(row),
+                        rows_per_image: None,
+                    },
                 },
-                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
             );
             (buf, row, w, h)
         });
@@ -193,8 +243,13 @@ impl App {
         if let (Some((buf, row, w, h)), Some(path)) = (readback, shot) {
             buf.map_async(wgpu::MapMode::Read, .., |_| {});
             g.gpu.wait()?;
-            let data = buf.get_mapped_range(..).map_err(|e| Error::internal(format!("screenshot: {e}")))?;
-            let bgra = matches!(g.config.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+            let data = buf
+                .get_mapped_range(..)
+                .map_err(|e| Error::internal(format!("screenshot: {e}")))?;
+            let bgra = matches!(
+                g.config.format,
+                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+            );
             let mut rgba = Vec::with_capacity((w * h * 4) as usize);
             for y in 0..h {
                 let r = &data[(y * row) as usize..(y * row + w * 4) as usize];
@@ -227,13 +282,18 @@ impl App {
         if counted {
             let rest = &self.times[1.min(self.times.len())..];
             let mean = rest.iter().sum::<f64>() / rest.len().max(1) as f64;
-            println!("window frames: n={} first={:.1} ms mean(rest)={:.2} ms", self.frame, self.times[0], mean);
+            println!(
+                "window frames: n={} first={:.1} ms mean(rest)={:.2} ms",
+                self.frame, self.times[0], mean
+            );
             self.done_at = Some(Instant::now());
         }
         match self.done_at {
             None => g.window.request_redraw(),
             Some(d) if d.elapsed() >= self.opts.hold => el.exit(),
-            Some(_) => el.set_control_flow(ControlFlow::WaitUntil(Instant::now() + Duration::from_millis(100))),
+            Some(_) => el.set_control_flow(ControlFlow::WaitUntil(
+                Instant::now() + Duration::from_millis(100),
+            )),
         }
         Ok(())
     }
@@ -357,7 +417,9 @@ pub fn run(prepared: Prepared, opts: WindowOptions) -> Result<()> {
         right: false,
         shift: false,
     };
-    event_loop.run_app(&mut app).map_err(|e| Error::internal(format!("event loop: {e}")))?;
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| Error::internal(format!("event loop: {e}")))?;
     match app.error {
         Some(e) => Err(e),
         None => Ok(()),

@@ -17,7 +17,11 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 fn normalize(a: [f64; 3]) -> [f64; 3] {
     let l = dot(a, a).sqrt();
@@ -51,7 +55,9 @@ pub fn transform(m: &Mat4, p: [f64; 4]) -> [f64; 4] {
 impl Camera {
     /// Near and far clip distances (see the module doc).
     pub fn near_far(&self) -> (f64, f64) {
-        let d = dot(sub(self.eye, self.target), sub(self.eye, self.target)).sqrt().max(1e-9);
+        let d = dot(sub(self.eye, self.target), sub(self.eye, self.target))
+            .sqrt()
+            .max(1e-9);
         (0.01 * d, 100.0 * d)
     }
 
@@ -61,7 +67,11 @@ impl Camera {
         let mut up = normalize(self.up);
         if dot(f, up).abs() > 0.999_999 {
             // up parallel to the view direction: pick any perpendicular one
-            up = if f[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 0.0, 1.0] };
+            up = if f[0].abs() < 0.9 {
+                [1.0, 0.0, 0.0]
+            } else {
+                [0.0, 0.0, 1.0]
+            };
         }
         let s = normalize(cross(f, up));
         let u = cross(s, f);
@@ -104,7 +114,12 @@ mod tests {
 
     #[test]
     fn target_projects_to_centre_and_depth_is_in_range() {
-        let cam = Camera { eye: [1.0, 2.0, 5.0], target: [0.5, -0.3, 0.2], up: [0.0, 1.0, 0.0], fov_y_deg: 40.0 };
+        let cam = Camera {
+            eye: [1.0, 2.0, 5.0],
+            target: [0.5, -0.3, 0.2],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 40.0,
+        };
         let m = cam.view_proj(200, 100);
         let c = transform(&m, [0.5, -0.3, 0.2, 1.0]);
         assert!((c[0] / c[3]).abs() < 1e-12 && (c[1] / c[3]).abs() < 1e-12);

@@ -53,7 +53,10 @@ impl Mesh {
             ));
         }
         if self.indices.len() % 3 != 0 {
-            return Err(format!("{} indices is not a whole number of triangles", self.indices.len()));
+            return Err(format!(
+                "{} indices is not a whole number of triangles",
+                self.indices.len()
+            ));
         }
         if let Some(i) = self.indices.iter().find(|&&i| i as usize >= n) {
             return Err(format!("index {i} out of range ({n} vertices)"));
@@ -67,7 +70,12 @@ impl Mesh {
     /// A 1 x 1 square in the xy-plane centred on the origin, facing +z, `t = +x`,
     /// uv (0,0) at the bottom-left corner.
     pub fn quad() -> Mesh {
-        let positions = vec![[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.5, 0.0]];
+        let positions = vec![
+            [-0.5, -0.5, 0.0],
+            [0.5, -0.5, 0.0],
+            [0.5, 0.5, 0.0],
+            [-0.5, 0.5, 0.0],
+        ];
         Mesh {
             positions,
             normals: vec![[0.0, 0.0, 1.0]; 4],
@@ -90,12 +98,21 @@ impl Mesh {
                 let u = s as f64 / segments as f64;
                 let ph = u * std::f64::consts::TAU;
                 let n = [th.sin() * ph.cos(), th.cos(), -th.sin() * ph.sin()];
-                m.positions.push([(0.5 * n[0]) as f32, (0.5 * n[1]) as f32, (0.5 * n[2]) as f32]);
+                m.positions.push([
+                    (0.5 * n[0]) as f32,
+                    (0.5 * n[1]) as f32,
+                    (0.5 * n[2]) as f32,
+                ]);
                 m.normals.push([n[0] as f32, n[1] as f32, n[2] as f32]);
                 m.uvs.push([u as f32, 1.0 - v as f32]);
                 // d n / d ph = (-sin ph, 0, -cos ph) * sin th: eastward
-                let t = if th.sin() > 1e-9 { [-ph.sin(), 0.0, -ph.cos()] } else { [1.0, 0.0, 0.0] };
-                m.tangents.push([t[0] as f32, t[1] as f32, t[2] as f32, 1.0]);
+                let t = if th.sin() > 1e-9 {
+                    [-ph.sin(), 0.0, -ph.cos()]
+                } else {
+                    [1.0, 0.0, 0.0]
+                };
+                m.tangents
+                    .push([t[0] as f32, t[1] as f32, t[2] as f32, 1.0]);
             }
         }
         let row = segments + 1;
@@ -122,7 +139,10 @@ impl Mesh {
         Some(match name {
             "quad" => Ok(Mesh::quad()),
             "sphere" => Ok(Mesh::uv_sphere(96, 48)),
-            other => Err(format!("unknown built-in mesh '{other}' (known: {})", BUILTINS.join(", "))),
+            other => Err(format!(
+                "unknown built-in mesh '{other}' (known: {})",
+                BUILTINS.join(", ")
+            )),
         })
     }
 }
@@ -140,7 +160,11 @@ mod tests {
         [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
     }
     fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
     }
     fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
         a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -154,7 +178,10 @@ mod tests {
                 let [a, b, c] = [0, 1, 2].map(|k| m.positions[tri[k] as usize]);
                 let face = cross(sub(b, a), sub(c, a));
                 let n = m.normals[tri[0] as usize];
-                assert!(dot(face, n) > 0.0, "triangle {tri:?} is not counter-clockwise from outside");
+                assert!(
+                    dot(face, n) > 0.0,
+                    "triangle {tri:?} is not counter-clockwise from outside"
+                );
             }
             for (t, n) in m.tangents.iter().zip(&m.normals) {
                 assert!(dot([t[0], t[1], t[2]], *n).abs() < 1e-5);

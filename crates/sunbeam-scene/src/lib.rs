@@ -102,7 +102,11 @@ fn default_lights() -> Vec<Light> {
 impl Light {
     /// The documented default light: D65 from above and a little behind the viewer.
     pub fn default_light() -> Self {
-        Light { direction: [0.3, 1.0, 0.6], intensity: 1.0, spectrum: default_spectrum() }
+        Light {
+            direction: [0.3, 1.0, 0.6],
+            intensity: 1.0,
+            spectrum: default_spectrum(),
+        }
     }
 }
 
@@ -112,13 +116,24 @@ impl Scene {
     /// the bounds once the mesh is loaded), the default light, exposure 0.
     pub fn default_for(mesh: PathBuf, pack: Option<PathBuf>, bounds: ([f64; 3], [f64; 3])) -> Self {
         let (lo, hi) = bounds;
-        let c = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, (lo[2] + hi[2]) / 2.0];
-        let r = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt() / 2.0;
+        let c = [
+            (lo[0] + hi[0]) / 2.0,
+            (lo[1] + hi[1]) / 2.0,
+            (lo[2] + hi[2]) / 2.0,
+        ];
+        let r = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
+            .sqrt()
+            / 2.0;
         let r = if r > 0.0 && r.is_finite() { r } else { 1.0 };
         let fov = default_fov();
         let dist = r / (fov.to_radians() / 2.0).sin() * 1.05;
         Scene {
-            camera: Camera { eye: [c[0], c[1], c[2] + dist], target: c, up: default_up(), fov_y_deg: fov },
+            camera: Camera {
+                eye: [c[0], c[1], c[2] + dist],
+                target: c,
+                up: default_up(),
+                fov_y_deg: fov,
+            },
             lights: default_lights(),
             meshes: vec![MeshInstance {
                 mesh,
@@ -135,8 +150,8 @@ impl Scene {
     /// Read a scene file; relative paths are resolved against its folder.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::input_file(path, e))?;
-        let mut s: Scene =
-            serde_json::from_str(&text).map_err(|e| Error::input_file(path, format!("invalid scene: {e}")))?;
+        let mut s: Scene = serde_json::from_str(&text)
+            .map_err(|e| Error::input_file(path, format!("invalid scene: {e}")))?;
         let base = path.parent().unwrap_or(Path::new(""));
         for m in &mut s.meshes {
             if m.mesh.is_relative() && !geometry::is_builtin(&m.mesh) {
@@ -163,11 +178,16 @@ impl Scene {
         for (i, l) in self.lights.iter_mut().enumerate() {
             let n = (l.direction.iter().map(|v| v * v).sum::<f64>()).sqrt();
             if !(n.is_finite() && n > 0.0) {
-                return Err(Error::input(format!("lights[{i}].direction must be a non-zero vector")));
+                return Err(Error::input(format!(
+                    "lights[{i}].direction must be a non-zero vector"
+                )));
             }
             l.direction = l.direction.map(|v| v / n);
             if l.spectrum != "D65" {
-                return Err(Error::input(format!("lights[{i}].spectrum '{}': only D65 is supported", l.spectrum)));
+                return Err(Error::input(format!(
+                    "lights[{i}].spectrum '{}': only D65 is supported",
+                    l.spectrum
+                )));
             }
         }
         if self.size[0] == 0 || self.size[1] == 0 || self.size[0] > 16384 || self.size[1] > 16384 {
@@ -189,6 +209,9 @@ mod tests {
         s.validate().unwrap();
         assert_eq!(s.lights.len(), 1);
         assert!((s.lights[0].direction.iter().map(|v| v * v).sum::<f64>() - 1.0).abs() < 1e-12);
-        assert!(serde_json::from_str::<Scene>(r#"{"camera":{"eye":[0,0,3],"target":[0,0,0]},"meshes":[],"bogus":1}"#).is_err());
+        assert!(serde_json::from_str::<Scene>(
+            r#"{"camera":{"eye":[0,0,3],"target":[0,0,0]},"meshes":[],"bogus":1}"#
+        )
+        .is_err());
     }
 }

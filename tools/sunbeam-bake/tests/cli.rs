@@ -126,6 +126,15 @@ fn every_output_passes_the_validator() {
             s(&p("uv.csv")),
         ],
         vec![
+            s(&p("snake.glb")),
+            "-o".into(),
+            s(&p("snake_sibson.glb")),
+            "--samples".into(),
+            s(&p("uv.csv")),
+            "--interpolation".into(),
+            "sibson".into(),
+        ],
+        vec![
             s(&p("plain.obj")),
             "-o".into(),
             s(&p("plain.glb")),
@@ -209,6 +218,7 @@ fn every_output_passes_the_validator() {
         "snake_curve.glb",
         "snake_uv.glb",
         "snake_samples.glb",
+        "snake_sibson.glb",
         "plain.glb",
         "full.glb",
         "full2.glb",

@@ -13,7 +13,11 @@ use sunbeam_render::{Backend, Gpu, Mode, Settings};
 use sunbeam_scene::Scene;
 
 #[derive(Parser, Debug)]
-#[command(name = "sunbeam-play", version, about = "Diffraction colour from term packs: window or headless frames")]
+#[command(
+    name = "sunbeam-play",
+    version,
+    about = "Diffraction colour from term packs: window or headless frames"
+)]
 struct Cli {
     /// Scene file (JSON, docs/SCENE.md). Or use --mesh and --pack.
     scene: Option<PathBuf>,
@@ -84,15 +88,25 @@ struct Cli {
 
 fn load_scene(cli: &Cli) -> Result<Scene> {
     let mut scene = match (&cli.scene, &cli.mesh) {
-        (Some(_), Some(_)) => return Err(Error::usage("give either SCENE.json or --mesh/--pack, not both")),
+        (Some(_), Some(_)) => {
+            return Err(Error::usage(
+                "give either SCENE.json or --mesh/--pack, not both",
+            ))
+        }
         (Some(s), None) => {
             if cli.pack.is_some() {
-                return Err(Error::usage("--pack goes with --mesh (a scene file names its own packs)"));
+                return Err(Error::usage(
+                    "--pack goes with --mesh (a scene file names its own packs)",
+                ));
             }
             Scene::load(s)?
         }
         (None, Some(m)) => sunbeam_raster::default_scene(m, cli.pack.as_deref())?,
-        (None, None) => return Err(Error::usage("nothing to render: give SCENE.json or --mesh M.glb --pack P.ktx2")),
+        (None, None) => {
+            return Err(Error::usage(
+                "nothing to render: give SCENE.json or --mesh M.glb --pack P.ktx2",
+            ))
+        }
     };
     if let Some(ev) = cli.exposure {
         if !ev.is_finite() {
@@ -128,7 +142,12 @@ fn settings(cli: &Cli) -> Result<Settings> {
         }
     }
     let curve: ToneCurve = cli.tone.parse()?;
-    Ok(Settings { mode, lambda_samples: cli.lambda_samples, curve, term_tolerance: cli.term_tolerance })
+    Ok(Settings {
+        mode,
+        lambda_samples: cli.lambda_samples,
+        curve,
+        term_tolerance: cli.term_tolerance,
+    })
 }
 
 fn inputs(p: &Prepared, cli: &Cli) -> Vec<PathBuf> {
@@ -175,7 +194,10 @@ fn run(cli: Cli) -> Result<()> {
     });
     let image: Image = if cli.cpu {
         let t = std::time::Instant::now();
-        let opts = sunbeam_raster::Options { curve: st.curve, ..Default::default() };
+        let opts = sunbeam_raster::Options {
+            curve: st.curve,
+            ..Default::default()
+        };
         let img = sunbeam_raster::render_prepared(&prepared, &opts);
         report["renderer"] = "cpu reference (sunbeam-raster)".into();
         report["render_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
@@ -208,7 +230,12 @@ fn run(cli: Cli) -> Result<()> {
             }
             img
         } else {
-            let r = sunbeam_render::Renderer::new(&gpu, &prepared, &st, sunbeam_render::OFFSCREEN_FORMAT)?;
+            let r = sunbeam_render::Renderer::new(
+                &gpu,
+                &prepared,
+                &st,
+                sunbeam_render::OFFSCREEN_FORMAT,
+            )?;
             for w in &r.warnings {
                 eprintln!("sunbeam-play: warning: {w}");
             }
@@ -250,7 +277,10 @@ fn run(cli: Cli) -> Result<()> {
 fn main() {
     sunbeam_common::error::run_main("sunbeam-play", || {
         let cli = Cli::try_parse().map_err(|e| {
-            if matches!(e.kind(), clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion) {
+            if matches!(
+                e.kind(),
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion
+            ) {
                 let _ = e.print();
                 std::process::exit(0);
             }

@@ -18,8 +18,18 @@ fn tmp(name: &str) -> PathBuf {
 /// A scene file with the blazed grating on the built-in quad; None when the data is missing.
 fn blazed_scene(dir: &Path, size: u32) -> Option<PathBuf> {
     let data = sunbeam_common::testdata::shared_file("snake/BlazingBump.bmp")?;
-    let pack = fixtures::pack(&fixtures::BLAZED, data.parent().unwrap(), &Default::default()).unwrap();
-    sunbeam_pack::io::write_pack(&pack, &dir.join("blazed.ktx2"), sunbeam_pack::io::OutputKind::Ktx2).unwrap();
+    let pack = fixtures::pack(
+        &fixtures::BLAZED,
+        data.parent().unwrap(),
+        &Default::default(),
+    )
+    .unwrap();
+    sunbeam_pack::io::write_pack(
+        &pack,
+        &dir.join("blazed.ktx2"),
+        sunbeam_pack::io::OutputKind::Ktx2,
+    )
+    .unwrap();
     let (mut scene, _) = fixtures::quad_scene([size, size]);
     scene.meshes[0].pack = Some("blazed.ktx2".into());
     let text = serde_json::to_string_pretty(&scene).unwrap();
@@ -42,19 +52,32 @@ fn have_gpu() -> bool {
 #[test]
 fn headless_frame_matches_cpu_reference_and_is_deterministic() {
     let dir = tmp("headless");
-    let Some(scene) = blazed_scene(&dir, 64) else { return };
+    let Some(scene) = blazed_scene(&dir, 64) else {
+        return;
+    };
     if !have_gpu() {
         return;
     }
     let run = |args: &[&str]| {
         let o = Command::new(BIN).arg(&scene).args(args).output().unwrap();
-        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         String::from_utf8_lossy(&o.stdout).to_string()
     };
     let gpu = dir.join("gpu.png");
     let cpu = dir.join("cpu.png");
     run(&["--cpu", "-o", cpu.to_str().unwrap()]);
-    let out = run(&["--headless", "-o", gpu.to_str().unwrap(), "--compare", cpu.to_str().unwrap(), "--json"]);
+    let out = run(&[
+        "--headless",
+        "-o",
+        gpu.to_str().unwrap(),
+        "--compare",
+        cpu.to_str().unwrap(),
+        "--json",
+    ]);
     let report: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
     let mean = report["ciede2000"]["mean"].as_f64().unwrap();
     let p99 = report["ciede2000"]["p99"].as_f64().unwrap();
@@ -62,7 +85,11 @@ fn headless_frame_matches_cpu_reference_and_is_deterministic() {
     let a = std::fs::read(&gpu).unwrap();
     let gpu2 = dir.join("gpu2.png");
     run(&["--headless", "-o", gpu2.to_str().unwrap(), "--frames", "2"]);
-    assert_eq!(a, std::fs::read(&gpu2).unwrap(), "headless frames are not deterministic");
+    assert_eq!(
+        a,
+        std::fs::read(&gpu2).unwrap(),
+        "headless frames are not deterministic"
+    );
     let img = Image::read_png(&gpu).unwrap();
     assert!(img.mean_sd().1 > 0.02, "blank frame");
 }
@@ -71,10 +98,16 @@ fn headless_frame_matches_cpu_reference_and_is_deterministic() {
 fn usage_and_input_errors_have_their_exit_codes() {
     let o = Command::new(BIN).output().unwrap();
     assert_eq!(o.status.code(), Some(1));
-    let o = Command::new(BIN).args(["/nonexistent/scene.json", "--headless", "-o", "x.png"]).output().unwrap();
+    let o = Command::new(BIN)
+        .args(["/nonexistent/scene.json", "--headless", "-o", "x.png"])
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/scene.json"));
-    let o = Command::new(BIN).args(["--mesh", "builtin:cube", "--headless", "-o", "x.png"]).output().unwrap();
+    let o = Command::new(BIN)
+        .args(["--mesh", "builtin:cube", "--headless", "-o", "x.png"])
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2));
 }
 
@@ -82,7 +115,14 @@ fn usage_and_input_errors_have_their_exit_codes() {
 fn no_adapter_says_what_to_install() {
     let dir = tmp("noadapter");
     let o = Command::new(BIN)
-        .args(["--mesh", "builtin:quad", "--headless", "--backend", "vulkan", "-o"])
+        .args([
+            "--mesh",
+            "builtin:quad",
+            "--headless",
+            "--backend",
+            "vulkan",
+            "-o",
+        ])
         .arg(dir.join("x.png"))
         .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
         .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
@@ -102,7 +142,9 @@ fn window_opens_under_xvfb_and_is_not_blank() {
         return;
     }
     let dir = tmp("window");
-    let Some(scene) = blazed_scene(&dir, 160) else { return };
+    let Some(scene) = blazed_scene(&dir, 160) else {
+        return;
+    };
     if !have_gpu() {
         return;
     }
@@ -114,12 +156,27 @@ fn window_opens_under_xvfb_and_is_not_blank() {
         .arg(&shot)
         .output()
         .unwrap();
-    let log = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    let log = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
     assert!(o.status.success(), "window run failed: {log}");
     assert!(log.contains("window frames: n=3"), "{log}");
     let img = Image::read_png(&shot).unwrap_or_else(|e| panic!("no screenshot ({e}): {log}"));
     let (mean, sd) = img.mean_sd();
-    eprintln!("window screenshot {}x{} mean {mean:.3} sd {sd:.3}", img.width, img.height);
-    assert!(img.width == 160 && img.height == 160, "{}x{}", img.width, img.height);
-    assert!(mean > 0.02 && sd > 0.02, "screenshot looks blank: mean {mean} sd {sd}");
+    eprintln!(
+        "window screenshot {}x{} mean {mean:.3} sd {sd:.3}",
+        img.width, img.height
+    );
+    assert!(
+        img.width == 160 && img.height == 160,
+        "{}x{}",
+        img.width,
+        img.height
+    );
+    assert!(
+        mean > 0.02 && sd > 0.02,
+        "screenshot looks blank: mean {mean} sd {sd}"
+    );
 }
