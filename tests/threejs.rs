@@ -36,7 +36,13 @@ fn threejs_loads_the_baked_glb_and_the_ktx2_pack() {
     let exr = d.join("elaphe.exr");
     let ktx2 = d.join("elaphe.ktx2");
     let manifest = d.join("elaphe.json");
-    let bake = run_ok(Command::new(tool("sunbeam-bake")).arg("--generate-snake").arg("-o").arg(&glb).arg("--json"));
+    let bake = run_ok(
+        Command::new(tool("sunbeam-bake"))
+            .arg("--generate-snake")
+            .arg("-o")
+            .arg(&glb)
+            .arg("--json"),
+    );
     let bake: serde_json::Value = serde_json::from_slice(&bake.stdout).unwrap();
     run_ok(
         Command::new(tool("sunbeam-import"))
@@ -57,9 +63,18 @@ fn threejs_loads_the_baked_glb_and_the_ktx2_pack() {
     // The example, as a user would run it, next to a node_modules with three.
     let js = d.join("js");
     std::fs::create_dir_all(&js).unwrap();
-    std::fs::copy(workspace_root().join("examples/threejs/load.mjs"), js.join("load.mjs")).unwrap();
+    std::fs::copy(
+        workspace_root().join("examples/threejs/load.mjs"),
+        js.join("load.mjs"),
+    )
+    .unwrap();
     std::os::unix::fs::symlink(&modules, js.join("node_modules")).unwrap();
-    let o = run_ok(Command::new("node").arg(js.join("load.mjs")).arg(&glb).arg(&ktx2));
+    let o = run_ok(
+        Command::new("node")
+            .arg(js.join("load.mjs"))
+            .arg(&glb)
+            .arg(&ktx2),
+    );
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
 
     let mesh = &v["mesh"];
@@ -80,6 +95,9 @@ fn threejs_loads_the_baked_glb_and_the_ktx2_pack() {
     assert_eq!(p["manifest_crop"], m["crop"]);
     // Term 0 (T_0 = 1) at frequency 0 is real and positive (the windowed mean, deapodised).
     let t0 = p["term0_centre"].as_array().unwrap();
-    assert!(t0[0].as_f64().unwrap() > 0.5 && t0[1].as_f64().unwrap().abs() < 1e-6, "{t0:?}");
+    assert!(
+        t0[0].as_f64().unwrap() > 0.5 && t0[1].as_f64().unwrap().abs() < 1e-6,
+        "{t0:?}"
+    );
     assert_eq!(v["material"], "ShaderMaterial");
 }

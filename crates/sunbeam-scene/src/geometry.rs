@@ -52,7 +52,7 @@ impl Mesh {
                 self.tangents.len()
             ));
         }
-        if self.indices.len() % 3 != 0 {
+        if !self.indices.len().is_multiple_of(3) {
             return Err(format!(
                 "{} indices is not a whole number of triangles",
                 self.indices.len()

@@ -139,5 +139,29 @@ fn compare_passes_and_fails() {
     .parse()
     .unwrap();
     assert!((rp - rt).abs() < 1e-4, "{rp} vs {rt}");
+    // render: the CPU reference image of the default scene of a quad with this pack.
+    let obj = dir.join("quad.obj");
+    std::fs::write(
+        &obj,
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n\
+         f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n",
+    )
+    .unwrap();
+    let frame = dir.join("frame.png");
+    ok(&[
+        "render",
+        "--mesh",
+        obj.to_str().unwrap(),
+        "--pack",
+        good.to_str().unwrap(),
+        "--size",
+        "32x24",
+        "-o",
+        frame.to_str().unwrap(),
+    ]);
+    let b = std::fs::read(&frame).unwrap();
+    assert!(b.starts_with(b"\x89PNG"));
+    assert_eq!(u32::from_be_bytes([b[16], b[17], b[18], b[19]]), 32);
+    assert_eq!(u32::from_be_bytes([b[20], b[21], b[22], b[23]]), 24);
     std::fs::remove_dir_all(&dir).ok();
 }

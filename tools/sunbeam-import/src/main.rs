@@ -386,8 +386,8 @@ fn synthetic(cli: &Cli, name: &str) -> Result<Vec<Channel>> {
             cli.synthetic_size
         )));
     }
-    let pixel = parse_positive_length(&cli.synthetic_pixel)
-        .map_err(|e| e.context("--synthetic-pixel"))?;
+    let pixel =
+        parse_positive_length(&cli.synthetic_pixel).map_err(|e| e.context("--synthetic-pixel"))?;
     let field = sunbeam_synth::preset(name, cli.synthetic_size, pixel)?;
     Ok(vec![Channel {
         name: "Height".into(),
@@ -405,7 +405,8 @@ fn run(cli: Cli) -> Result<()> {
     let synth = synthetic_name(input);
     let in_file = |e: Error| e.context(input.display());
     let (chans, fmt, calibrated_by_user) = if let Some(name) = synth {
-        if plan.read.format.is_some() || plan.read.z_range.is_some() || plan.read.z_scale.is_some() {
+        if plan.read.format.is_some() || plan.read.z_range.is_some() || plan.read.z_scale.is_some()
+        {
             return Err(Error::usage(format!(
                 "{}: --format, --z-range and --z-scale do not apply to synthetic fields",
                 input.display()

@@ -9,7 +9,10 @@ use std::process::{Command, Output};
 const BIN: &str = env!("CARGO_BIN_EXE_sunbeam-import");
 
 fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("sunbeam-import-synth-{name}-{}", std::process::id()));
+    let d = std::env::temp_dir().join(format!(
+        "sunbeam-import-synth-{name}-{}",
+        std::process::id()
+    ));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -44,7 +47,11 @@ fn dominant_bin(f: &sunbeam_field::HeightField) -> usize {
 fn presets_have_their_period_size_and_pixel() {
     let d = tmpdir("period");
     // (preset, period in metres): the thesis' estimates (sunbeam-synth docs).
-    for (name, period) in [("elaphe", 1.144e-6), ("xenopeltis", 1.552e-6), ("sine", 2.5e-6)] {
+    for (name, period) in [
+        ("elaphe", 1.144e-6),
+        ("xenopeltis", 1.552e-6),
+        ("sine", 2.5e-6),
+    ] {
         let out = d.join(format!("{name}.exr"));
         let o = run(&[
             &format!("synthetic:{name}"),
@@ -67,7 +74,11 @@ fn presets_have_their_period_size_and_pixel() {
             .data
             .iter()
             .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-        assert!(hi - lo > 100e-9 && hi - lo < 700e-9, "{name}: z span {}", hi - lo);
+        assert!(
+            hi - lo > 100e-9 && hi - lo < 700e-9,
+            "{name}: z span {}",
+            hi - lo
+        );
     }
 }
 
@@ -76,7 +87,14 @@ fn synthetic_is_deterministic_and_depends_on_no_file() {
     let d = tmpdir("det");
     let (a, b, dep) = (d.join("a.exr"), d.join("b.exr"), d.join("a.d"));
     for (out, extra) in [(&a, Some(&dep)), (&b, None)] {
-        let mut args = vec!["synthetic:elaphe", "-o", out.to_str().unwrap(), "--synthetic-size", "64", "-q"];
+        let mut args = vec![
+            "synthetic:elaphe",
+            "-o",
+            out.to_str().unwrap(),
+            "--synthetic-size",
+            "64",
+            "-q",
+        ];
         if let Some(dep) = extra {
             args.extend(["--depfile", dep.to_str().unwrap()]);
         }
@@ -88,7 +106,16 @@ fn synthetic_is_deterministic_and_depends_on_no_file() {
     assert_eq!(dep.trim_end(), format!("{}:", a.display()), "{dep}");
     // Processing applies to synthetic fields like to scans.
     let c = d.join("c.exr");
-    let o = run(&["synthetic:sine", "-o", c.to_str().unwrap(), "--synthetic-size", "64", "--resample-to", "50nm", "--json"]);
+    let o = run(&[
+        "synthetic:sine",
+        "-o",
+        c.to_str().unwrap(),
+        "--synthetic-size",
+        "64",
+        "--resample-to",
+        "50nm",
+        "--json",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["source_format"], "synthetic");
@@ -101,14 +128,40 @@ fn bad_synthetic_requests_are_usage_errors() {
     let out = d.join("x.exr");
     for args in [
         vec!["synthetic:python", "-o", out.to_str().unwrap()],
-        vec!["synthetic:elaphe", "-o", out.to_str().unwrap(), "--synthetic-size", "0"],
-        vec!["synthetic:elaphe", "-o", out.to_str().unwrap(), "--synthetic-pixel", "-3nm"],
-        vec!["synthetic:elaphe", "-o", out.to_str().unwrap(), "--z-range", "3nm"],
+        vec![
+            "synthetic:elaphe",
+            "-o",
+            out.to_str().unwrap(),
+            "--synthetic-size",
+            "0",
+        ],
+        vec![
+            "synthetic:elaphe",
+            "-o",
+            out.to_str().unwrap(),
+            "--synthetic-pixel",
+            "-3nm",
+        ],
+        vec![
+            "synthetic:elaphe",
+            "-o",
+            out.to_str().unwrap(),
+            "--z-range",
+            "3nm",
+        ],
     ] {
         let o = run(&args);
-        assert_eq!(o.status.code(), Some(1), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         assert!(!out.exists());
     }
     let o = run(&["synthetic:python", "-o", out.to_str().unwrap()]);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("elaphe"), "names the presets");
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("elaphe"),
+        "names the presets"
+    );
 }
