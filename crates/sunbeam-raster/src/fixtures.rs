@@ -76,7 +76,7 @@ fn read_bmp(b: &[u8]) -> std::result::Result<(usize, usize, Vec<f64>), String> {
         return Err(format!("unsupported BMP (compression {comp}, {w}x{h})"));
     }
     let (w, hh) = (w as usize, h.unsigned_abs() as usize);
-    let row = ((bpp as usize * w + 31) / 32) * 4;
+    let row = (bpp as usize * w).div_ceil(32) * 4;
     if b.len() < off + row * hh {
         return Err("truncated BMP pixel data".into());
     }

@@ -31,7 +31,7 @@ use sunbeam_pack::Pack;
 use sunbeam_scene::Scene;
 
 /// How the reference renders (all defaults are the documented reference).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Options {
     /// Wavelength samples of the colour integral: None = the 1 nm reference sum
     /// of `sunbeam_optics::cie::integrate_xyz_1nm` over 380..=780 nm; Some(n) = the
@@ -43,17 +43,6 @@ pub struct Options {
     pub threads: usize,
     /// Output size override (None: the scene's `size`).
     pub size: Option<[u32; 2]>,
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Options {
-            lambda_samples: None,
-            curve: ToneCurve::default(),
-            threads: 0,
-            size: None,
-        }
-    }
 }
 
 /// What one mesh instance is shaded with.
@@ -181,8 +170,8 @@ pub fn render_prepared(p: &Prepared, opts: &Options) -> Image {
     };
     let mut rgb = vec![[0.0f32; 3]; (w as usize) * (h as usize)];
     let rows: Vec<&mut [[f32; 3]]> = rgb.chunks_mut(w as usize).collect();
-    let mut per_thread: Vec<Vec<(usize, &mut [[f32; 3]])>> =
-        (0..threads).map(|_| Vec::new()).collect();
+    type Rows<'a> = Vec<(usize, &'a mut [[f32; 3]])>;
+    let mut per_thread: Vec<Rows> = (0..threads).map(|_| Vec::new()).collect();
     for (j, row) in rows.into_iter().enumerate() {
         per_thread[j % threads].push((j, row));
     }

@@ -113,9 +113,10 @@ fn raster_triangle(
     t: &[ClipVert; 3],
     _vp: &Mat4,
 ) {
-    if t.iter()
-        .any(|v| !(v.c[3] > 0.0) || v.c.iter().any(|x| !x.is_finite()))
-    {
+    if t.iter().any(|v| {
+        v.c[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+            || v.c.iter().any(|x| !x.is_finite())
+    }) {
         return;
     }
     // Screen position (y down), snapped to 1/256 pixel.
@@ -184,16 +185,16 @@ fn raster_triangle(
                 continue;
             }
             let pix = &mut buf[(j as usize) * w as usize + i as usize];
-            if !(z < pix.depth) {
+            if z.partial_cmp(&pix.depth) != Some(std::cmp::Ordering::Less) {
                 continue;
             }
             // Perspective-correct weights on the clipped vertices, then on the original ones.
             let pw = [l[0] * inv_w[0], l[1] * inv_w[1], l[2] * inv_w[2]];
             let sum = pw[0] + pw[1] + pw[2];
             let mut bo = [0.0; 3];
-            for k in 0..3 {
-                for o in 0..3 {
-                    bo[o] += pw[k] / sum * t[k].bary[o];
+            for (k, tk) in t.iter().enumerate() {
+                for (o, b) in bo.iter_mut().enumerate() {
+                    *b += pw[k] / sum * tk.bary[o];
                 }
             }
             let attr = |v: &Vec<[f32; 3]>| -> [f64; 3] {

@@ -63,8 +63,8 @@ impl Samples {
         for s in &self.0 {
             let v = r(s.lambda_m);
             if v != 0.0 {
-                for k in 0..3 {
-                    acc[k] += v * s.weight[k];
+                for (a, w) in acc.iter_mut().zip(&s.weight) {
+                    *a += v * w;
                 }
             }
         }

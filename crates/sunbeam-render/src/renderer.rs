@@ -305,20 +305,19 @@ impl Renderer {
         let mut pack_bufs: Vec<(*const Pack, Arc<wgpu::Buffer>, usize)> = Vec::new();
         let mut meshes = Vec::new();
         for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
-            let verts: Vec<Vertex> = (0..mesh.positions.len())
+            let mut verts: Vec<Vertex> = (0..mesh.positions.len())
                 .map(|i| Vertex {
                     pos: mesh.positions[i],
                     normal: mesh.normals[i],
                     tangent: mesh.tangents[i],
                 })
                 .collect();
+            if verts.is_empty() {
+                verts.push(Vertex::zeroed());
+            }
             let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("vertices"),
-                contents: bytemuck::cast_slice(if verts.is_empty() {
-                    &[Vertex::zeroed()][..]
-                } else {
-                    &verts
-                }),
+                contents: bytemuck::cast_slice(&verts),
                 usage: wgpu::BufferUsages::VERTEX,
             });
             let ibuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

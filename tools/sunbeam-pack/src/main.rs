@@ -231,9 +231,7 @@ fn run(cli: Cli) -> Result<()> {
             m.t_max, m.error.f32_rounding_estimate
         ));
     }
-    if let Some(tol) = m.error.tolerance {
-        let _ = tol;
-    } else if m.error.series_bound > 1e-3 {
+    if m.error.tolerance.is_none() && m.error.series_bound > 1e-3 {
         warnings.push(format!(
             "--terms {}: the series bound on |dR| is {:.2e} at |t| = {:.1}",
             m.terms, m.error.series_bound, m.t_max
