@@ -147,6 +147,7 @@ fn settings(cli: &Cli) -> Result<Settings> {
         lambda_samples: cli.lambda_samples,
         curve,
         term_tolerance: cli.term_tolerance,
+        ..Default::default()
     })
 }
 
