@@ -225,6 +225,39 @@ fn touching_a_scan_rebuilds_only_its_dependents() {
     assert!(changed.iter().any(|k| *k == "elaphe.ktx2"), "{changed:?}");
 }
 
+/// Process group of a process, from /proc (Linux).
+fn pgrp_of(pid: &str) -> Option<u32> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // "pid (comm) state ppid pgrp ...": fields after the last ')'.
+    stat.rsplit_once(')')?
+        .1
+        .split_whitespace()
+        .nth(2)?
+        .parse()
+        .ok()
+}
+
+/// SIGKILL every process of the group `pgid` (make and the tool it runs), one by
+/// one by id; never our own group.
+fn kill_group(pgid: u32) {
+    let own = pgrp_of("self");
+    assert_ne!(
+        own,
+        Some(pgid),
+        "refusing to kill the test's own process group"
+    );
+    let pids: Vec<String> = std::fs::read_dir("/proc")
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.bytes().all(|b| b.is_ascii_digit()))
+        .filter(|n| pgrp_of(n) == Some(pgid))
+        .collect();
+    for pid in pids {
+        let _ = Command::new("kill").args(["-KILL", &pid]).status();
+    }
+}
+
 fn ktx2_complete(path: &Path) -> bool {
     let b = std::fs::read(path).unwrap();
     let magic = b"\xABKTX 20\xBB\r\n\x1A\n";
@@ -266,9 +299,11 @@ fn interrupted_build_keeps_nothing_half_written_and_is_redone() {
     // none is seen within 60 ms of a pack starting (its input exists), kill it mid-run.
     let t0 = Instant::now();
     let mut started: Option<Instant> = None;
+    let mut exited = false;
     let mut how = "not caught (make finished first)";
     while t0.elapsed() < Duration::from_secs(120) {
         if child.try_wait().unwrap().is_some() {
+            exited = true;
             break;
         }
         let names: Vec<String> = std::fs::read_dir(&out)
@@ -294,9 +329,9 @@ fn interrupted_build_keeps_nothing_half_written_and_is_redone() {
         }
         std::thread::sleep(Duration::from_micros(200));
     }
-    let _ = Command::new("kill")
-        .args(["-KILL", &format!("-{pgid}")])
-        .status();
+    if !exited {
+        kill_group(pgid);
+    }
     let _ = child.wait();
     eprintln!(
         "killed make {how} after {:.2} s",

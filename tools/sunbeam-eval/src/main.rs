@@ -12,6 +12,7 @@ mod plot;
 mod probe;
 mod render;
 mod sample;
+mod sheet;
 mod source;
 
 use clap::{Parser, Subcommand};
@@ -37,6 +38,19 @@ struct Cli {
     verbose: bool,
 }
 
+#[derive(clap::Args)]
+struct SheetArgs {
+    /// Output PNG.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Pictures per row.
+    #[arg(long, default_value_t = 4)]
+    columns: usize,
+    /// Input PNGs, in order.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+}
+
 #[derive(Subcommand)]
 enum Cmd {
     /// R(u, v, w, lambda) at the points of a CSV file, one value per line on stdout (docs/EVAL.md).
@@ -51,6 +65,8 @@ enum Cmd {
     Bench(BenchArgs),
     /// The CPU reference image of a scene (needs sunbeam-raster).
     Render(RenderArgs),
+    /// Contact sheet: PNGs on a grid, row by row (the demo's overview picture).
+    Sheet(SheetArgs),
 }
 
 #[derive(clap::Args)]
@@ -244,6 +260,7 @@ fn main() {
                 })
             }
             Cmd::Render(a) => render::run(&a),
+            Cmd::Sheet(a) => sheet::run(&a.output, &a.inputs, a.columns),
         }
     })
 }

@@ -198,7 +198,12 @@ mod tests {
         assert_eq!(first, std::fs::read(&out).unwrap());
         // Errors: no inputs, zero columns, a missing input (names it), not a PNG output.
         assert_eq!(run(&out, &[], 2).unwrap_err().exit_code(), 1);
-        assert_eq!(run(&out, std::slice::from_ref(&a), 0).unwrap_err().exit_code(), 1);
+        assert_eq!(
+            run(&out, std::slice::from_ref(&a), 0)
+                .unwrap_err()
+                .exit_code(),
+            1
+        );
         let e = run(&out, &[d.join("missing.png")], 1).unwrap_err();
         assert_eq!(e.exit_code(), 2);
         assert!(e.to_string().contains("missing.png"));

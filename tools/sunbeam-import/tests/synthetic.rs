@@ -50,7 +50,7 @@ fn presets_have_their_period_size_and_pixel() {
     for (name, period) in [
         ("elaphe", 1.144e-6),
         ("xenopeltis", 1.552e-6),
-        ("sine", 2.5e-6),
+        ("sine", 2.5e-6_f64),
     ] {
         let out = d.join(format!("{name}.exr"));
         let o = run(&[
@@ -68,7 +68,7 @@ fn presets_have_their_period_size_and_pixel() {
         assert_eq!((f.width, f.height), (320, 320));
         assert!((f.dx - 25e-9).abs() < 1e-18 && (f.dy - 25e-9).abs() < 1e-18);
         assert_eq!(f.provenance.source_format, "synthetic");
-        let k_want = (320.0 * 25e-9 / period as f64).round() as usize;
+        let k_want = (320.0 * 25e-9 / period).round() as usize;
         assert_eq!(dominant_bin(&f), k_want, "{name}");
         let (lo, hi) = f
             .data
