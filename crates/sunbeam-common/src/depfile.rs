@@ -47,7 +47,10 @@ mod tests {
     use super::*;
     #[test]
     fn escapes_and_lists_inputs() {
-        let s = render(&[Path::new("out dir/a.exr")], &[Path::new("in.spm"), Path::new("c:d")]);
+        let s = render(
+            &[Path::new("out dir/a.exr")],
+            &[Path::new("in.spm"), Path::new("c:d")],
+        );
         assert!(s.starts_with("out\\ dir/a.exr: \\\n  in.spm \\\n  c\\:d\n"));
         assert!(s.contains("\nin.spm:\n"));
     }

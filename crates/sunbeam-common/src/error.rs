@@ -25,23 +25,35 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
     pub fn usage(msg: impl Into<String>) -> Self {
-        Self { code: ExitCode::Usage, message: msg.into() }
+        Self {
+            code: ExitCode::Usage,
+            message: msg.into(),
+        }
     }
     pub fn input(msg: impl Into<String>) -> Self {
-        Self { code: ExitCode::Input, message: msg.into() }
+        Self {
+            code: ExitCode::Input,
+            message: msg.into(),
+        }
     }
     /// An input error that names the file: "FILE: what is wrong".
     pub fn input_file(path: &Path, msg: impl fmt::Display) -> Self {
         Self::input(format!("{}: {}", path.display(), msg))
     }
     pub fn output(msg: impl Into<String>) -> Self {
-        Self { code: ExitCode::Output, message: msg.into() }
+        Self {
+            code: ExitCode::Output,
+            message: msg.into(),
+        }
     }
     pub fn output_file(path: &Path, msg: impl fmt::Display) -> Self {
         Self::output(format!("{}: {}", path.display(), msg))
     }
     pub fn internal(msg: impl Into<String>) -> Self {
-        Self { code: ExitCode::Internal, message: msg.into() }
+        Self {
+            code: ExitCode::Internal,
+            message: msg.into(),
+        }
     }
     /// Prefix the message with context, keeping the code.
     pub fn context(mut self, ctx: impl fmt::Display) -> Self {

@@ -42,7 +42,10 @@ pub fn temp_sibling(path: &Path) -> PathBuf {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "output".into());
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     dir.join(format!(".{name}.tmp.{}", std::process::id()))
 }
 
@@ -58,7 +61,11 @@ mod tests {
         let r = write_atomic_with(&out, |_| Err(std::io::Error::other("boom")));
         assert!(r.is_err());
         assert!(!out.exists());
-        assert_eq!(fs::read_dir(&dir).unwrap().count(), 0, "temporary file left behind");
+        assert_eq!(
+            fs::read_dir(&dir).unwrap().count(),
+            0,
+            "temporary file left behind"
+        );
         write_atomic(&out, b"abc").unwrap();
         assert_eq!(fs::read(&out).unwrap(), b"abc");
         fs::remove_dir_all(&dir).unwrap();

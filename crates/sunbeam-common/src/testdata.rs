@@ -40,7 +40,9 @@ fn found_or_skip(p: Option<PathBuf>) -> Option<PathBuf> {
         Some(p) if p.is_dir() => Some(p),
         other => missing(&format!(
             "shared data folder ({})",
-            other.map(|p| p.display().to_string()).unwrap_or_else(|| "../shared/data".into())
+            other
+                .map(|p| p.display().to_string())
+                .unwrap_or_else(|| "../shared/data".into())
         )),
     }
 }
@@ -49,7 +51,9 @@ fn missing(what: &str) -> Option<PathBuf> {
     if require_all() {
         panic!("{what} is missing and SUNBEAM_REQUIRE_ALL=1: CI needs it");
     }
-    eprintln!("SKIP: {what} not found (set SUNBEAM_SHARED_DATA or SUNBEAM_REQUIRE_ALL=1 to fail instead)");
+    eprintln!(
+        "SKIP: {what} not found (set SUNBEAM_SHARED_DATA or SUNBEAM_REQUIRE_ALL=1 to fail instead)"
+    );
     None
 }
 
@@ -57,14 +61,20 @@ fn missing(what: &str) -> Option<PathBuf> {
 /// true when `cmd --version` (or `args`) runs.
 pub fn have_command(cmd: &str, args: &[&str]) -> bool {
     let ok = std::process::Command::new(cmd)
-        .args(if args.is_empty() { &["--version"][..] } else { args })
+        .args(if args.is_empty() {
+            &["--version"][..]
+        } else {
+            args
+        })
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
         .status()
         .is_ok_and(|s| s.success());
     if !ok {
         if require_all() {
-            panic!("`{cmd}` is not available and SUNBEAM_REQUIRE_ALL=1 (run scripts/ensure-deps.sh)");
+            panic!(
+                "`{cmd}` is not available and SUNBEAM_REQUIRE_ALL=1 (run scripts/ensure-deps.sh)"
+            );
         }
         eprintln!("SKIP: `{cmd}` not available (scripts/ensure-deps.sh installs it)");
     }

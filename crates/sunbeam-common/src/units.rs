@@ -26,7 +26,8 @@ fn split_number(s: &str) -> (&str, &str) {
                 || c == '+'
                 || c == '-'
                 || ((c == 'e' || c == 'E')
-                    && s[i + 1..].starts_with(|d: char| d.is_ascii_digit() || d == '-' || d == '+')))
+                    && s[i + 1..]
+                        .starts_with(|d: char| d.is_ascii_digit() || d == '-' || d == '+')))
         })
         .map(|(i, _)| i)
         .unwrap_or(s.len());
@@ -46,9 +47,8 @@ pub fn parse_length_default(s: &str, default_unit: Option<&str>) -> Result<f64> 
         .parse()
         .map_err(|_| Error::usage(format!("'{s}' is not a length (expected e.g. 20nm, 1.5um)")))?;
     let unit = if unit.is_empty() {
-        default_unit.ok_or_else(|| {
-            Error::usage(format!("'{s}' has no unit (write e.g. {s}nm or {s}um)"))
-        })?
+        default_unit
+            .ok_or_else(|| Error::usage(format!("'{s}' has no unit (write e.g. {s}nm or {s}um)")))?
     } else {
         unit
     };
@@ -56,7 +56,11 @@ pub fn parse_length_default(s: &str, default_unit: Option<&str>) -> Result<f64> 
         .iter()
         .find(|(u, _)| *u == unit)
         .map(|(_, f)| *f)
-        .ok_or_else(|| Error::usage(format!("'{s}': unknown length unit '{unit}' (pm, nm, um, mm, m)")))?;
+        .ok_or_else(|| {
+            Error::usage(format!(
+                "'{s}': unknown length unit '{unit}' (pm, nm, um, mm, m)"
+            ))
+        })?;
     let m = v * scale;
     if !m.is_finite() {
         return Err(Error::usage(format!("'{s}' is not a finite length")));
@@ -75,9 +79,9 @@ pub fn parse_positive_length(s: &str) -> Result<f64> {
 
 /// A range `380nm..780nm` (the unit may be given once at the end: `380..780nm`).
 pub fn parse_length_range(s: &str) -> Result<(f64, f64)> {
-    let (a, b) = s
-        .split_once("..")
-        .ok_or_else(|| Error::usage(format!("'{s}' is not a range (expected e.g. 380nm..780nm)")))?;
+    let (a, b) = s.split_once("..").ok_or_else(|| {
+        Error::usage(format!("'{s}' is not a range (expected e.g. 380nm..780nm)"))
+    })?;
     let (_, unit_b) = split_number(b);
     let (_, unit_a) = split_number(a);
     let lo = if unit_a.is_empty() && !unit_b.is_empty() {
@@ -101,7 +105,11 @@ pub fn parse_angle(s: &str) -> Result<f64> {
     let r = match unit {
         "" | "deg" | "°" => v.to_radians(),
         "rad" => v,
-        _ => return Err(Error::usage(format!("'{s}': unknown angle unit '{unit}' (deg, rad)"))),
+        _ => {
+            return Err(Error::usage(format!(
+                "'{s}': unknown angle unit '{unit}' (deg, rad)"
+            )))
+        }
     };
     if !r.is_finite() {
         return Err(Error::usage(format!("'{s}' is not a finite angle")));
@@ -114,10 +122,18 @@ pub fn parse_size(s: &str) -> Result<(usize, usize)> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| Error::usage(format!("'{s}' is not a size (expected WxH, e.g. 512x512)")))?;
-    let w: usize = w.trim().parse().map_err(|_| Error::usage(format!("'{s}': bad width")))?;
-    let h: usize = h.trim().parse().map_err(|_| Error::usage(format!("'{s}': bad height")))?;
+    let w: usize = w
+        .trim()
+        .parse()
+        .map_err(|_| Error::usage(format!("'{s}': bad width")))?;
+    let h: usize = h
+        .trim()
+        .parse()
+        .map_err(|_| Error::usage(format!("'{s}': bad height")))?;
     if w == 0 || h == 0 || w > 1 << 16 || h > 1 << 16 {
-        return Err(Error::usage(format!("'{s}': width and height must be 1..65536")));
+        return Err(Error::usage(format!(
+            "'{s}': width and height must be 1..65536"
+        )));
     }
     Ok((w, h))
 }

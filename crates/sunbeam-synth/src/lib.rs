@@ -89,9 +89,17 @@ impl Ridges {
     }
 
     /// Sample the field on `width x height` pixels of size `pixel` (metres).
-    pub fn generate(&self, name: &str, width: usize, height: usize, pixel: f64) -> Result<HeightField> {
+    pub fn generate(
+        &self,
+        name: &str,
+        width: usize,
+        height: usize,
+        pixel: f64,
+    ) -> Result<HeightField> {
         if !(self.period > 0.0 && self.height >= 0.0 && (0.0..=1.0).contains(&self.rise)) {
-            return Err(Error::usage("synthetic ridges: need period > 0, height >= 0, rise in [0, 1]"));
+            return Err(Error::usage(
+                "synthetic ridges: need period > 0, height >= 0, rise in [0, 1]",
+            ));
         }
         let mut rng = SplitMix64(self.seed);
         let noise = if self.roughness > 0.0 {
@@ -106,7 +114,8 @@ impl Ridges {
         for r in 0..height {
             // y runs up the image (PHYSICS.md 1): row 0 is the top.
             let y = (height - 1 - r) as f64 * pixel;
-            let shift = self.wave_amplitude * (2.0 * std::f64::consts::PI * y / self.wave_length).sin();
+            let shift =
+                self.wave_amplitude * (2.0 * std::f64::consts::PI * y / self.wave_length).sin();
             for c in 0..width {
                 let x = c as f64 * pixel + shift;
                 let phase = x / self.period;
@@ -225,8 +234,9 @@ mod tests {
             let px = 20e-9;
             let n = 400; // 8 um
             let f = preset(name, n, px).unwrap();
-            let mean_row: Vec<f64> =
-                (0..n).map(|c| (0..n).map(|r| f.at(r, c)).sum::<f64>() / n as f64).collect();
+            let mean_row: Vec<f64> = (0..n)
+                .map(|c| (0..n).map(|r| f.at(r, c)).sum::<f64>() / n as f64)
+                .collect();
             let mut best = (0, 0.0);
             for k in 1..n / 2 {
                 let (mut re, mut im) = (0.0, 0.0);
