@@ -6,6 +6,10 @@ CARGO_FLAGS ?= --release --locked
 
 .PHONY: all build demo test deps clean
 
+# wgpu's GL/Wayland probing complains without a runtime dir; give tests a private one.
+XDG_RUNTIME_DIR ?= $(shell d=$${TMPDIR:-/tmp}/sunbeam-xdg-$$(id -u); mkdir -p -m 700 $$d && echo $$d)
+export XDG_RUNTIME_DIR
+
 all: build
 
 deps:
@@ -15,7 +19,7 @@ build:
 	$(CARGO) build $(CARGO_FLAGS) --workspace
 
 demo: deps build
-	$(MAKE) -C examples
+	$(MAKE) -C examples -j2
 
 # One feature set and one profile for build and test, so nothing compiles twice.
 test: deps

@@ -301,7 +301,7 @@ impl Renderer {
         });
 
         // Packs: one terms buffer per distinct pack.
-        let max_binding = device.limits().max_storage_buffer_binding_size as u64;
+        let max_binding = device.limits().max_storage_buffer_binding_size;
         let mut pack_bufs: Vec<(*const Pack, Arc<wgpu::Buffer>, usize)> = Vec::new();
         let mut meshes = Vec::new();
         for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {

@@ -99,7 +99,9 @@ pub fn build(
     let mut data = vec![[0.0f32; 4]; nu * nv * nw];
     let threads = threads.max(1);
     let slices: Vec<(usize, &mut [[f32; 4]])> = data.chunks_mut(nu * nv).enumerate().collect();
-    let mut work: Vec<Vec<(usize, &mut [[f32; 4]])>> = (0..threads).map(|_| Vec::new()).collect();
+    // One list of (w slice index, slice) per worker thread.
+    type Slice<'a> = (usize, &'a mut [[f32; 4]]);
+    let mut work: Vec<Vec<Slice>> = (0..threads).map(|_| Vec::new()).collect();
     for (k, s) in slices {
         work[k % threads].push((k, s));
     }
@@ -205,8 +207,8 @@ pub fn build(
                                     Model::Tiled => sre,
                                 };
                                 let cell = &mut acc[iv * nu + iu];
-                                for k in 0..3 {
-                                    cell[k] += r * s.weight[k];
+                                for (c, w) in cell.iter_mut().zip(&s.weight) {
+                                    *c += r * w;
                                 }
                             }
                         }
