@@ -314,7 +314,7 @@ pub fn list_channels_bytes(bytes: &[u8], opts: &ReadOptions) -> Result<Vec<Chann
     Ok(read_bytes(bytes, opts)?
         .iter()
         .enumerate()
-        .map(|(i, c)| info(i, c, fmt))
+        .map(|(i, c)| ChannelInfo::of(i, c, fmt.unwrap_or(Format::Ascii)))
         .collect())
 }
 
@@ -325,17 +325,20 @@ pub fn list_channels(path: &Path, opts: &ReadOptions) -> Result<Vec<ChannelInfo>
     list_channels_bytes(&bytes, opts).map_err(|e| e.context(path.display()))
 }
 
-fn info(index: usize, c: &Channel, fmt: Option<Format>) -> ChannelInfo {
-    ChannelInfo {
-        index,
-        name: c.name.clone(),
-        z_unit: c.z_unit.clone(),
-        xy_unit: c.xy_unit.clone(),
-        is_height: c.is_height,
-        width: c.field.width,
-        height: c.field.height,
-        size: (c.field.size_x(), c.field.size_y()),
-        format: fmt.unwrap_or(Format::Ascii),
+impl ChannelInfo {
+    /// The description of channel `index` of a file in format `format`.
+    pub fn of(index: usize, c: &Channel, format: Format) -> Self {
+        ChannelInfo {
+            index,
+            name: c.name.clone(),
+            z_unit: c.z_unit.clone(),
+            xy_unit: c.xy_unit.clone(),
+            is_height: c.is_height,
+            width: c.field.width,
+            height: c.field.height,
+            size: (c.field.size_x(), c.field.size_y()),
+            format,
+        }
     }
 }
 

@@ -298,17 +298,7 @@ fn list_infos(bytes: &[u8], plan: &Plan) -> Result<(Vec<ChannelInfo>, Format)> {
         let infos = chans
             .iter()
             .enumerate()
-            .map(|(index, c)| ChannelInfo {
-                index,
-                name: c.name.clone(),
-                z_unit: c.z_unit.clone(),
-                xy_unit: c.xy_unit.clone(),
-                is_height: c.is_height,
-                width: c.field.width,
-                height: c.field.height,
-                size: (c.field.size_x(), c.field.size_y()),
-                format: Format::Exr,
-            })
+            .map(|(index, c)| ChannelInfo::of(index, c, Format::Exr))
             .collect();
         return Ok((infos, Format::Exr));
     }
