@@ -416,8 +416,8 @@ impl Renderer {
                     };
                     mu.n_table = table.len() as u32;
                     mu.bin_scale_um = [
-                        (m.bin_scale_m[0] * 1e-6) as f32,
-                        (m.bin_scale_m[1] * 1e-6) as f32,
+                        (m.bin_scale_m[0] * 1e6) as f32,
+                        (m.bin_scale_m[1] * 1e6) as f32,
                     ];
                     mu.half_range_um = (h * 1e6) as f32;
                     mu.beta = m.kernel.beta as f32;

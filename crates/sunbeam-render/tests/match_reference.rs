@@ -41,11 +41,15 @@ fn out_dir() -> PathBuf {
 }
 
 fn check(name: &str, gpu: &Gpu, p: &Prepared, mean_max: f64, p99_max: f64) {
+    check_with(name, gpu, p, &Settings::default(), mean_max, p99_max)
+}
+
+fn check_with(name: &str, gpu: &Gpu, p: &Prepared, st: &Settings, mean_max: f64, p99_max: f64) {
     let t = std::time::Instant::now();
     let reference = sunbeam_raster::render_prepared(p, &Options::default());
     let t_cpu = t.elapsed();
     let t = std::time::Instant::now();
-    let frame = sunbeam_render::render_headless(gpu, p, &Settings::default(), None, 1).unwrap();
+    let frame = sunbeam_render::render_headless(gpu, p, st, None, 1).unwrap();
     let t_gpu = t.elapsed();
     let dir = out_dir();
     reference
@@ -87,6 +91,22 @@ fn blazed_grating_quad_matches_reference() {
     };
     let Some(gpu) = gpu() else { return };
     check("quad-blazed", &gpu, &p, 0.5, 2.0);
+}
+
+/// The per-fragment path (`--mode direct`, shared with the thesis mode) against the
+/// same reference: a regression test for a pack-unit slip (bin scale in um) that
+/// sent every fragment to the specular bin and rendered the mesh white.
+#[test]
+fn direct_mode_quad_matches_reference() {
+    let Some(p) = with_pack(&fixtures::BLAZED, fixtures::quad_scene(SIZE)) else {
+        return;
+    };
+    let Some(gpu) = gpu() else { return };
+    let st = Settings {
+        mode: Mode::Direct,
+        ..Default::default()
+    };
+    check_with("quad-blazed-direct", &gpu, &p, &st, 0.5, 2.0);
 }
 
 #[test]
