@@ -9,9 +9,11 @@
 //   (tiled model), exactly as sunbeam_pack::Pack::reflectance;
 // XYZ = G * sum_l R_l weight_l; linear sRGB; diffuse blend; exposure; tone curve; sRGB OETF.
 //
-// Modes: 0 = default: the same sum precomputed per pack as a response table
-// T(u, v, w) (XYZ without G, crates/sunbeam-render/src/table.rs) read with 8
-// loads and trilinear interpolation; 3 = direct (the sum above per fragment);
+// Modes: 0 = default: the same sum precomputed per pack, T(u, v, w) (XYZ
+// without G), read from the response map (crates/sunbeam-response: a 3D texture
+// over a polar grid, docs/PACK_FORMAT.md "Response map") with trilinear samples
+// averaged over the pixel's footprint; or, without a map, from the Cartesian
+// response table (crates/sunbeam-render/src/table.rs, `--mode table`); 3 = direct (the sum above per fragment);
 // 1 = thesis (fixed term count, 5 nm samples, nearest texel, no interpolation);
 // 2 = Lambert (base colour only).
 
@@ -30,7 +32,8 @@ struct Globals {
     n_lights: u32,
     mode: u32,
     curve: u32,
-    // 0: write display values (UNORM/float target); 1: write their linear value (sRGB target)
+    // 0: write display values (UNORM/float target); 1: write their linear value (sRGB target);
+    // 2: write linear light times the exposure (offscreen; the display transform follows on the CPU)
     output: u32,
     exposure_scale: f32,
     n_lambda: u32,
@@ -74,6 +77,16 @@ struct Material {
     _q0: f32,
     _q1: f32,
     _q2: f32,
+    // response map (sunbeam-response): 1 when bound; texels (angle, radius, s);
+    // radial warp rho = asinh(r / r0) / rho_scale; 1 = average over the footprint
+    resp_on: u32,
+    resp_n_theta: f32,
+    resp_n_rho: f32,
+    resp_n_s: f32,
+    resp_r0: f32,
+    resp_rho_scale: f32,
+    resp_footprint: u32,
+    _r0: f32,
 };
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -87,6 +100,9 @@ struct Material {
 @group(1) @binding(2) var<storage, read> term_table: array<u32>;
 // response table, (iw * nv + iv) * nu + iu, xyz
 @group(1) @binding(3) var<storage, read> response: array<vec4<f32>>;
+// response map: XYZ at texel (angle, radius, s); repeat in angle, clamp elsewhere
+@group(1) @binding(4) var resp_tex: texture_3d<f32>;
+@group(1) @binding(5) var resp_smp: sampler;
 
 struct VsIn {
     @location(0) pos: vec3<f32>,
@@ -367,6 +383,54 @@ fn response_xyz(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     return mix(mix(c00, c01, f.y), mix(c10, c11, f.y), f.z);
 }
 
+// ---------------------------------------------------------------- response map
+// Continuous texel coordinates (angle, radius, s) of (u, v, w), texel centres at
+// integers (crates/sunbeam-response/src/grid.rs).
+fn resp_coords(uvw: vec3<f32>) -> vec3<f32> {
+    let r = length(uvw.xy);
+    var th = atan2(uvw.y, uvw.x);
+    if (th < 0.0) {
+        th = th + TAU;
+    }
+    let rho = clamp(asinh(r / mat.resp_r0) / mat.resp_rho_scale, 0.0, 1.0);
+    let s = clamp(-uvw.z / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
+    return vec3<f32>(th / TAU * mat.resp_n_theta, rho * (mat.resp_n_rho - 1.0), s * (mat.resp_n_s - 1.0));
+}
+
+// Derivative of the angle coordinate (texels) along a screen direction, from
+// those of u and v (no jump where the angle wraps).
+fn resp_dtheta(uv: vec2<f32>, duv: vec2<f32>) -> f32 {
+    let r2 = max(dot(uv, uv), 1e-12);
+    return (uv.x * duv.y - uv.y * duv.x) / r2 * mat.resp_n_theta / TAU;
+}
+
+fn resp_sample(c: vec3<f32>) -> vec3<f32> {
+    let n = vec3<f32>(mat.resp_n_theta, mat.resp_n_rho, mat.resp_n_s);
+    let cc = vec3<f32>(c.x, clamp(c.y, 0.0, n.y - 1.0), clamp(c.z, 0.0, n.z - 1.0));
+    return textureSampleLevel(resp_tex, resp_smp, (cc + 0.5) / n, 0.0).xyz;
+}
+
+// T over the pixel: the footprint is the parallelogram spanned by the texel-space
+// derivatives jx, jy; up to 4 x 4 stratified samples cover it (a box filter,
+// as a camera pixel integrates), one sample when it is within a texel.
+fn response_map_xyz(c: vec3<f32>, jx: vec3<f32>, jy: vec3<f32>) -> vec3<f32> {
+    var nx = 1u;
+    var ny = 1u;
+    if (mat.resp_footprint == 1u) {
+        nx = u32(clamp(ceil(length(jx)), 1.0, 4.0));
+        ny = u32(clamp(ceil(length(jy)), 1.0, 4.0));
+    }
+    var acc = vec3<f32>(0.0);
+    for (var a = 0u; a < nx; a = a + 1u) {
+        for (var b = 0u; b < ny; b = b + 1u) {
+            let ox = (f32(a) + 0.5) / f32(nx) - 0.5;
+            let oy = (f32(b) + 0.5) / f32(ny) - 0.5;
+            acc = acc + resp_sample(c + ox * jx + oy * jy);
+        }
+    }
+    return acc / f32(nx * ny);
+}
+
 // ---------------------------------------------------------------- colour
 fn schlick(c: f32) -> f32 {
     let m = 1.0 - clamp(c, 0.0, 1.0);
@@ -409,6 +473,11 @@ fn srgb_eotf(v: f32) -> f32 {
 
 // sunbeam_optics::colour::display_encode
 fn display(rgb: vec3<f32>) -> vec4<f32> {
+    if (g.output == 2u) {
+        var lin = rgb * g.exposure_scale;
+        lin = select(lin, vec3<f32>(0.0), lin != lin);
+        return vec4<f32>(max(lin, vec3<f32>(0.0)), 1.0);
+    }
     var out = vec3<f32>(0.0);
     for (var k = 0; k < 3; k = k + 1) {
         var x = rgb[k] * g.exposure_scale;
@@ -460,10 +529,20 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         let wi = g.lights[i].xyz;
         let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
         let cos_i = max(wi_l.z, 0.0);
+        // Response-map coordinates and their screen derivatives, here in uniform
+        // control flow (derivatives are undefined inside the branch below).
+        let uvw = -wi_l - wr_l;
+        let rc = resp_coords(uvw);
+        let duv_x = dpdx(uvw.xy);
+        let duv_y = dpdy(uvw.xy);
+        let jx = vec3<f32>(resp_dtheta(uvw.xy, duv_x), dpdx(rc.y), dpdx(rc.z));
+        let jy = vec3<f32>(resp_dtheta(uvw.xy, duv_y), dpdy(rc.y), dpdy(rc.z));
         var diff = vec3<f32>(0.0);
         if (diffract && dw < 1.0 && wi_l.z > 0.0 && wr_l.z > 0.0) {
             var xyz: vec3<f32>;
-            if (g.mode == 0u && mat.tab_on == 1u) {
+            if (g.mode == 0u && mat.resp_on == 1u) {
+                xyz = response_map_xyz(rc, jx, jy);
+            } else if (g.mode == 0u && mat.tab_on == 1u) {
                 xyz = response_xyz(wi_l, wr_l);
             } else {
                 xyz = diffraction_xyz(wi_l, wr_l);

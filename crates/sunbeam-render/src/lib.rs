@@ -15,6 +15,7 @@
 
 pub mod gpu;
 pub mod renderer;
+pub mod response;
 pub mod table;
 pub mod window;
 
@@ -35,12 +36,33 @@ pub fn render_headless(
 ) -> Result<Image> {
     let [w, h] = size.unwrap_or(p.scene.size);
     let r = Renderer::new(gpu, p, settings, OFFSCREEN_FORMAT)?;
-    let target = Offscreen::new(gpu, w, h)?;
+    let target = Offscreen::new(gpu, &r, w, h)?;
     let state = FrameState::from_scene(p);
     for _ in 1..frames.max(1) {
         target.draw(gpu, &r, &state)?;
     }
     target.render(gpu, &r, &state)
+}
+
+/// Render one frame offscreen in linear light, `supersample` x the size in each
+/// direction and box-filtered back (1: no supersampling; MSAA as in `settings`).
+pub fn render_headless_linear(
+    gpu: &Gpu,
+    p: &Prepared,
+    settings: &Settings,
+    size: Option<[u32; 2]>,
+    frames: u32,
+    supersample: u32,
+) -> Result<sunbeam_raster::LinearImage> {
+    let [w, h] = size.unwrap_or(p.scene.size);
+    let k = supersample.max(1);
+    let r = Renderer::new(gpu, p, settings, OFFSCREEN_FORMAT)?;
+    let target = Offscreen::new(gpu, &r, w * k, h * k)?;
+    let state = FrameState::from_scene(p);
+    for _ in 1..frames.max(1) {
+        target.draw(gpu, &r, &state)?;
+    }
+    Ok(target.render_linear(gpu, &r, &state)?.downsample(k))
 }
 
 /// Frame times of a headless run, milliseconds (each frame waited for).
@@ -76,17 +98,18 @@ impl FrameTimes {
     }
 }
 
-/// Time `frames` offscreen frames (the first is reported apart) and return the last image.
+/// Time `frames` offscreen frames (the first is reported apart) and return the
+/// last image in linear light.
 pub fn bench_headless(
     gpu: &Gpu,
     p: &Prepared,
     settings: &Settings,
     size: [u32; 2],
     frames: u32,
-) -> Result<(FrameTimes, Image)> {
+) -> Result<(FrameTimes, sunbeam_raster::LinearImage)> {
     let t0 = Instant::now();
     let r = Renderer::new(gpu, p, settings, OFFSCREEN_FORMAT)?;
-    let target = Offscreen::new(gpu, size[0], size[1])?;
+    let target = Offscreen::new(gpu, &r, size[0], size[1])?;
     let state = FrameState::from_scene(p);
     gpu.wait()?;
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -96,7 +119,7 @@ pub fn bench_headless(
         target.draw(gpu, &r, &state)?;
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
-    let img = target.render(gpu, &r, &state)?;
+    let img = target.render_linear(gpu, &r, &state)?;
     let first_ms = times[0];
     Ok((
         FrameTimes {

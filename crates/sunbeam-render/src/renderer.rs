@@ -8,7 +8,7 @@ use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
 use sunbeam_optics::{cie, gain};
 use sunbeam_pack::{Basis, Model, Pack};
 use sunbeam_raster::spectral::Samples;
-use sunbeam_raster::{Image, Prepared};
+use sunbeam_raster::{Image, LinearImage, Prepared};
 use sunbeam_scene::{camera, Camera, Light};
 use wgpu::util::DeviceExt;
 
@@ -29,9 +29,13 @@ pub const THESIS_TERMS: u32 = 39;
 /// Which shading the pipeline does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Mode {
-    /// PHYSICS.md 2 through the pack's response table (built at load, trilinear).
+    /// PHYSICS.md 2 through the pack's response map (sunbeam-response: built by
+    /// `sunbeam-pack --response`, loaded; polar grid, filtered over the pixel footprint).
     #[default]
     Default,
+    /// The former default: a Cartesian 256 x 256 x 32 table over (u, v, w) built on
+    /// the CPU at load (crate::table). Kept as the benchmark baseline.
+    Table,
     /// PHYSICS.md 2 summed per fragment (terms, taps, wavelengths), no table.
     Direct,
     /// The thesis' shader: fixed 39 terms, 5 nm steps, nearest bin.
@@ -44,12 +48,13 @@ impl std::str::FromStr for Mode {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
         match s {
-            "default" | "table" => Ok(Mode::Default),
+            "default" | "response" => Ok(Mode::Default),
+            "table" => Ok(Mode::Table),
             "direct" => Ok(Mode::Direct),
             "thesis" => Ok(Mode::Thesis),
             "lambert" => Ok(Mode::Lambert),
             _ => Err(Error::usage(format!(
-                "unknown mode '{s}' (default, direct, thesis, lambert)"
+                "unknown mode '{s}' (default, table, direct, thesis, lambert)"
             ))),
         }
     }
@@ -65,8 +70,15 @@ pub struct Settings {
     /// Bound on |dR| from truncating the series per fragment (None: the pack's own
     /// tolerance or series bound, whichever is larger).
     pub term_tolerance: Option<f64>,
-    /// Response table resolution of the default mode.
+    /// Response table resolution of the table mode.
     pub table: crate::table::Dims,
+    /// How the default mode builds a response map when none is beside the pack.
+    pub response: sunbeam_response::Options,
+    /// Multisample count of the colour target (1 or 4): anti-aliased silhouettes.
+    pub msaa: u32,
+    /// Default mode: average the response over the pixel's footprint (up to 4 x 4
+    /// samples) instead of reading it at the pixel centre.
+    pub footprint: bool,
 }
 
 /// Default wavelength sample count (docs/PLAY.md: chosen by measurement).
@@ -80,6 +92,9 @@ impl Default for Settings {
             curve: ToneCurve::default(),
             term_tolerance: None,
             table: Default::default(),
+            response: Default::default(),
+            msaa: 4,
+            footprint: true,
         }
     }
 }
@@ -162,6 +177,14 @@ struct MaterialU {
     tab_w0: f32,
     tab_dw: f32,
     _q: [f32; 3],
+    resp_on: u32,
+    resp_n_theta: f32,
+    resp_n_rho: f32,
+    resp_n_s: f32,
+    resp_r0: f32,
+    resp_rho_scale: f32,
+    resp_footprint: u32,
+    _r: f32,
 }
 
 struct GpuMesh {
@@ -283,8 +306,37 @@ impl Renderer {
                 storage_entry(1),
                 storage_entry(2),
                 storage_entry(3),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D3,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
             ],
         });
+        // Response maps: angle repeats, radius and s clamp, trilinear.
+        let resp_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("response map"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let dummy_view = Arc::new(dummy_texture(gpu));
+        let mut resp_views: Vec<(Arc<sunbeam_response::Response>, Arc<wgpu::TextureView>)> =
+            Vec::new();
         let global_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("globals"),
             layout: &gl0,
@@ -341,6 +393,7 @@ impl Renderer {
                 ..Default::default()
             };
             let mut response: Option<Vec<[f32; 4]>> = None;
+            let mut resp_map: Option<Arc<sunbeam_response::Response>> = None;
             let (terms_buf, table): (Arc<wgpu::Buffer>, Vec<u32>) = match &mat.pack {
                 Some(pack) if settings.mode != Mode::Lambert => {
                     let m = &pack.manifest;
@@ -429,6 +482,27 @@ impl Renderer {
                     };
                     mu.table_dt = dt as f32;
                     if settings.mode == Mode::Default {
+                        let path = p.scene.meshes.get(mi).and_then(|m| m.pack.as_deref());
+                        let t0 = std::time::Instant::now();
+                        let (resp, note) =
+                            crate::response::load_or_build(pack, path, &settings.response)?;
+                        log::info!(
+                            "response map {:?} ready in {:.2?}",
+                            resp.info.grid,
+                            t0.elapsed()
+                        );
+                        warnings.extend(note);
+                        let gr = resp.info.grid;
+                        mu.resp_on = 1;
+                        mu.resp_n_theta = gr.n_theta as f32;
+                        mu.resp_n_rho = gr.n_rho as f32;
+                        mu.resp_n_s = gr.n_s as f32;
+                        mu.resp_r0 = gr.r0 as f32;
+                        mu.resp_rho_scale = gr.rho_scale() as f32;
+                        mu.resp_footprint = u32::from(settings.footprint);
+                        resp_map = Some(resp);
+                    }
+                    if settings.mode == Mode::Table {
                         let t0 = std::time::Instant::now();
                         let tt = table.clone();
                         let terms_at = move |at: f64| -> usize {
@@ -487,6 +561,18 @@ impl Renderer {
                 contents: bytemuck::cast_slice(&rdata),
                 usage: wgpu::BufferUsages::STORAGE,
             });
+            let resp_view = match &resp_map {
+                Some(r) => resp_views
+                    .iter()
+                    .find(|(k, _)| Arc::ptr_eq(k, r))
+                    .map(|(_, v)| v.clone())
+                    .unwrap_or_else(|| {
+                        let v = Arc::new(response_texture(gpu, r));
+                        resp_views.push((r.clone(), v.clone()));
+                        v
+                    }),
+                None => dummy_view.clone(),
+            };
             let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("material"),
                 layout: &gl1,
@@ -506,6 +592,14 @@ impl Renderer {
                     wgpu::BindGroupEntry {
                         binding: 3,
                         resource: rbuf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: wgpu::BindingResource::TextureView(&resp_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: wgpu::BindingResource::Sampler(&resp_sampler),
                     },
                 ],
             });
@@ -553,7 +647,10 @@ impl Renderer {
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
-            multisample: Default::default(),
+            multisample: wgpu::MultisampleState {
+                count: settings.msaa.max(1),
+                ..Default::default()
+            },
             fragment: Some(wgpu::FragmentState {
                 module: &module,
                 entry_point: Some("fs_main"),
@@ -623,7 +720,7 @@ impl Renderer {
             ],
             n_lights: n as u32,
             mode: match self.settings.mode {
-                Mode::Default => 0,
+                Mode::Default | Mode::Table => 0,
                 Mode::Thesis => 1,
                 Mode::Lambert => 2,
                 Mode::Direct => 3,
@@ -632,7 +729,11 @@ impl Renderer {
                 ToneCurve::Clamp => 0,
                 ToneCurve::Reinhard => 1,
             },
-            output: u32::from(self.format.is_srgb()),
+            output: if self.format == OFFSCREEN_FORMAT {
+                2
+            } else {
+                u32::from(self.format.is_srgb())
+            },
             exposure_scale: state.exposure.exp2() as f32,
             n_lambda: self.n_lambda,
             f0: gain::f0(gain::DEFAULT_IOR) as f32,
@@ -660,11 +761,24 @@ impl Renderer {
         }
     }
 
-    /// Record a frame into `colour` (with `depth` of the same size).
+    /// Multisample count of the pipeline (the colour and depth targets must match).
+    pub fn msaa(&self) -> u32 {
+        self.settings.msaa.max(1)
+    }
+
+    /// Tone curve of the display transform.
+    pub fn curve(&self) -> ToneCurve {
+        self.settings.curve
+    }
+
+    /// Record a frame into `colour` (with `depth` of the same size and sample
+    /// count); with MSAA, `colour` is the multisampled target and `resolve` the
+    /// single-sample one that receives the average.
     pub fn encode(
         &self,
         enc: &mut wgpu::CommandEncoder,
         colour: &wgpu::TextureView,
+        resolve: Option<&wgpu::TextureView>,
         depth: &wgpu::TextureView,
         state: &FrameState,
     ) {
@@ -673,7 +787,7 @@ impl Renderer {
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: colour,
                 depth_slice: None,
-                resolve_target: None,
+                resolve_target: resolve,
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(self.clear_colour(state)),
                     store: wgpu::StoreOp::Store,
@@ -705,8 +819,52 @@ impl Renderer {
     }
 }
 
-/// A depth texture view of the given size.
+/// A 3D RGBA16F texture holding a response map.
+fn response_texture(gpu: &Gpu, r: &sunbeam_response::Response) -> wgpu::TextureView {
+    let g = r.info.grid;
+    texture_3d(
+        gpu,
+        [g.n_theta as u32, g.n_rho as u32, g.n_s as u32],
+        &r.data,
+    )
+}
+
+fn texture_3d(gpu: &Gpu, size: [u32; 3], data: &[u16]) -> wgpu::TextureView {
+    gpu.device
+        .create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("response map"),
+                size: wgpu::Extent3d {
+                    width: size[0],
+                    height: size[1],
+                    depth_or_array_layers: size[2],
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(data),
+        )
+        .create_view(&Default::default())
+}
+
+/// A 1x1x1 stand-in for materials without a response map.
+fn dummy_texture(gpu: &Gpu) -> wgpu::TextureView {
+    texture_3d(gpu, [1, 1, 1], &[0; 4])
+}
+
+/// A depth texture view of the given size (single-sample).
 pub fn depth_view(gpu: &Gpu, w: u32, h: u32) -> wgpu::TextureView {
+    depth_view_ms(gpu, w, h, 1)
+}
+
+/// A depth texture view of the given size and sample count.
+pub fn depth_view_ms(gpu: &Gpu, w: u32, h: u32, samples: u32) -> wgpu::TextureView {
     gpu.device
         .create_texture(&wgpu::TextureDescriptor {
             label: Some("depth"),
@@ -716,7 +874,7 @@ pub fn depth_view(gpu: &Gpu, w: u32, h: u32) -> wgpu::TextureView {
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
-            sample_count: 1,
+            sample_count: samples.max(1),
             dimension: wgpu::TextureDimension::D2,
             format: DEPTH_FORMAT,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -725,22 +883,53 @@ pub fn depth_view(gpu: &Gpu, w: u32, h: u32) -> wgpu::TextureView {
         .create_view(&Default::default())
 }
 
-/// An offscreen float target with readback: frames come back as display values.
+/// A colour texture view to render into (`samples > 1`: multisampled, not readable).
+pub fn colour_view(
+    gpu: &Gpu,
+    w: u32,
+    h: u32,
+    format: wgpu::TextureFormat,
+    samples: u32,
+) -> wgpu::TextureView {
+    gpu.device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("msaa colour"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: samples.max(1),
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+}
+
+/// An offscreen float target with readback: frames come back in linear light
+/// (exposure applied) and go through the display transform on the CPU
+/// (`sunbeam_raster::LinearImage::display`), so that MSAA resolves average
+/// linear values, as a camera does.
 pub struct Offscreen {
     pub width: u32,
     pub height: u32,
     tex: wgpu::Texture,
     view: wgpu::TextureView,
+    msaa: Option<wgpu::TextureView>,
     depth: wgpu::TextureView,
     readback: wgpu::Buffer,
     padded_row: u32,
 }
 
-/// Colour format of offscreen frames (exact display values, quantised only when written).
-pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// Colour format of offscreen frames (linear values; MSAA-resolvable everywhere).
+pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 impl Offscreen {
-    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Offscreen> {
+    /// A target for `r`'s pipeline (its sample count).
+    pub fn new(gpu: &Gpu, r: &Renderer, width: u32, height: u32) -> Result<Offscreen> {
         let lim = gpu.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > lim || height > lim {
             return Err(Error::usage(format!(
@@ -762,7 +951,9 @@ impl Offscreen {
             view_formats: &[],
         });
         let view = tex.create_view(&Default::default());
-        let padded_row = (width * 16).div_ceil(256) * 256;
+        let ms = r.msaa();
+        let msaa = (ms > 1).then(|| colour_view(gpu, width, height, OFFSCREEN_FORMAT, ms));
+        let padded_row = (width * 8).div_ceil(256) * 256;
         let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size: padded_row as u64 * height as u64,
@@ -774,27 +965,45 @@ impl Offscreen {
             height,
             tex,
             view,
-            depth: depth_view(gpu, width, height),
+            msaa,
+            depth: depth_view_ms(gpu, width, height, ms),
             readback,
             padded_row,
         })
+    }
+
+    fn record(&self, enc: &mut wgpu::CommandEncoder, r: &Renderer, state: &FrameState) {
+        match &self.msaa {
+            Some(ms) => r.encode(enc, ms, Some(&self.view), &self.depth, state),
+            None => r.encode(enc, &self.view, None, &self.depth, state),
+        }
     }
 
     /// Render one frame and wait for it (no readback).
     pub fn draw(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<()> {
         r.update(gpu, state, self.width, self.height);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        r.encode(&mut enc, &self.view, &self.depth, state);
+        self.record(&mut enc, r, state);
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
         gpu.take_errors()
     }
 
-    /// Render one frame and read it back.
+    /// Render one frame and read it back as display values.
     pub fn render(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<Image> {
+        Ok(self.render_linear(gpu, r, state)?.display(r.curve()))
+    }
+
+    /// Render one frame and read it back in linear light (exposure applied).
+    pub fn render_linear(
+        &self,
+        gpu: &Gpu,
+        r: &Renderer,
+        state: &FrameState,
+    ) -> Result<LinearImage> {
         r.update(gpu, state, self.width, self.height);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        r.encode(&mut enc, &self.view, &self.depth, state);
+        self.record(&mut enc, r, state);
         enc.copy_texture_to_buffer(
             self.tex.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
@@ -822,18 +1031,19 @@ impl Offscreen {
             .map_err(|e| Error::internal(format!("readback: {e}")))?
             .map_err(|e| Error::internal(format!("readback: {e}")))?;
         gpu.take_errors()?;
-        let mut img = Image::new(self.width, self.height);
+        let mut img = LinearImage::new(self.width, self.height);
         {
             let data = self
                 .readback
                 .get_mapped_range(..)
                 .map_err(|e| Error::internal(format!("readback: {e}")))?;
-            let px: &[f32] = bytemuck::cast_slice(&data);
-            let stride = (self.padded_row / 4) as usize;
+            let px: &[u16] = bytemuck::cast_slice(&data);
+            let stride = (self.padded_row / 2) as usize;
+            let f = |b: u16| half::f16::from_bits(b).to_f32();
             for y in 0..self.height as usize {
                 for x in 0..self.width as usize {
                     let i = y * stride + x * 4;
-                    img.rgb[y * self.width as usize + x] = [px[i], px[i + 1], px[i + 2]];
+                    img.rgb[y * self.width as usize + x] = [f(px[i]), f(px[i + 1]), f(px[i + 2])];
                 }
             }
         }

@@ -10,7 +10,7 @@
 //! for `--hold-secs`, then exits (the Xvfb test uses this).
 
 use crate::gpu::{Backend, Gpu, INSTALL_HINT};
-use crate::renderer::{depth_view, FrameState, Renderer, Settings};
+use crate::renderer::{colour_view, depth_view_ms, FrameState, Renderer, Settings};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -76,6 +76,8 @@ struct Gfx {
     config: wgpu::SurfaceConfiguration,
     renderer: Renderer,
     depth: wgpu::TextureView,
+    /// The multisampled colour target (MSAA), resolved into the surface.
+    msaa: Option<wgpu::TextureView>,
     can_copy: bool,
 }
 
@@ -168,7 +170,10 @@ impl App {
             config.width,
             config.height
         );
-        let depth = depth_view(&gpu, config.width, config.height);
+        let ms = renderer.msaa();
+        let depth = depth_view_ms(&gpu, config.width, config.height, ms);
+        let msaa =
+            (ms > 1).then(|| colour_view(&gpu, config.width, config.height, config.format, ms));
         window.request_redraw();
         self.gfx = Some(Gfx {
             window,
@@ -177,6 +182,7 @@ impl App {
             config,
             renderer,
             depth,
+            msaa,
             can_copy,
         });
         Ok(())
@@ -201,7 +207,14 @@ impl App {
         g.renderer
             .update(&g.gpu, &self.state, g.config.width, g.config.height);
         let mut enc = g.gpu.device.create_command_encoder(&Default::default());
-        g.renderer.encode(&mut enc, &view, &g.depth, &self.state);
+        match &g.msaa {
+            Some(ms) => g
+                .renderer
+                .encode(&mut enc, ms, Some(&view), &g.depth, &self.state),
+            None => g
+                .renderer
+                .encode(&mut enc, &view, None, &g.depth, &self.state),
+        }
         let counted = self.opts.frames.is_some_and(|n| self.frame + 1 == n);
         let shot = if counted && g.can_copy {
             self.opts.screenshot.as_ref()
@@ -322,7 +335,10 @@ impl ApplicationHandler for App {
                     g.config.width = sz.width;
                     g.config.height = sz.height;
                     g.surface.configure(&g.gpu.device, &g.config);
-                    g.depth = depth_view(&g.gpu, sz.width, sz.height);
+                    let ms = g.renderer.msaa();
+                    g.depth = depth_view_ms(&g.gpu, sz.width, sz.height, ms);
+                    g.msaa = (ms > 1)
+                        .then(|| colour_view(&g.gpu, sz.width, sz.height, g.config.format, ms));
                     g.window.request_redraw();
                 }
             }

@@ -208,9 +208,12 @@ struct GratingArgs {
 pub struct RenderArgs {
     /// Scene JSON (docs/SCENE.md); or give --mesh and --pack for the default scene.
     scene: Option<PathBuf>,
-    /// Output PNG.
+    /// Output: FRAME.png (display values) or FRAME.exr (linear light, exposure applied).
     #[arg(short, long)]
     output: PathBuf,
+    /// Samples per pixel: a stratified s x s grid averaged in linear light (1, 4, 9, 16, ...).
+    #[arg(long, default_value_t = 1)]
+    samples: u32,
     /// Mesh (GLB/glTF/OBJ) for the default scene of sunbeam-play --mesh --pack.
     #[arg(long)]
     mesh: Option<PathBuf>,

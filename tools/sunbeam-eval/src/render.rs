@@ -1,7 +1,9 @@
 //! `sunbeam-eval render`: the CPU reference image of a scene, through
 //! `sunbeam_raster::render` (the same scene loading and defaults as
 //! `sunbeam-play`: a scene file, or `--mesh M --pack P` for
-//! `Scene::default_for`).
+//! `Scene::default_for`). `--samples N` averages a stratified grid of sub-pixel
+//! samples in linear light (the anti-aliased reference); `-o F.exr` writes the
+//! linear frame (exposure applied, no tone curve) instead of display values.
 
 use sunbeam_common::{units, Error, Result};
 use sunbeam_scene::Scene;
@@ -39,6 +41,18 @@ pub fn run(a: &crate::RenderArgs) -> Result<()> {
         scene.size = [w as u32, h as u32];
         scene.validate()?;
     }
-    let img = sunbeam_raster::render(&scene)?;
-    img.write_png(&a.output)
+    let opts = sunbeam_raster::Options {
+        samples: a.samples,
+        ..Default::default()
+    };
+    sunbeam_raster::samples_side(a.samples)?;
+    let exr = a
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if exr {
+        sunbeam_raster::render_linear(&scene, &opts)?.write_exr(&a.output)
+    } else {
+        sunbeam_raster::render_with(&scene, &opts)?.write_png(&a.output)
+    }
 }

@@ -90,6 +90,19 @@ struct Cli {
     /// Worker threads (the output does not depend on it).
     #[arg(long)]
     threads: Option<usize>,
+    /// Also write the response map the player and engines read (docs/PACK_FORMAT.md
+    /// "Response map"): beside the pack as NAME.response.ktx2, or to --response-out.
+    #[arg(long)]
+    response: bool,
+    /// Where to write the response map (implies --response).
+    #[arg(long, value_name = "FILE.ktx2")]
+    response_out: Option<PathBuf>,
+    /// Wavelength samples of the response map's colour integral.
+    #[arg(long, default_value_t = sunbeam_response::build::DEFAULT_LAMBDA_SAMPLES)]
+    response_lambda: usize,
+    /// Size bound of the response map (e.g. 64MiB; RGBA16F texels).
+    #[arg(long, default_value = "64MiB")]
+    response_budget: String,
     /// Print a JSON report on stdout.
     #[arg(long)]
     json: bool,
@@ -114,6 +127,35 @@ fn parse_pixel_size(s: &str) -> Result<(f64, f64)> {
             let v = units::parse_positive_length(s)?;
             Ok((v, v))
         }
+    }
+}
+
+/// `NAME.response.ktx2` beside the pack `NAME.ktx2` / `NAME.exr` (what the player looks for).
+fn sunbeam_response_path(pack: &std::path::Path) -> PathBuf {
+    let stem = pack
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    pack.with_file_name(format!("{stem}.response.ktx2"))
+}
+
+/// A byte count with an optional KiB/MiB/GiB suffix.
+fn parse_bytes(s: &str) -> Result<usize> {
+    let t = s.trim();
+    let (num, mult) = [
+        ("GiB", 1usize << 30),
+        ("MiB", 1 << 20),
+        ("KiB", 1 << 10),
+        ("B", 1),
+    ]
+    .iter()
+    .find_map(|(suf, m)| t.strip_suffix(suf).map(|n| (n.trim(), *m)))
+    .unwrap_or((t, 1));
+    match num.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 1.0 => Ok((v * mult as f64) as usize),
+        _ => Err(Error::usage(format!(
+            "--response-budget '{s}': give a size such as 64MiB"
+        ))),
     }
 }
 
@@ -273,7 +315,30 @@ fn run(cli: Cli) -> Result<()> {
         }
     };
     let pack = build::run(fr, &plan, o.threads, &mut progress)?;
-    let files = write_pack(&pack, &cli.output, kind)?;
+    let pack_secs = t0.elapsed().as_secs_f64();
+    let response_path = cli
+        .response_out
+        .clone()
+        .or_else(|| cli.response.then(|| sunbeam_response_path(&cli.output)));
+    let response = match &response_path {
+        Some(_) => {
+            let t = Instant::now();
+            let ro = sunbeam_response::Options {
+                lambda_samples: cli.response_lambda.clamp(1, 4096),
+                budget_bytes: parse_bytes(&cli.response_budget)?,
+                grid: None,
+            };
+            let r = sunbeam_response::build(&pack, &ro);
+            Some((r, t.elapsed().as_secs_f64()))
+        }
+        None => None,
+    };
+    let mut files = write_pack(&pack, &cli.output, kind)?;
+    if let (Some(rp), Some((r, _))) = (&response_path, &response) {
+        let bytes = sunbeam_response::ktx2::encode(r);
+        sunbeam_common::output::write_atomic(rp, &bytes)?;
+        files.push((rp.clone(), bytes.len() as u64));
+    }
     let mut bytes: u64 = files.iter().map(|f| f.1).sum();
     if let Some(mp) = &cli.manifest {
         let s = pack.manifest.to_json_pretty();
@@ -308,6 +373,14 @@ fn run(cli: Cli) -> Result<()> {
             "max_w": m.max_w,
             "bytes_written": bytes,
             "time_s": secs,
+            "pack_time_s": pack_secs,
+            "response": response.as_ref().map(|(r, t)| serde_json::json!({
+                "grid": [r.info.grid.n_theta, r.info.grid.n_rho, r.info.grid.n_s],
+                "r0": r.info.grid.r0,
+                "lambda_samples": r.info.lambda_samples,
+                "bytes": r.byte_len(),
+                "time_s": t,
+            })),
             "warnings": warnings,
             "notes": m.notes,
         });

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 use sunbeam_common::{units, Error, Result};
 use sunbeam_optics::colour::ToneCurve;
-use sunbeam_raster::{Image, Prepared};
+use sunbeam_raster::{Image, LinearImage, Prepared};
 use sunbeam_render::window::{self, WindowOptions};
 use sunbeam_render::{Backend, Gpu, Mode, Settings};
 use sunbeam_scene::Scene;
@@ -30,9 +30,19 @@ struct Cli {
     /// Render offscreen (no window) and write -o.
     #[arg(long)]
     headless: bool,
-    /// Output PNG (headless), or the screenshot of the window (with --frames).
+    /// Output FRAME.png (display values) or FRAME.exr (headless: linear light, exposure
+    /// applied), or the PNG screenshot of the window (with --frames).
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Multisample anti-aliasing of silhouettes: 1 (off) or 4.
+    #[arg(long, default_value_t = 4)]
+    msaa: u32,
+    /// Headless: render K x K times the size and box-filter in linear light.
+    #[arg(long, default_value_t = 1)]
+    supersample: u32,
+    /// Default mode: read the response map at the pixel centre only (no footprint filter).
+    #[arg(long)]
+    no_footprint: bool,
     /// Frame size WxH (headless: default the scene's size; window: initial size).
     #[arg(long)]
     size: Option<String>,
@@ -45,7 +55,8 @@ struct Cli {
     /// GPU backend.
     #[arg(long, default_value = "auto")]
     backend: String,
-    /// Shading: default, thesis (39 terms, 5 nm, nearest bin), lambert (base colour only).
+    /// Shading: default (response map), table (the former Cartesian table, built at load),
+    /// direct (per-fragment sum), thesis (39 terms, 5 nm, nearest bin), lambert (base colour only).
     #[arg(long, default_value = "default")]
     mode: String,
     /// Same as --mode thesis.
@@ -69,7 +80,8 @@ struct Cli {
     /// Render with the CPU reference (sunbeam-raster) instead of the GPU.
     #[arg(long)]
     cpu: bool,
-    /// Compare the frame with a reference PNG (CIEDE2000 mean / p99 / max in the report).
+    /// Compare the frame with a reference: PNG (8-bit, every pixel) or EXR (linear,
+    /// lit pixels): CIEDE2000 mean / p99 / max in the report.
     #[arg(long)]
     compare: Option<PathBuf>,
     /// Headless benchmark: time --frames frames (default 10) and print the frame times.
@@ -142,13 +154,25 @@ fn settings(cli: &Cli) -> Result<Settings> {
         }
     }
     let curve: ToneCurve = cli.tone.parse()?;
+    if cli.msaa != 1 && cli.msaa != 4 {
+        return Err(Error::usage("--msaa must be 1 or 4"));
+    }
+    if !(1..=4).contains(&cli.supersample) {
+        return Err(Error::usage("--supersample must be 1..4"));
+    }
     Ok(Settings {
         mode,
         lambda_samples: cli.lambda_samples,
         curve,
         term_tolerance: cli.term_tolerance,
+        msaa: cli.msaa,
+        footprint: !cli.no_footprint,
         ..Default::default()
     })
+}
+
+fn is_exr(p: &std::path::Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
 fn inputs(p: &Prepared, cli: &Cli) -> Vec<PathBuf> {
@@ -193,13 +217,15 @@ fn run(cli: Cli) -> Result<()> {
         "size": size,
         "mode": format!("{:?}", st.mode).to_lowercase(),
     });
-    let image: Image = if cli.cpu {
+    let image: LinearImage = if cli.cpu {
         let t = std::time::Instant::now();
+        let k = cli.supersample.max(1);
         let opts = sunbeam_raster::Options {
             curve: st.curve,
+            samples: k * k,
             ..Default::default()
         };
-        let img = sunbeam_raster::render_prepared(&prepared, &opts);
+        let img = sunbeam_raster::render_prepared_linear(&prepared, &opts)?;
         report["renderer"] = "cpu reference (sunbeam-raster)".into();
         report["render_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
         img
@@ -214,6 +240,7 @@ fn run(cli: Cli) -> Result<()> {
             report["frame_ms_median"] = times.median_ms().into();
             report["frame_ms_mean"] = times.mean_ms().into();
             report["frame_ms"] = times.rest_ms.clone().into();
+            report["msaa"] = st.msaa.into();
             if !cli.json {
                 println!(
                     "{} {:?} {}x{}: setup {:.0} ms, first frame {:.1} ms, then median {:.2} ms / mean {:.2} ms over {} frames ({:.1} fps)",
@@ -231,6 +258,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             img
         } else {
+            let t = std::time::Instant::now();
             let r = sunbeam_render::Renderer::new(
                 &gpu,
                 &prepared,
@@ -240,25 +268,38 @@ fn run(cli: Cli) -> Result<()> {
             for w in &r.warnings {
                 eprintln!("sunbeam-play: warning: {w}");
             }
-            let target = sunbeam_render::Offscreen::new(&gpu, size[0], size[1])?;
+            report["setup_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
+            let k = cli.supersample.max(1);
+            let target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;
             let state = sunbeam_render::FrameState::from_scene(&prepared);
             for _ in 1..cli.frames.unwrap_or(1).max(1) {
                 target.draw(&gpu, &r, &state)?;
             }
-            target.render(&gpu, &r, &state)?
+            target.render_linear(&gpu, &r, &state)?.downsample(k)
         }
     };
     if let Some(refp) = &cli.compare {
-        let reference = Image::read_png(refp)?;
-        let q = Image::from_rgba8(image.width, image.height, &image.to_rgba8());
-        let d = sunbeam_raster::compare(&q, &reference).map_err(|e| e.context(refp.display()))?;
+        let d = if is_exr(refp) {
+            let reference = LinearImage::read_exr(refp)?;
+            sunbeam_raster::compare_linear(&image, &reference)
+                .map_err(|e| e.context(refp.display()))?
+        } else {
+            let reference = Image::read_png(refp)?;
+            let disp = image.display(st.curve);
+            let q = Image::from_rgba8(disp.width, disp.height, &disp.to_rgba8());
+            sunbeam_raster::compare(&q, &reference).map_err(|e| e.context(refp.display()))?
+        };
         report["ciede2000"] = serde_json::json!({"mean": d.mean, "p99": d.p99, "max": d.max});
         if !cli.json && !cli.quiet {
             println!("against {}: {d}", refp.display());
         }
     }
     if let Some(out) = &cli.output {
-        image.write_png(out)?;
+        if is_exr(out) {
+            image.write_exr(out)?;
+        } else {
+            image.display(st.curve).write_png(out)?;
+        }
         report["output"] = out.display().to_string().into();
         if let Some(dep) = &cli.depfile {
             let ins = inputs(&prepared, &cli);

@@ -1,0 +1,225 @@
+//! Linear-light frames: what a camera records before the display transform.
+//!
+//! A [`LinearImage`] holds linear sRGB (Rec. 709 primaries, D65 white) radiance
+//! times `2^exposure`, so that `display_encode` with exposure 0 turns it into the
+//! PNG a renderer writes. Comparisons between renderers are made on these values
+//! (CIEDE2000 over lit pixels, [`compare_linear`]): they are not clipped by the
+//! 8-bit display transform. Files are single-part RGB float32 OpenEXR,
+//! uncompressed (written by `exr`; no attributes beyond the required ones, so the
+//! bytes depend on the pixels only).
+
+use std::path::Path;
+use sunbeam_common::{Error, Result};
+use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
+
+use crate::image::ColourDiff;
+use crate::Image;
+
+/// Linear sRGB values (exposure applied), row 0 at the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearImage {
+    pub width: u32,
+    pub height: u32,
+    pub rgb: Vec<[f32; 3]>,
+}
+
+/// Luminance `Y` (white = 1) under which a pixel of the reference counts as unlit:
+/// L* = 1.0, darker than the 8-bit display can show apart from black.
+pub const LIT_Y: f64 = 0.0011;
+
+impl LinearImage {
+    pub fn new(width: u32, height: u32) -> LinearImage {
+        LinearImage {
+            width,
+            height,
+            rgb: vec![[0.0; 3]; width as usize * height as usize],
+        }
+    }
+
+    /// Average `s x s` blocks (a box filter in linear light): the anti-aliased frame.
+    pub fn downsample(&self, s: u32) -> LinearImage {
+        if s <= 1 {
+            return self.clone();
+        }
+        let (w, h) = (self.width / s, self.height / s);
+        let mut out = LinearImage::new(w, h);
+        let inv = 1.0 / (s * s) as f64;
+        for y in 0..h {
+            for x in 0..w {
+                let mut acc = [0.0f64; 3];
+                for j in 0..s {
+                    let row = ((y * s + j) * self.width + x * s) as usize;
+                    for p in &self.rgb[row..row + s as usize] {
+                        for k in 0..3 {
+                            acc[k] += p[k] as f64;
+                        }
+                    }
+                }
+                out.rgb[(y * w + x) as usize] = acc.map(|v| (v * inv) as f32);
+            }
+        }
+        out
+    }
+
+    /// The display image (tone curve and sRGB OETF; the exposure is already applied).
+    pub fn display(&self, curve: ToneCurve) -> Image {
+        let tm = ToneMap {
+            exposure_ev: 0.0,
+            curve,
+        };
+        Image {
+            width: self.width,
+            height: self.height,
+            rgb: self
+                .rgb
+                .iter()
+                .map(|p| colour::display_encode(p.map(f64::from), &tm).map(|v| v as f32))
+                .collect(),
+        }
+    }
+
+    /// OpenEXR bytes: RGB float32, uncompressed, deterministic.
+    pub fn exr_bytes(&self) -> Result<Vec<u8>> {
+        use exr::prelude::{
+            Encoding, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage,
+        };
+        let (w, h) = (self.width as usize, self.height as usize);
+        let px = |p: Vec2<usize>| {
+            let c = self.rgb[p.y() * w + p.x()];
+            (c[0], c[1], c[2])
+        };
+        let channels = SpecificChannels::rgb(px);
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::default(),
+            Encoding::UNCOMPRESSED,
+            channels,
+        );
+        let image = exr::image::Image::from_layer(layer);
+        let mut out = std::io::Cursor::new(Vec::new());
+        image
+            .write()
+            .non_parallel()
+            .to_buffered(&mut out)
+            .map_err(|e| Error::internal(format!("OpenEXR encoding: {e}")))?;
+        Ok(out.into_inner())
+    }
+
+    /// Write atomically as OpenEXR.
+    pub fn write_exr(&self, path: &Path) -> Result<()> {
+        let bytes = self.exr_bytes()?;
+        sunbeam_common::output::write_atomic(path, &bytes)
+    }
+
+    /// Read an RGB(A) OpenEXR (the first layer; channels R, G, B).
+    pub fn read_exr(path: &Path) -> Result<LinearImage> {
+        use exr::prelude::{read, ReadChannels, ReadLayers, Vec2};
+        let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, e.to_string()))?;
+        let img = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .rgb_channels(
+                |res, _| LinearImage::new(res.width() as u32, res.height() as u32),
+                |im: &mut LinearImage, p: Vec2<usize>, (r, g, b): (f32, f32, f32)| {
+                    let w = im.width as usize;
+                    im.rgb[p.y() * w + p.x()] = [r, g, b];
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .non_parallel()
+            .from_buffered(std::io::Cursor::new(bytes))
+            .map_err(|e| Error::input_file(path, format!("not an RGB OpenEXR image: {e}")))?;
+        Ok(img.layer_data.channel_data.pixels)
+    }
+}
+
+/// Luminance of a linear sRGB pixel (white = 1).
+pub fn luminance(p: [f32; 3]) -> f64 {
+    colour::linear_srgb_to_xyz(p.map(f64::from))[1]
+}
+
+/// CIEDE2000 between two linear images over the pixels that are lit in the
+/// reference `b` (`Y >= LIT_Y`): mean, 99th percentile, max (PHYSICS.md 4, with
+/// Lab relative to the D65 white of Y = 1, so values above 1 are allowed).
+pub fn compare_linear(a: &LinearImage, reference: &LinearImage) -> Result<ColourDiff> {
+    if a.width != reference.width || a.height != reference.height {
+        return Err(Error::input(format!(
+            "image sizes differ: {}x{} vs {}x{}",
+            a.width, a.height, reference.width, reference.height
+        )));
+    }
+    let mut d: Vec<f64> = a
+        .rgb
+        .iter()
+        .zip(&reference.rgb)
+        .filter(|(_, q)| luminance(**q) >= LIT_Y)
+        .map(|(p, q)| {
+            colour::ciede2000_xyz(
+                colour::linear_srgb_to_xyz(p.map(|v| f64::from(v).max(0.0))),
+                colour::linear_srgb_to_xyz(q.map(|v| f64::from(v).max(0.0))),
+            )
+        })
+        .collect();
+    Ok(stats(&mut d))
+}
+
+/// Mean, 99th percentile and max of a list of differences.
+pub fn stats(d: &mut [f64]) -> ColourDiff {
+    let n = d.len();
+    if n == 0 {
+        return ColourDiff {
+            mean: 0.0,
+            p99: 0.0,
+            max: 0.0,
+            pixels: 0,
+        };
+    }
+    let mean = d.iter().sum::<f64>() / n as f64;
+    d.sort_by(|x, y| x.total_cmp(y));
+    let p99 = d[((n as f64 * 0.99).ceil() as usize).clamp(1, n) - 1];
+    ColourDiff {
+        mean,
+        p99,
+        max: d[n - 1],
+        pixels: n,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trip_and_box_filter() {
+        let mut im = LinearImage::new(4, 2);
+        for (i, p) in im.rgb.iter_mut().enumerate() {
+            *p = [i as f32, 0.5, 2.0 * i as f32];
+        }
+        let dir = std::env::temp_dir().join(format!("sunbeam-linear-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("a.exr");
+        im.write_exr(&f).unwrap();
+        let back = LinearImage::read_exr(&f).unwrap();
+        assert_eq!(back, im);
+        let d = im.downsample(2);
+        assert_eq!((d.width, d.height), (2, 1));
+        // (0 + 1 + 4 + 5) / 4 and (2 + 3 + 6 + 7) / 4
+        assert_eq!(d.rgb[0][0], 2.5);
+        assert_eq!(d.rgb[1][0], 4.5);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn compare_counts_lit_pixels_only() {
+        let mut a = LinearImage::new(2, 1);
+        let mut b = LinearImage::new(2, 1);
+        a.rgb = vec![[0.5, 0.5, 0.5], [0.0, 0.0, 0.0]];
+        b.rgb = vec![[0.5, 0.5, 0.5], [1e-5, 0.0, 0.0]];
+        let d = compare_linear(&a, &b).unwrap();
+        assert_eq!(d.pixels, 1);
+        assert!(d.max < 1e-9);
+        b.rgb[0] = [0.6, 0.5, 0.5];
+        assert!(compare_linear(&a, &b).unwrap().max > 1.0);
+    }
+}

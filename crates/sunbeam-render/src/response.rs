@@ -1,0 +1,62 @@
+//! Finding a pack's response map (sunbeam-response) for the default mode.
+//!
+//! `sunbeam-pack --response` writes it beside the pack as `NAME.response.ktx2`
+//! (for `NAME.ktx2` or `NAME.exr`). The player loads that file when it exists
+//! and was built from the same pack (the embedded manifests are equal); else it
+//! builds the map itself, which takes seconds for large packs, and says so.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use sunbeam_common::Result;
+use sunbeam_pack::Pack;
+use sunbeam_response::{ktx2, Response};
+
+/// `dir/NAME.response.ktx2` for a pack `dir/NAME.ext`.
+pub fn sidecar(pack: &Path) -> PathBuf {
+    let stem = pack
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    pack.with_file_name(format!("{stem}.response.ktx2"))
+}
+
+/// The map of `pack` (read from `path`'s sidecar, or built), and a note for the
+/// user when it had to be built.
+pub fn load_or_build(
+    pack: &Arc<Pack>,
+    path: Option<&Path>,
+    opts: &sunbeam_response::Options,
+) -> Result<(Arc<Response>, Option<String>)> {
+    if let Some(p) = path {
+        let side = sidecar(p);
+        if side.is_file() {
+            let r = ktx2::read(&side)?;
+            if r.info.pack == pack.manifest {
+                return Ok((Arc::new(r), None));
+            }
+            let t = std::time::Instant::now();
+            let r = sunbeam_response::build(pack, opts);
+            return Ok((
+                Arc::new(r),
+                Some(format!(
+                    "{} was built from another pack; built the response map in {:.1} s \
+                     (rebuild it: sunbeam-pack --response)",
+                    side.display(),
+                    t.elapsed().as_secs_f64()
+                )),
+            ));
+        }
+    }
+    let t = std::time::Instant::now();
+    let r = sunbeam_response::build(pack, opts);
+    let note = path.map(|p| {
+        format!(
+            "no response map beside {} ({}); built it in {:.1} s: write it once with \
+             `sunbeam-pack --response` to open instantly",
+            p.display(),
+            sidecar(p).display(),
+            t.elapsed().as_secs_f64()
+        )
+    });
+    Ok((Arc::new(r), note))
+}

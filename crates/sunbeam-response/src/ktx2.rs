@@ -1,0 +1,193 @@
+//! KTX2 files of response maps: one 3D texture, `VK_FORMAT_R16G16B16A16_SFLOAT`,
+//! one level, no supercompression, the [`Info`](crate::Info) JSON under the key
+//! `sunbeam.response` (and `KTXwriter`). Hand-written rather than through a
+//! crate because the `ktx2` crate only reads, and the layout is a few fixed
+//! fields (KTX 2.0 spec sections 3-4; the same rules as sunbeam-pack's
+//! 2D-array writer, which this mirrors for a 3D, four-channel texture).
+
+use crate::{Info, Response, INFO_KEY};
+use sunbeam_common::{Error, Result};
+use sunbeam_pack::ktx2::IDENTIFIER;
+
+/// VK_FORMAT_R16G16B16A16_SFLOAT.
+pub const VK_R16G16B16A16_SFLOAT: u32 = 97;
+const HEADER_LEN: usize = 80;
+const LEVEL_INDEX_LEN: usize = 24;
+const TEXEL: usize = 8;
+
+fn dfd() -> Vec<u8> {
+    let block = 24 + 16 * 4;
+    let mut d = Vec::with_capacity(4 + block);
+    d.extend_from_slice(&((4 + block) as u32).to_le_bytes());
+    d.extend_from_slice(&0u32.to_le_bytes()); // Khronos, basic descriptor
+    d.extend_from_slice(&(2u32 | ((block as u32) << 16)).to_le_bytes());
+    d.extend_from_slice(&[1, 1, 1, 0]); // RGBSDA, BT.709 primaries, linear, flags 0
+    d.extend_from_slice(&[0, 0, 0, 0]); // 1x1x1x1 block
+    d.extend_from_slice(&[TEXEL as u8, 0, 0, 0, 0, 0, 0, 0]);
+    for (c, id) in [0u32, 1, 2, 15].into_iter().enumerate() {
+        let w0 = (c as u32 * 16) | (15 << 16) | ((id | 0xC0) << 24); // signed float
+        d.extend_from_slice(&w0.to_le_bytes());
+        d.extend_from_slice(&0u32.to_le_bytes());
+        d.extend_from_slice(&(-1.0f32).to_bits().to_le_bytes());
+        d.extend_from_slice(&1.0f32.to_bits().to_le_bytes());
+    }
+    d
+}
+
+fn kvd(info_json: &str) -> Vec<u8> {
+    let writer = format!("sunbeam-response {}", env!("CARGO_PKG_VERSION"));
+    let mut out = Vec::new();
+    // Sorted by key bytes: "KTXwriter" < "sunbeam.response".
+    for (k, v) in [("KTXwriter", writer.as_str()), (INFO_KEY, info_json)] {
+        let len = k.len() + 1 + v.len() + 1;
+        out.extend_from_slice(&(len as u32).to_le_bytes());
+        out.extend_from_slice(k.as_bytes());
+        out.push(0);
+        out.extend_from_slice(v.as_bytes());
+        out.push(0);
+        while out.len() % 4 != 0 {
+            out.push(0);
+        }
+    }
+    out
+}
+
+/// Encode a map as KTX2 bytes (deterministic).
+pub fn encode(r: &Response) -> Vec<u8> {
+    let g = &r.info.grid;
+    let info = serde_json::to_string(&r.info).expect("info serialises");
+    let dfd = dfd();
+    let kvd = kvd(&info);
+    let dfd_off = HEADER_LEN + LEVEL_INDEX_LEN;
+    let kvd_off = dfd_off + dfd.len();
+    let data_off = (kvd_off + kvd.len()).div_ceil(TEXEL) * TEXEL;
+    let data_len = r.data.len() * 2;
+    let mut out = Vec::with_capacity(data_off + data_len);
+    out.extend_from_slice(&IDENTIFIER);
+    for v in [
+        VK_R16G16B16A16_SFLOAT,
+        2, // typeSize
+        g.n_theta as u32,
+        g.n_rho as u32,
+        g.n_s as u32,
+        0, // layerCount
+        1, // faceCount
+        1, // levelCount
+        0, // supercompression
+        dfd_off as u32,
+        dfd.len() as u32,
+        kvd_off as u32,
+        kvd.len() as u32,
+    ] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&0u64.to_le_bytes()); // sgd offset
+    out.extend_from_slice(&0u64.to_le_bytes()); // sgd length
+    for v in [data_off as u64, data_len as u64, data_len as u64] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&dfd);
+    out.extend_from_slice(&kvd);
+    out.resize(data_off, 0);
+    for v in &r.data {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out
+}
+
+/// Whether `bytes` look like a response map (KTX2 with a `sunbeam.response` key).
+pub fn is_response(bytes: &[u8]) -> bool {
+    bytes.starts_with(&IDENTIFIER)
+        && bytes.len() >= HEADER_LEN
+        && u32::from_le_bytes(bytes[12..16].try_into().unwrap()) == VK_R16G16B16A16_SFLOAT
+}
+
+/// Decode KTX2 bytes; every size is checked against the file length first.
+pub fn decode(bytes: &[u8]) -> Result<Response> {
+    if !bytes.starts_with(&IDENTIFIER) {
+        return Err(Error::input("not a KTX2 file (wrong identifier)"));
+    }
+    if bytes.len() < HEADER_LEN + LEVEL_INDEX_LEN {
+        return Err(Error::input("KTX2 file truncated in its header"));
+    }
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
+    let u64_at = |o: usize| u64::from_le_bytes(bytes[o..o + 8].try_into().unwrap());
+    if u32_at(12) != VK_R16G16B16A16_SFLOAT {
+        return Err(Error::input(format!(
+            "KTX2 vkFormat {} is not a response map (R16G16B16A16_SFLOAT, 97)",
+            u32_at(12)
+        )));
+    }
+    let (w, h, d) = (
+        u32_at(20) as usize,
+        u32_at(24) as usize,
+        u32_at(28) as usize,
+    );
+    if u32_at(36) != 1 || u32_at(40) != 1 || u32_at(44) != 0 {
+        return Err(Error::input(
+            "KTX2 response map must have one face, one level, no supercompression",
+        ));
+    }
+    let (kvd_off, kvd_len) = (u32_at(56) as usize, u32_at(60) as usize);
+    let (lv_off, lv_len) = (u64_at(80), u64_at(88));
+    let need = (w as u128) * (h as u128) * (d as u128) * TEXEL as u128;
+    if lv_len as u128 != need
+        || lv_off
+            .checked_add(lv_len)
+            .is_none_or(|e| e > bytes.len() as u64)
+        || kvd_off.checked_add(kvd_len).is_none_or(|e| e > bytes.len())
+    {
+        return Err(Error::input(format!(
+            "KTX2 level of {lv_len} bytes at {lv_off} does not fit a {w}x{h}x{d} RGBA16F texture in a {}-byte file",
+            bytes.len()
+        )));
+    }
+    let mut info: Option<Info> = None;
+    let mut p = kvd_off;
+    while p + 4 <= kvd_off + kvd_len {
+        let len = u32_at(p) as usize;
+        let Some(entry) = bytes.get(p + 4..p + 4 + len) else {
+            return Err(Error::input("KTX2 key/value data truncated"));
+        };
+        if let Some(z) = entry.iter().position(|&b| b == 0) {
+            if &entry[..z] == INFO_KEY.as_bytes() {
+                let v = &entry[z + 1..];
+                let v = v.strip_suffix(&[0]).unwrap_or(v);
+                let text = std::str::from_utf8(v)
+                    .map_err(|_| Error::input("sunbeam.response is not UTF-8"))?;
+                info =
+                    Some(serde_json::from_str(text).map_err(|e| {
+                        Error::input(format!("sunbeam.response JSON is invalid: {e}"))
+                    })?);
+            }
+        }
+        p += 4 + len.div_ceil(4) * 4;
+    }
+    let info = info.ok_or_else(|| Error::input("KTX2 file has no sunbeam.response key"))?;
+    let g = &info.grid;
+    if (g.n_theta, g.n_rho, g.n_s) != (w, h, d) {
+        return Err(Error::input(format!(
+            "sunbeam.response grid {}x{}x{} differs from the texture {w}x{h}x{d}",
+            g.n_theta, g.n_rho, g.n_s
+        )));
+    }
+    let raw = &bytes[lv_off as usize..(lv_off + lv_len) as usize];
+    let data = raw
+        .chunks_exact(2)
+        .map(|c| u16::from_le_bytes([c[0], c[1]]))
+        .collect();
+    let r = Response { info, data };
+    r.validate()?;
+    Ok(r)
+}
+
+/// Read a map from a file (errors name the file).
+pub fn read(path: &std::path::Path) -> Result<Response> {
+    let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, e))?;
+    decode(&bytes).map_err(|e| e.context(path.display().to_string()))
+}
+
+/// Write a map atomically.
+pub fn write(r: &Response, path: &std::path::Path) -> Result<()> {
+    sunbeam_common::output::write_atomic(path, &encode(r))
+}

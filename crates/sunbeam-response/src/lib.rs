@@ -1,0 +1,143 @@
+//! The response map: the real-time representation of a term pack that the
+//! player (`sunbeam-play`) and engines read (docs/PACK_FORMAT.md "Response map").
+//!
+//! It stores, after the spectral integral,
+//! `T(u, v, w) = sum_l R(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)` (XYZ,
+//! without the gain `G`, which a shader computes per light) on the polar grid of
+//! [`grid`], as one RGBA16F 3D texture (XYZ in RGB). A shader then reads it with
+//! one trilinear sample per light (more when a pixel's footprint spans several
+//! texels), times `G`. It is built once, offline, by `sunbeam-pack --response`
+//! ([`build::build`]); the player only loads it.
+//!
+//! Files: KTX2 (a 3D texture, `VK_FORMAT_R16G16B16A16_SFLOAT`, the [`Info`] JSON
+//! under the key `sunbeam.response`), see [`ktx2`].
+
+pub mod build;
+pub mod grid;
+pub mod ktx2;
+
+pub use build::{build, Options};
+pub use grid::Grid;
+
+use serde::{Deserialize, Serialize};
+use sunbeam_common::{Error, Result};
+use sunbeam_pack::Manifest;
+
+/// `Info::format` of every response map.
+pub const FORMAT: &str = "sunbeam-response";
+/// Format version.
+pub const VERSION: u32 = 1;
+/// Key of the info JSON in the KTX2 key/value data.
+pub const INFO_KEY: &str = "sunbeam.response";
+
+/// What a response map holds (JSON in the file).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Info {
+    /// Always "sunbeam-response".
+    pub format: String,
+    pub version: u32,
+    pub generator: String,
+    pub grid: Grid,
+    /// Wavelength samples of the colour integral (midpoints of equal intervals).
+    pub lambda_samples: usize,
+    pub lambda_range_nm: [u32; 2],
+    /// What the texels are (a sentence).
+    pub quantity: String,
+    /// The manifest of the pack it was built from.
+    pub pack: Manifest,
+}
+
+/// A response map in memory: `data` holds f16 bits, RGBA, texel
+/// `(i, j, k)` (angle, radius, s) at `4 * ((k * n_rho + j) * n_theta + i)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Response {
+    pub info: Info,
+    pub data: Vec<u16>,
+}
+
+impl Response {
+    /// Check sizes and values (after reading a file).
+    pub fn validate(&self) -> Result<()> {
+        let g = &self.info.grid;
+        if self.info.format != FORMAT || self.info.version != VERSION {
+            return Err(Error::input(format!(
+                "not a {FORMAT} v{VERSION} map (format '{}', version {})",
+                self.info.format, self.info.version
+            )));
+        }
+        let sides_ok = [g.n_theta, g.n_rho, g.n_s]
+            .iter()
+            .all(|n| (2..=4096).contains(n));
+        if !(sides_ok && g.r0.is_finite() && g.r0 > 0.0) {
+            return Err(Error::input(format!("response grid out of range: {g:?}")));
+        }
+        if self.data.len() != g.texels() * 4 {
+            return Err(Error::input(format!(
+                "response data holds {} values, the grid needs {}",
+                self.data.len(),
+                g.texels() * 4
+            )));
+        }
+        if self
+            .data
+            .iter()
+            .any(|&b| !half::f16::from_bits(b).is_finite())
+        {
+            return Err(Error::input("response data holds NaN or Inf values"));
+        }
+        Ok(())
+    }
+
+    /// XYZ of texel `(i, j, k)`.
+    pub fn texel(&self, i: usize, j: usize, k: usize) -> [f64; 3] {
+        let g = &self.info.grid;
+        let o = 4 * ((k * g.n_rho + j) * g.n_theta + i);
+        [0, 1, 2].map(|c| half::f16::from_bits(self.data[o + c]).to_f64())
+    }
+
+    /// `T(u, v, w)` (XYZ without `G`) by trilinear interpolation, angle wrapping,
+    /// radius and `s` clamped: what a shader's single texture sample returns.
+    pub fn lookup(&self, u: f64, v: f64, w: f64) -> [f64; 3] {
+        let g = &self.info.grid;
+        let Some(c) = g.coords(u, v, w) else {
+            return [0.0; 3];
+        };
+        self.lookup_texel(c)
+    }
+
+    /// Trilinear interpolation at continuous texel coordinates (see [`Grid::coords`]).
+    pub fn lookup_texel(&self, c: [f64; 3]) -> [f64; 3] {
+        let g = &self.info.grid;
+        let fi = c[0].floor();
+        let (ti, i0) = (c[0] - fi, (fi as i64).rem_euclid(g.n_theta as i64) as usize);
+        let i1 = (i0 + 1) % g.n_theta;
+        let split = |x: f64, n: usize| {
+            let x = x.clamp(0.0, (n - 1) as f64);
+            let j = (x.floor() as usize).min(n - 2);
+            (j, x - j as f64)
+        };
+        let (j0, tj) = split(c[1], g.n_rho);
+        let (k0, tk) = split(c[2], g.n_s);
+        let mut out = [0.0; 3];
+        for (k, wk) in [(k0, 1.0 - tk), (k0 + 1, tk)] {
+            for (j, wj) in [(j0, 1.0 - tj), (j0 + 1, tj)] {
+                for (i, wi) in [(i0, 1.0 - ti), (i1, ti)] {
+                    let wgt = wk * wj * wi;
+                    if wgt == 0.0 {
+                        continue;
+                    }
+                    let t = self.texel(i, j, k);
+                    for a in 0..3 {
+                        out[a] += wgt * t[a];
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Size in bytes of the texel data.
+    pub fn byte_len(&self) -> usize {
+        self.data.len() * 2
+    }
+}
