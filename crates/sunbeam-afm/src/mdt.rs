@@ -113,7 +113,10 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
         bail!("not an NT-MDT file (no magic 01 B0 93 FF at the start)");
     }
     if b.len() < FILE_HEADER {
-        bail!("NT-MDT: the file ({} bytes) is shorter than its 33-byte header", b.len());
+        bail!(
+            "NT-MDT: the file ({} bytes) is shorter than its 33-byte header",
+            b.len()
+        );
     }
     let size = le_u32(b, 4, "NT-MDT file header")? as u64;
     if size + FILE_HEADER as u64 != b.len() as u64 {
@@ -190,7 +193,14 @@ fn scanned(f: &[u8], var_size: usize, i: usize, index: usize, what: &str) -> Res
         q += 14 + 16 * ndots;
     }
     let n = xres * yres;
-    let mut data = decode(f, q, n, Sample::I16, Endian::Little, &format!("{what} image data"))?;
+    let mut data = decode(
+        f,
+        q,
+        n,
+        Sample::I16,
+        Endian::Little,
+        &format!("{what} image data"),
+    )?;
     q += 2 * n;
     let (mxy, xyunit) = parse_unit(unit_code(xunit));
     let (mz, zu) = parse_unit(unit_code(zunit));
@@ -212,7 +222,17 @@ fn scanned(f: &[u8], var_size: usize, i: usize, index: usize, what: &str) -> Res
         None => fallback_title(&zu, index),
     };
     let (xreal, yreal) = (xres as f64 * mxy * xstep, yres as f64 * mxy * ystep);
-    channel(Format::Mdt, &name, &zu, &xyunit, xres, yres, xreal, yreal, data)
+    channel(
+        Format::Mdt,
+        &name,
+        &zu,
+        &xyunit,
+        xres,
+        yres,
+        xreal,
+        yreal,
+        data,
+    )
 }
 
 struct Calibration {
@@ -325,7 +345,7 @@ fn mda(f: &[u8], i: usize, index: usize, what: &str) -> Result<Option<Channel>> 
     let mut data = match sample {
         Some(t) => decode(f, c, n, t, Endian::Little, &data_what)?,
         None => {
-            let len = n.checked_mul(8).unwrap_or(usize::MAX);
+            let len = n.saturating_mul(8);
             let s = slice(f, c, len, &data_what)?;
             let signed = z.data_type < 0;
             s.chunks_exact(8)

@@ -58,8 +58,12 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
             let t = match v {
                 "BINARY" | "" => Sample::I16,
                 "BINARY_32" => Sample::I32,
-                "ASCII" => bail!("PicoView MI: ASCII data is not supported (only BINARY, BINARY_32)"),
-                o => bail!("PicoView MI: data type {o:?} is not supported (only BINARY, BINARY_32)"),
+                "ASCII" => {
+                    bail!("PicoView MI: ASCII data is not supported (only BINARY, BINARY_32)")
+                }
+                o => {
+                    bail!("PicoView MI: data type {o:?} is not supported (only BINARY, BINARY_32)")
+                }
             };
             data = Some((next, t));
             break;
@@ -101,7 +105,11 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
         bail!("PicoView MI: missing or invalid yLength")
     };
     let n = xres * yres;
-    let q = if sample == Sample::I32 { 2147483648.0 } else { 32768.0 };
+    let q = if sample == Sample::I32 {
+        2147483648.0
+    } else {
+        32768.0
+    };
     let mut out = Vec::new();
     for (i, buf) in bufs.iter().enumerate() {
         let off = start + i * n * sample.size();
@@ -121,7 +129,17 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
         } else {
             &buf.label
         };
-        out.push(channel(Format::Mi, name, &unit, "m", xres, yres, xreal, yreal, d)?);
+        out.push(channel(
+            Format::Mi,
+            name,
+            &unit,
+            "m",
+            xres,
+            yres,
+            xreal,
+            yreal,
+            d,
+        )?);
     }
     Ok(out)
 }

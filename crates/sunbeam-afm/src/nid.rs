@@ -4,11 +4,12 @@
 //!
 //! `[DataSet]` has `GroupCount` and per group `GrI-Count` and the channels
 //! `GrI-ChJ=<section>`; the images follow `#!` in (group, channel) order.
-//! Each channel section: `Points` x `Lines`, `SaveBits` 8/16/32, `SaveSign=Signed`,
-//! `SaveOrder=Intel`, `Dim0Range`/`Dim1Range` (+ units) the physical size,
-//! `Dim2Name`, `Dim2Unit`, `Dim2Min`, `Dim2Range`: z = (raw + 2^(bits-1)) / 2^bits
-//! * range + min. Stored bottom row first (whatever `Scan direction` says, as
-//! Gwyddion does); backward scans are not mirrored. 1-D data (`Lines` < 2) is skipped.
+//! Each channel section: `Points` x `Lines`, `SaveBits` 8/16/32,
+//! `SaveSign=Signed`, `SaveOrder=Intel`, `Dim0Range`/`Dim1Range` (+ units)
+//! the physical size, `Dim2Name`, `Dim2Unit`, `Dim2Min`, `Dim2Range`:
+//! z = (raw + 2^(bits-1)) / 2^bits * range + min. Stored bottom row first
+//! (whatever `Scan direction` says, as Gwyddion does); backward scans are not
+//! mirrored. 1-D data (`Lines` below 2) is skipped.
 
 use std::collections::HashMap;
 
@@ -44,7 +45,10 @@ fn parse_header(head: &str) -> Result<Vec<Section>> {
             continue;
         }
         let Some(sec) = secs.last_mut() else {
-            bail!("Nanosurf NID header: text before the first [section] (line {})", lineno + 1)
+            bail!(
+                "Nanosurf NID header: text before the first [section] (line {})",
+                lineno + 1
+            )
         };
         if t.starts_with("--") {
             continue; // comment
@@ -76,7 +80,10 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
         bail!("Nanosurf NID: the header has no [DataSet] section")
     };
     if first.name != "DataSet" {
-        bail!("Nanosurf NID: the first section is [{}], not [DataSet]", first.name);
+        bail!(
+            "Nanosurf NID: the first section is [{}], not [DataSet]",
+            first.name
+        );
     }
     let ds = &first.keys;
     let ngroups = match ds.get("GroupCount") {
@@ -100,7 +107,10 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
         if i < 0 || i >= ngroups || j < 0 {
             continue;
         }
-        let count = ds.get(&format!("Gr{i}-Count")).map(|c| atol(c)).unwrap_or(0);
+        let count = ds
+            .get(&format!("Gr{i}-Count"))
+            .map(|c| atol(c))
+            .unwrap_or(0);
         if j < count {
             chans.push((i, j, v.as_str()));
         }
@@ -111,7 +121,9 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
     for (i, j, secname) in chans {
         let key = format!("Gr{i}-Ch{j}");
         let Some(sec) = secs[1..].iter().find(|s| s.name == secname) else {
-            bail!("Nanosurf NID [DataSet]: {key}={secname} names a section the header does not have")
+            bail!(
+                "Nanosurf NID [DataSet]: {key}={secname} names a section the header does not have"
+            )
         };
         let s = &sec.keys;
         let what = format!("Nanosurf NID [{secname}]");
@@ -131,7 +143,11 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
                 s.get("SaveBits").map(String::as_str).unwrap_or("")
             ),
         };
-        for (k, want) in [("SaveMode", "Binary"), ("SaveSign", "Signed"), ("SaveOrder", "Intel")] {
+        for (k, want) in [
+            ("SaveMode", "Binary"),
+            ("SaveSign", "Signed"),
+            ("SaveOrder", "Intel"),
+        ] {
             if let Some(v) = s.get(k) {
                 if v != want {
                     bail!("{what}: {k}={v} is not supported (only {want})");
@@ -151,7 +167,14 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
         let xreal = mx * num("Dim0Range");
         let yreal = my * num("Dim1Range");
         let n = xres * yres;
-        let mut data = decode(b, off, n, sample, Endian::Little, &format!("{what} data ({key})"))?;
+        let mut data = decode(
+            b,
+            off,
+            n,
+            sample,
+            Endian::Little,
+            &format!("{what} data ({key})"),
+        )?;
         off += n * sample.size();
         let q = (1u64 << bits) as f64;
         let (scale, zmin) = (mz * num("Dim2Range"), mz * num("Dim2Min"));

@@ -102,7 +102,9 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
         None | Some("short") | Some("integer") => Sample::I16,
         Some("float") => Sample::F32,
         Some("double") => Sample::F64,
-        Some(o) => bail!("WSxM: Image Data Type {o:?} is not supported (short, integer, float, double)"),
+        Some(o) => {
+            bail!("WSxM: Image Data Type {o:?} is not supported (short, integer, float, double)")
+        }
     };
     let Some((za, zm, zunit)) = get("General Info::Z Amplitude").and_then(amplitude) else {
         bail!(
@@ -130,8 +132,10 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
             hi = hi.max(v);
         }
     }
-    if !(hi > lo) {
-        bail!("WSxM: the image is flat (or not finite), so `Z Amplitude` / (max - min) has no scale");
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+        bail!(
+            "WSxM: the image is flat (or not finite), so `Z Amplitude` / (max - min) has no scale"
+        );
     }
     let f = za * zm / (hi - lo);
     for v in &mut data {
