@@ -104,8 +104,8 @@ pub fn read(b: &[u8]) -> Result<Vec<Channel>> {
         let (Ok(i), Ok(j)) = (gi.parse::<i64>(), cj.parse::<i64>()) else {
             continue;
         };
-        if i < 0 || i >= ngroups || j < 0 {
-            continue;
+        if i < 0 || i >= ngroups || j < 0 || *k != format!("Gr{i}-Ch{j}") {
+            continue; // (Gwyddion looks up exactly `GrI-ChJ`: no `Gr01-Ch1`)
         }
         let count = ds
             .get(&format!("Gr{i}-Count"))
