@@ -110,6 +110,21 @@ put("ascii", "small", b"# Channel: Height\n# Width: 2 um\n# Height: 1 um\n# Valu
 put("ascii", "bare", b"1,2;3\n4 5 6\n")
 put("xyz", "grid", b"".join(b"%g %g %g\n" % (i, j, i * j) for i in range(3) for j in range(3)))
 put("xyz", "scatter", b"0 0 1\n1 0 2\n0 1 3\n0.3 0.4 5\n1 1 1\n")
+# Nanosurf .nid, PicoView .mi, WSxM, NT-MDT: the samples and the small layout
+# variants of crates/sunbeam-afm/tests/data/gwyddion_variants (in the repository).
+V = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "crates", "sunbeam-afm",
+                 "tests", "data", "gwyddion_variants")
+for t, exts, samples in [
+        ("nid", (".nid",), ["surfacetopography_nid-1.nid", "nsfopen_grid1.nid", "nsfopen_circles.nid"]),
+        ("mi", (".mi",), ["surfacetopography_mi-1.mi"]),
+        ("wsxm", (".top",), ["surfacetopography_top-1.top", "surfacetopography_stp-1.stp"]),
+        ("mdt", (".mdt",), ["scifidatasets_test_mdt.mdt"])]:
+    for f in samples:
+        cp(t, os.path.join(S, f))
+    if os.path.isdir(V):
+        for f in sorted(os.listdir(V)):
+            if f.endswith(exts):
+                cp(t, os.path.join(V, f))
 for t in os.listdir(out):
     if t == "detect":
         continue

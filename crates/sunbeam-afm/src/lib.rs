@@ -28,6 +28,12 @@ mod sxm;
 mod tiffdir;
 mod xyz;
 
+mod mdt;
+mod mi;
+mod nid;
+mod text;
+mod wsxm;
+
 /// The file formats this crate reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Format {
@@ -44,16 +50,28 @@ pub enum Format {
     Xyz,
     Exr,
     Bmp,
+    /// Nanosurf `.nid`/`.ezd`.
+    Nid,
+    /// Keysight/Agilent PicoView `.mi`.
+    Mi,
+    /// WSxM `.top`/`.stp`/`.tom`.
+    Wsxm,
+    /// NT-MDT `.mdt`.
+    Mdt,
 }
 
 impl Format {
     /// All formats, in the order `detect` tries them.
-    pub const ALL: [Format; 13] = [
+    pub const ALL: [Format; 17] = [
         Format::Nanoscope,
         Format::Gwy,
         Format::Gsf,
         Format::Ibw,
         Format::Sxm,
+        Format::Nid,
+        Format::Mi,
+        Format::Wsxm,
+        Format::Mdt,
         Format::ParkTiff,
         Format::Jpk,
         Format::Png,
@@ -80,6 +98,10 @@ impl Format {
             Format::Xyz => "xyz",
             Format::Exr => "exr",
             Format::Bmp => "bmp",
+            Format::Nid => "nid",
+            Format::Mi => "mi",
+            Format::Wsxm => "wsxm",
+            Format::Mdt => "mdt",
         }
     }
 
@@ -100,6 +122,10 @@ impl Format {
             "xyz" => Format::Xyz,
             "exr" => Format::Exr,
             "bmp" => Format::Bmp,
+            "nid" | "nanosurf" | "ezd" => Format::Nid,
+            "mi" | "picoview" | "keysight" | "agilent" => Format::Mi,
+            "wsxm" | "top" | "stp" | "tom" => Format::Wsxm,
+            "mdt" | "nt-mdt" | "ntmdt" => Format::Mdt,
             _ => return None,
         };
         Some(f)
@@ -190,6 +216,18 @@ pub fn detect(bytes: &[u8]) -> Option<Format> {
     if bytes.starts_with(b":NANONIS_VERSION:") {
         return Some(Format::Sxm);
     }
+    if nid::detect(bytes) {
+        return Some(Format::Nid);
+    }
+    if mi::detect(bytes) {
+        return Some(Format::Mi);
+    }
+    if wsxm::detect(bytes) {
+        return Some(Format::Wsxm);
+    }
+    if mdt::detect(bytes) {
+        return Some(Format::Mdt);
+    }
     if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
         return Some(Format::Png);
     }
@@ -225,7 +263,8 @@ pub fn read_bytes(bytes: &[u8], opts: &ReadOptions) -> Result<Vec<Channel>> {
         None => {
             return Err(Error::input(
                 "unknown file format (not Nanoscope, Gwyddion .gwy/.gsf, Igor .ibw, Nanonis .sxm, Park/JPK TIFF, \
-                 PNG/TIFF/BMP, ASCII matrix or XYZ); convert it with `gwyddion --convert-to-gwy` (docs/FORMATS.md)",
+                 Nanosurf .nid, PicoView .mi, WSxM, NT-MDT .mdt, PNG/TIFF/BMP, ASCII matrix or XYZ); \
+                 convert it with `gwyddion --convert-to-gwy` (docs/FORMATS.md)",
             ))
         }
     };
@@ -243,6 +282,10 @@ pub fn read_bytes(bytes: &[u8], opts: &ReadOptions) -> Result<Vec<Channel>> {
         Format::Ascii => ascii::read(bytes, opts)?,
         Format::Xyz => xyz::read(bytes, opts)?,
         Format::Exr => vec![read_exr(bytes)?],
+        Format::Nid => nid::read(bytes)?,
+        Format::Mi => mi::read(bytes)?,
+        Format::Wsxm => wsxm::read(bytes)?,
+        Format::Mdt => mdt::read(bytes)?,
     };
     if chans.is_empty() {
         return Err(Error::input(format!(
