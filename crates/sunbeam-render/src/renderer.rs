@@ -411,8 +411,22 @@ impl Renderer {
                         ));
                     }
                     let key = Arc::as_ptr(pack);
+                    // Only the per-fragment modes read the terms on the GPU; the
+                    // default and table modes read their precomputed maps.
+                    let gpu_terms = matches!(settings.mode, Mode::Direct | Mode::Thesis);
                     let buf = match pack_bufs.iter().find(|(k, _, _)| *k == key) {
                         Some((_, b, _)) => b.clone(),
+                        None if !gpu_terms => {
+                            let b = Arc::new(device.create_buffer_init(
+                                &wgpu::util::BufferInitDescriptor {
+                                    label: Some("no terms"),
+                                    contents: bytemuck::cast_slice(&[0.0f32; 4]),
+                                    usage: wgpu::BufferUsages::STORAGE,
+                                },
+                            ));
+                            pack_bufs.push((key, b.clone(), used));
+                            b
+                        }
                         None => {
                             let n = used * m.layer_texels() * 2;
                             let bytes = (n * 4) as u64;
@@ -1053,3 +1067,123 @@ impl Offscreen {
 }
 
 use bytemuck::Zeroable;
+
+#[cfg(test)]
+mod layout_tests {
+    //! The uniform structs mirror the WGSL by hand; naga's reflection of the
+    //! shader checks every shared member's offset and the total size, so the two
+    //! cannot drift (a field added on one side only fails here).
+    use super::{Globals, MaterialU, SHADER};
+    use std::mem::{offset_of, size_of};
+
+    fn wgsl_struct(name: &str) -> (u32, Vec<(String, u32)>) {
+        let module = naga::front::wgsl::parse_str(SHADER).expect("the shader parses");
+        for (_, ty) in module.types.iter() {
+            if ty.name.as_deref() == Some(name) {
+                if let naga::TypeInner::Struct { members, span } = &ty.inner {
+                    return (
+                        *span,
+                        members
+                            .iter()
+                            .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                            .collect(),
+                    );
+                }
+            }
+        }
+        panic!("struct {name} not found in the WGSL");
+    }
+
+    fn check(name: &str, size: usize, rust: &[(&str, usize)]) {
+        let (span, members) = wgsl_struct(name);
+        assert_eq!(span as usize, size, "{name}: WGSL size vs Rust size");
+        let mut matched = 0;
+        for (field, off) in rust {
+            let Some((_, w)) = members.iter().find(|(n, _)| n == field) else {
+                panic!("{name}.{field} is not in the WGSL struct");
+            };
+            assert_eq!(
+                *w as usize, *off,
+                "{name}.{field}: WGSL offset vs Rust offset"
+            );
+            matched += 1;
+        }
+        let named = members.iter().filter(|(n, _)| !n.starts_with('_')).count();
+        assert_eq!(
+            matched, named,
+            "{name}: every named WGSL member has a Rust twin"
+        );
+    }
+
+    #[test]
+    fn globals_match_the_wgsl() {
+        macro_rules! f {
+            ($($n:ident),*) => { [$((stringify!($n), offset_of!(Globals, $n))),*] };
+        }
+        check(
+            "Globals",
+            size_of::<Globals>(),
+            &f!(
+                view_proj,
+                eye,
+                lights,
+                xyz_to_rgb,
+                background,
+                n_lights,
+                mode,
+                curve,
+                output,
+                exposure_scale,
+                n_lambda,
+                f0
+            ),
+        );
+    }
+
+    #[test]
+    fn material_matches_the_wgsl() {
+        macro_rules! f {
+            ($($n:ident),*) => { [$((stringify!($n), offset_of!(MaterialU, $n))),*] };
+        }
+        check(
+            "Material",
+            size_of::<MaterialU>(),
+            &f!(
+                base,
+                has_pack,
+                basis,
+                model,
+                taps,
+                crop_w,
+                crop_h,
+                kx,
+                ky,
+                terms,
+                fixed_terms,
+                n_table,
+                bin_scale_um,
+                half_range_um,
+                beta,
+                sigma_bins,
+                kb_norm,
+                table_dt,
+                tab_nu,
+                tab_nv,
+                tab_nw,
+                tab_on,
+                tab_u0,
+                tab_du,
+                tab_dv,
+                tab_w0,
+                tab_dw,
+                resp_on,
+                resp_n_theta,
+                resp_n_rho,
+                resp_n_s,
+                resp_r0,
+                resp_rho_scale,
+                resp_footprint
+            ),
+        );
+    }
+}
