@@ -410,22 +410,29 @@ fn resp_sample(c: vec3<f32>) -> vec3<f32> {
     return textureSampleLevel(resp_tex, resp_smp, (cc + 0.5) / n, 0.0).xyz;
 }
 
-// T over the pixel: the footprint is the parallelogram spanned by the texel-space
-// derivatives jx, jy; up to 4 x 4 stratified samples cover it (a box filter,
-// as a camera pixel integrates), one sample when it is within a texel.
-fn response_map_xyz(c: vec3<f32>, jx: vec3<f32>, jy: vec3<f32>) -> vec3<f32> {
+// G T over the pixel (XYZ): the footprint is the parallelogram spanned by the
+// screen derivatives of (u, v, w); up to 4 x 4 stratified samples cover it (a box
+// filter, as a camera pixel integrates), as many per axis as texels it spans,
+// one when it is within a texel. Each sample has its own (u, v, w), so its own
+// texel coordinates and gain G(wi, wr') with wr' = -(u, v, w)' - wi.
+fn response_map_xyz(wi: vec3<f32>, uvw: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, jx: vec3<f32>, jy: vec3<f32>) -> vec3<f32> {
     var nx = 1u;
     var ny = 1u;
     if (mat.resp_footprint == 1u) {
         nx = u32(clamp(ceil(length(jx)), 1.0, 4.0));
         ny = u32(clamp(ceil(length(jy)), 1.0, 4.0));
     }
+    if (nx * ny == 1u) {
+        return resp_sample(resp_coords(uvw)) * gain(wi, -uvw - wi);
+    }
     var acc = vec3<f32>(0.0);
     for (var a = 0u; a < nx; a = a + 1u) {
         for (var b = 0u; b < ny; b = b + 1u) {
             let ox = (f32(a) + 0.5) / f32(nx) - 0.5;
             let oy = (f32(b) + 0.5) / f32(ny) - 0.5;
-            acc = acc + resp_sample(c + ox * jx + oy * jy);
+            let q = uvw + ox * dx + oy * dy;
+            let wr = normalize(-q - wi);
+            acc = acc + resp_sample(resp_coords(-wi - wr)) * gain(wi, wr);
         }
     }
     return acc / f32(nx * ny);
@@ -535,19 +542,22 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         let rc = resp_coords(uvw);
         let duv_x = dpdx(uvw.xy);
         let duv_y = dpdy(uvw.xy);
+        let dw_x = dpdx(uvw.z);
+        let dw_y = dpdy(uvw.z);
         let jx = vec3<f32>(resp_dtheta(uvw.xy, duv_x), dpdx(rc.y), dpdx(rc.z));
         let jy = vec3<f32>(resp_dtheta(uvw.xy, duv_y), dpdy(rc.y), dpdy(rc.z));
         var diff = vec3<f32>(0.0);
         if (diffract && dw < 1.0 && wi_l.z > 0.0 && wr_l.z > 0.0) {
             var xyz: vec3<f32>;
             if (g.mode == 0u && mat.resp_on == 1u) {
-                xyz = response_map_xyz(rc, jx, jy);
+                // G is inside the footprint average
+                xyz = response_map_xyz(wi_l, uvw, vec3<f32>(duv_x, dw_x), vec3<f32>(duv_y, dw_y), jx, jy);
             } else if (g.mode == 0u && mat.tab_on == 1u) {
-                xyz = response_xyz(wi_l, wr_l);
+                xyz = response_xyz(wi_l, wr_l) * gain(wi_l, wr_l);
             } else {
-                xyz = diffraction_xyz(wi_l, wr_l);
+                xyz = diffraction_xyz(wi_l, wr_l) * gain(wi_l, wr_l);
             }
-            diff = xyz_to_rgb(xyz * gain(wi_l, wr_l));
+            diff = xyz_to_rgb(xyz);
         }
         rgb = rgb + g.lights[i].w * (dw * base * cos_i + (1.0 - dw) * diff);
     }
