@@ -8,7 +8,7 @@
 //! let prepared = sunbeam_raster::prepare(&scene).unwrap();
 //! let gpu = Gpu::headless(Backend::Auto).unwrap();
 //! let r = Renderer::new(&gpu, &prepared, &Settings::default(), OFFSCREEN_FORMAT).unwrap();
-//! let target = Offscreen::new(&gpu, 256, 256).unwrap();
+//! let target = Offscreen::new(&gpu, &r, 256, 256).unwrap();
 //! let image = target.render(&gpu, &r, &FrameState::from_scene(&prepared)).unwrap();
 //! # let _ = image;
 //! ```

@@ -1,0 +1,109 @@
+//! `sunbeam-pack --response`: the response map beside the pack, built from the
+//! same pack (its manifest embedded), listed in the depfile and the report,
+//! byte-identical across runs and thread counts; bad flags exit 1.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use sunbeam_field::HeightField;
+
+const BIN: &str = env!("CARGO_BIN_EXE_sunbeam-pack");
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sb-pack-resp-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn height(dir: &Path) -> PathBuf {
+    let (w, h) = (40usize, 32usize);
+    let d: Vec<f64> = (0..w * h)
+        .map(|i| {
+            let (c, r) = ((i % w) as f64, (i / w) as f64);
+            150e-9 * ((c * 0.9).sin() + 0.3 * (r * 0.4 + c * 0.1).cos())
+        })
+        .collect();
+    let f = HeightField::new(w, h, 25e-9, 25e-9, d).unwrap();
+    let p = dir.join("h.exr");
+    sunbeam_field::io::write(&p, &f).unwrap();
+    p
+}
+
+fn pack(args: &[&str]) -> (i32, String, String) {
+    let o = Command::new(BIN).args(args).output().unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into(),
+        String::from_utf8_lossy(&o.stderr).into(),
+    )
+}
+
+#[test]
+fn response_map_is_written_beside_the_pack() {
+    let d = tmpdir("beside");
+    let h = height(&d);
+    let out = d.join("skin.ktx2");
+    let dep = d.join("skin.d");
+    let (code, stdout, stderr) = pack(&[
+        h.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--response",
+        "--response-lambda",
+        "16",
+        "--depfile",
+        dep.to_str().unwrap(),
+        "--json",
+        "-q",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let side = d.join("skin.response.ktx2");
+    let map = sunbeam_response::ktx2::read(&side).unwrap();
+    let p = sunbeam_pack::Pack::read(&out).unwrap();
+    assert_eq!(map.info.pack, p.manifest, "built from the pack beside it");
+    assert_eq!(map.info.lambda_samples, 16);
+    let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(
+        report["response"]["bytes"].as_u64().unwrap() as usize,
+        map.byte_len()
+    );
+    let depfile = std::fs::read_to_string(&dep).unwrap();
+    assert!(depfile.contains("skin.response.ktx2"), "{depfile}");
+    // Deterministic, whatever the thread count.
+    let first = std::fs::read(&side).unwrap();
+    let out2 = d.join("again.ktx2");
+    let (code, _, stderr) = pack(&[
+        h.to_str().unwrap(),
+        "-o",
+        out2.to_str().unwrap(),
+        "--response-out",
+        d.join("again.map.ktx2").to_str().unwrap(),
+        "--response-lambda",
+        "16",
+        "--threads",
+        "1",
+        "-q",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(first, std::fs::read(d.join("again.map.ktx2")).unwrap());
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn bad_response_budget_is_a_usage_error() {
+    let d = tmpdir("budget");
+    let h = height(&d);
+    let out = d.join("p.ktx2");
+    let (code, _, stderr) = pack(&[
+        h.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--response",
+        "--response-budget",
+        "lots",
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("--response-budget"), "{stderr}");
+    assert!(!out.exists() && !d.join("p.response.ktx2").exists());
+    std::fs::remove_dir_all(&d).ok();
+}
