@@ -375,3 +375,68 @@ fn interrupted_build_keeps_nothing_half_written_and_is_redone() {
         );
     }
 }
+
+/// `make demo` when cargo builds elsewhere (issue 14, item 2): with
+/// `CARGO_TARGET_DIR` (or `build.target-dir`, here as `CARGO_BUILD_TARGET_DIR`)
+/// outside the checkout, the top Makefile asks cargo for its target directory
+/// and hands `DIR/release` to examples/. Cheap: that folder holds wrappers of
+/// the tools already built (which record that they ran), `-o deps -o build`
+/// skips the install and build steps, and only the synthetic height fields are made.
+#[test]
+fn demo_uses_the_folder_cargo_builds_into() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = scratch("pipeline-target-dir");
+    let target = std::env::temp_dir().join(format!("sunbeam-target-dir-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&target);
+    let rel = target.join("release");
+    std::fs::create_dir_all(&rel).unwrap();
+    let log = d.join("ran.log");
+    for name in [
+        "sunbeam-import",
+        "sunbeam-pack",
+        "sunbeam-bake",
+        "sunbeam-play",
+        "sunbeam-eval",
+    ] {
+        let w = rel.join(name);
+        std::fs::write(
+            &w,
+            format!(
+                "#!/bin/sh\necho {name} >> '{}'\nexec '{}' \"$@\"\n",
+                log.display(),
+                bin_dir().join(name).display()
+            ),
+        )
+        .unwrap();
+        std::fs::set_permissions(&w, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    for var in ["CARGO_TARGET_DIR", "CARGO_BUILD_TARGET_DIR"] {
+        let _ = std::fs::remove_file(&log);
+        let out = d.join(format!("out-{var}"));
+        let o = Command::new("make")
+            .arg("-C")
+            .arg(workspace_root())
+            .args(["demo", "-o", "deps", "-o", "build", "DEMO_GOALS=fields"])
+            .args(small_vars(&bin_dir(), &out).iter().skip(1)) // not BIN: the Makefile finds it
+            .arg("SHARED=")
+            .env_remove("CARGO_TARGET_DIR")
+            .env_remove("CARGO_BUILD_TARGET_DIR")
+            .env(var, &target)
+            .output()
+            .expect("run make");
+        let said = format!(
+            "{}\n{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(o.status.success(), "{var}: make demo failed:\n{said}");
+        let ran = std::fs::read_to_string(&log).unwrap_or_default();
+        assert!(
+            ran.lines().any(|l| l == "sunbeam-import"),
+            "{var}={}: make demo did not run the tools cargo built there:\n{said}",
+            target.display()
+        );
+        assert!(out.join("elaphe.exr").is_file() && out.join("xeno.exr").is_file());
+    }
+    std::fs::remove_dir_all(&target).ok();
+}
