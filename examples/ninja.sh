@@ -67,37 +67,37 @@ outdir = $(esc "$OUT")
 q = $(esc "$Q")
 
 rule import
-  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-import \$src \$flags -o \$outdir/\$name.exr --preview \$outdir/\$name-height.png --depfile \$outdir/\$name.exr.d \$q
-  depfile = \$outdir/\$name.exr.d
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-import \$src \$flags -o \${outdir}/\${name}.exr --preview \${outdir}/\${name}-height.png --depfile \${outdir}/\${name}.exr.d \$q
+  depfile = \${outdir}/\${name}.exr.d
   deps = gcc
-  description = import \$name
+  description = import \${name}
 rule pack
-  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-pack \$in -o \$target $(esc "$PACK_FLAGS") --depfile \$target.d \$q
-  depfile = \$target.d
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-pack \$in -o \${target} $(esc "$PACK_FLAGS") --depfile \${target}.d \$q
+  depfile = \${target}.d
   deps = gcc
-  description = pack \$target
+  description = pack \${target}
 rule bake
-  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-bake --generate-snake --snake-detail $(esc "$SNAKE_DETAIL") -o \$target --depfile \$target.d \$q
-  depfile = \$target.d
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-bake --generate-snake --snake-detail $(esc "$SNAKE_DETAIL") -o \${target} --depfile \${target}.d \$q
+  depfile = \${target}.d
   deps = gcc
-  description = bake \$target
+  description = bake \${target}
 rule scene
-  command = rm -f \$tidy && sed -e 's|@PACK@|\$name.ktx2|' -e 's|@MESH@|snake.glb|' \$in > \$outdir/.\$name-scene.json.tmp.\$\$\$\$ && mv \$outdir/.\$name-scene.json.tmp.\$\$\$\$ \$target
-  description = scene \$target
+  command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake.glb|' \$in > \${outdir}/.\${name}-scene.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-scene.json.tmp.\$\$\$\$ \${target}
+  description = scene \${target}
 rule play
-  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-play \$in --headless --size $(esc "$SIZE") $(esc "$PLAY_FLAGS") -o \$target --depfile \$target.d \$q
-  depfile = \$target.d
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-play \$in --headless --size $(esc "$SIZE") $(esc "$PLAY_FLAGS") -o \${target} --depfile \${target}.d \$q
+  depfile = \${target}.d
   deps = gcc
-  description = play \$target
+  description = play \${target}
 rule brdf
-  command = rm -f \$tidy && $(esc "$EVAL") brdf \$in --light 60deg,0deg --size $(esc "$BRDF_SIZE") -o \$target \$q
-  description = brdf \$target
+  command = rm -f \$tidy && $(esc "$EVAL") brdf \$in --light 60deg,0deg --size $(esc "$BRDF_SIZE") -o \${target} \$q
+  description = brdf \${target}
 rule grating
-  command = rm -f \$tidy && $(esc "$EVAL") grating \$in --lambda-step 20nm --angle-step 0.25deg --plot \$target \$q > /dev/null
-  description = grating \$target
+  command = rm -f \$tidy && $(esc "$EVAL") grating \$in --lambda-step 20nm --angle-step 0.25deg --plot \${target} \$q > /dev/null
+  description = grating \${target}
 rule sheet
-  command = rm -f \$tidy && $(esc "$SHEET") -o \$target --columns $(esc "$COLUMNS") \$in \$q
-  description = sheet \$target
+  command = rm -f \$tidy && $(esc "$SHEET") -o \${target} --columns $(esc "$COLUMNS") \$in \$q
+  description = sheet \${target}
 
 EOF
   # Ninja's $out is the edge's output list: rules use $target (one output), $name and $outdir.

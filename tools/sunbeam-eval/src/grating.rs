@@ -290,8 +290,10 @@ pub fn run(src: &Source, o: &Options) -> Result<Outcome> {
             let r = row[j];
             r.is_finite()
                 && r > 0.0
-                && (j == 0 || r > row[j - 1])
-                && (j + 1 == na || r >= row[j + 1])
+                && j > 0
+                && j + 1 < na
+                && r > row[j - 1]
+                && r >= row[j + 1]
                 && ((si + angles[j].sin()) / l).abs() >= fmin
         };
         let maxima: Vec<usize> = (0..na).filter(|&j| is_max(j)).collect();
@@ -302,6 +304,23 @@ pub fn run(src: &Source, o: &Options) -> Result<Outcome> {
                 .filter(|&j| row[j] >= MIN_RELATIVE_R * top)
                 .map(|j| (li, j)),
         );
+    }
+    // No lobe resolved at all (a patch of one or two periods under the window):
+    // the brightest R beyond the specular lobe per wavelength, as before; the
+    // orders then cannot be told apart.
+    let unresolved = found.is_empty();
+    if unresolved {
+        let cut = o.min_frequency.unwrap_or_else(|| src.specular_halfwidth());
+        for (li, row) in response.iter().enumerate() {
+            let best = (0..na)
+                .filter(|&j| {
+                    row[j].is_finite()
+                        && row[j] > 0.0
+                        && ((si + angles[j].sin()) / lambdas[li]).abs() >= cut
+                })
+                .max_by(|&a, &b| row[a].total_cmp(&row[b]));
+            found.extend(best.map(|j| (li, j)));
+        }
     }
     let mut peaks: Vec<Peak> = par_map(found.len(), |k| {
         let (li, j) = found[k];
@@ -334,7 +353,14 @@ pub fn run(src: &Source, o: &Options) -> Result<Outcome> {
             peaks[k].weight = peaks[k].r / top;
         }
     }
-    let orders = find_orders(&mut peaks, o.order);
+    let mut orders = find_orders(&mut peaks, o.order);
+    if unresolved {
+        orders.found = false;
+        orders.note = format!(
+            "orders cannot be told apart (no lobe resolved beyond the specular one: the brightest R beyond it is taken as order {}, --order; try --tile or --max-period)",
+            o.order
+        );
+    }
     // The fit: every peak with an order, weighted by its relative brightness;
     // not those on the specular lobe's tail (|f| below its half width, where it
     // pulls them outward) unless nothing else is left.
