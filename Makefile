@@ -4,6 +4,15 @@
 CARGO ?= cargo
 CARGO_FLAGS ?= --release --locked
 
+# Where cargo really puts the tools: CARGO_TARGET_DIR, build.target-dir of a cargo
+# config (CARGO_BUILD_TARGET_DIR), or ./target. Asked of cargo itself, and only when
+# a recipe needs it; the profile folder follows CARGO_FLAGS. `make demo BIN=DIR` overrides.
+TARGET_DIR = $(eval TARGET_DIR := $(shell $(CARGO) metadata --format-version 1 --no-deps | sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p'))$(TARGET_DIR)
+PROFILE_DIR = $(if $(filter --release,$(CARGO_FLAGS)),release,debug)
+BIN = $(TARGET_DIR)/$(PROFILE_DIR)
+# Goals of examples/Makefile for `make demo` (default: all of it).
+DEMO_GOALS ?=
+
 .PHONY: all build demo test deps clean
 
 # wgpu's GL/Wayland probing complains without a runtime dir; give tests a private one.
@@ -19,7 +28,8 @@ build:
 	$(CARGO) build $(CARGO_FLAGS) --workspace
 
 demo: deps build
-	$(MAKE) -C examples -j2
+	@test -x '$(BIN)/sunbeam-import' || { echo "make demo: no tools in '$(BIN)' (cargo metadata's target_directory + $(PROFILE_DIR)); set BIN=DIR" >&2; exit 1; }
+	$(MAKE) -C examples -j2 BIN='$(BIN)' $(DEMO_GOALS)
 
 # One feature set and one profile for build and test, so nothing compiles twice.
 test: deps

@@ -7,136 +7,13 @@
 //! are built only where a GPU stack is present (skipped otherwise, failing under
 //! SUNBEAM_REQUIRE_ALL=1), the contact sheet only when `sunbeam-eval sheet` exists.
 
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+mod common;
+use common::*;
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
-use sunbeam::{scratch, tool, workspace_root};
+use sunbeam::{scratch, workspace_root};
 use sunbeam_common::testdata;
-
-/// Small-size variables for every run.
-fn small_vars(bin: &Path, out: &Path) -> Vec<String> {
-    vec![
-        format!("BIN={}", bin.display()),
-        format!("OUT={}", out.display()),
-        "SYNTH_SIZE=64".into(),
-        "SYNTH_PIXEL=25nm".into(),
-        "BRDF_SIZE=40".into(),
-        "SIZE=96x54".into(),
-        "Q=-q".into(),
-    ]
-}
-
-fn bin_dir() -> PathBuf {
-    tool("sunbeam-import").parent().unwrap().to_path_buf()
-}
-
-/// Does the player render here? (`sunbeam-play` built and a GPU adapter, e.g. lavapipe.)
-fn player_works(dir: &Path) -> bool {
-    let play = bin_dir().join("sunbeam-play");
-    let ok = play.exists()
-        && Command::new(&play)
-            .args([
-                "--mesh",
-                "builtin:quad",
-                "--headless",
-                "--size",
-                "8x8",
-                "-q",
-                "-o",
-            ])
-            .arg(dir.join("probe.png"))
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success());
-    if !ok {
-        if testdata::require_all() {
-            panic!("sunbeam-play cannot render headless and SUNBEAM_REQUIRE_ALL=1 (install mesa-vulkan-drivers)");
-        }
-        eprintln!("SKIP: frames (sunbeam-play cannot render headless here)");
-    }
-    ok
-}
-
-fn sheet_works() -> bool {
-    let ok = Command::new(bin_dir().join("sunbeam-eval"))
-        .args(["sheet", "--help"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !ok {
-        eprintln!("SKIP: contact sheet (this sunbeam-eval has no `sheet` subcommand yet)");
-    }
-    ok
-}
-
-/// The make goals to build: everything this machine can build.
-fn goals(scratch_dir: &Path) -> Vec<String> {
-    let mut g: Vec<String> = ["fields", "packs", "pictures"].map(String::from).to_vec();
-    let frames = player_works(scratch_dir);
-    if frames {
-        g.push("frames".into());
-    }
-    if frames && sheet_works() {
-        g.push("sheet".into());
-    }
-    g
-}
-
-fn make(jobs: usize, vars: &[String], goals: &[String]) -> std::process::Output {
-    let o = Command::new("make")
-        .arg("-C")
-        .arg(workspace_root().join("examples"))
-        .arg(format!("-j{jobs}"))
-        .args(vars)
-        .args(goals)
-        .output()
-        .expect("run make");
-    assert!(
-        o.status.success(),
-        "make failed:\n{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
-
-/// Visible files of a folder (name -> bytes), depfiles with the folder's path made generic.
-fn contents(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut m = BTreeMap::new();
-    for e in std::fs::read_dir(dir).unwrap() {
-        let e = e.unwrap();
-        let name = e.file_name().to_string_lossy().into_owned();
-        if name.starts_with('.') || !e.file_type().unwrap().is_file() {
-            continue;
-        }
-        let mut bytes = std::fs::read(e.path()).unwrap();
-        if name.ends_with(".d") {
-            bytes = String::from_utf8(bytes)
-                .unwrap()
-                .replace(&dir.display().to_string(), "OUT")
-                .into_bytes();
-        }
-        m.insert(name, bytes);
-    }
-    m
-}
-
-fn mtimes(dir: &Path) -> BTreeMap<String, SystemTime> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap())
-        .filter(|e| !e.file_name().to_string_lossy().starts_with('.'))
-        .map(|e| {
-            (
-                e.file_name().to_string_lossy().into_owned(),
-                e.metadata().unwrap().modified().unwrap(),
-            )
-        })
-        .collect()
-}
 
 #[test]
 fn parallel_builds_are_byte_identical() {
@@ -374,4 +251,69 @@ fn interrupted_build_keeps_nothing_half_written_and_is_redone() {
             "{name} differs from a clean build"
         );
     }
+}
+
+/// `make demo` when cargo builds elsewhere (issue 14, item 2): with
+/// `CARGO_TARGET_DIR` (or `build.target-dir`, here as `CARGO_BUILD_TARGET_DIR`)
+/// outside the checkout, the top Makefile asks cargo for its target directory
+/// and hands `DIR/release` to examples/. Cheap: that folder holds wrappers of
+/// the tools already built (which record that they ran), `-o deps -o build`
+/// skips the install and build steps, and only the synthetic height fields are made.
+#[test]
+fn demo_uses_the_folder_cargo_builds_into() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = scratch("pipeline-target-dir");
+    let target = std::env::temp_dir().join(format!("sunbeam-target-dir-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&target);
+    let rel = target.join("release");
+    std::fs::create_dir_all(&rel).unwrap();
+    let log = d.join("ran.log");
+    for name in [
+        "sunbeam-import",
+        "sunbeam-pack",
+        "sunbeam-bake",
+        "sunbeam-play",
+        "sunbeam-eval",
+    ] {
+        let w = rel.join(name);
+        std::fs::write(
+            &w,
+            format!(
+                "#!/bin/sh\necho {name} >> '{}'\nexec '{}' \"$@\"\n",
+                log.display(),
+                bin_dir().join(name).display()
+            ),
+        )
+        .unwrap();
+        std::fs::set_permissions(&w, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    for var in ["CARGO_TARGET_DIR", "CARGO_BUILD_TARGET_DIR"] {
+        let _ = std::fs::remove_file(&log);
+        let out = d.join(format!("out-{var}"));
+        let o = Command::new("make")
+            .arg("-C")
+            .arg(workspace_root())
+            .args(["demo", "-o", "deps", "-o", "build", "DEMO_GOALS=fields"])
+            .args(small_vars(&bin_dir(), &out).iter().skip(1)) // not BIN: the Makefile finds it
+            .arg("SHARED=")
+            .env_remove("CARGO_TARGET_DIR")
+            .env_remove("CARGO_BUILD_TARGET_DIR")
+            .env(var, &target)
+            .output()
+            .expect("run make");
+        let said = format!(
+            "{}\n{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(o.status.success(), "{var}: make demo failed:\n{said}");
+        let ran = std::fs::read_to_string(&log).unwrap_or_default();
+        assert!(
+            ran.lines().any(|l| l == "sunbeam-import"),
+            "{var}={}: make demo did not run the tools cargo built there:\n{said}",
+            target.display()
+        );
+        assert!(out.join("elaphe.exr").is_file() && out.join("xeno.exr").is_file());
+    }
+    std::fs::remove_dir_all(&target).ok();
 }

@@ -64,9 +64,9 @@ pub fn draw(
             let norm = out
                 .peaks
                 .iter()
-                .find(|p| (p.lambda_m * 1e9 - lam).abs() < 1e-6)
+                .filter(|p| (p.lambda_m * 1e9 - lam).abs() < 1e-6)
                 .map(|p| p.r)
-                .unwrap_or(0.0);
+                .fold(0.0, f64::max);
             if norm <= 0.0 {
                 continue;
             }
@@ -88,45 +88,105 @@ pub fn draw(
             }
         }
         chart.draw_series(cells).map_err(perr)?;
-        // Grating equation for the estimated period.
-        let curve = |d: f64| -> Vec<(f64, f64)> {
+        // Grating equation for the estimated period, one curve per order seen
+        // (or the assumed order), labelled with its order at the short-wavelength end.
+        let curve = |d: f64, m: i32| -> Vec<(f64, f64)> {
             let mut v = Vec::new();
             let steps = 400;
             for i in 0..=steps {
                 let l = (y0 + (y1 - y0) * i as f64 / steps as f64) * 1e-9;
-                if let Some(a) = grating_angle_deg(theta_i, order, l, d) {
-                    v.push((a, l * 1e9));
+                if let Some(a) = grating_angle_deg(theta_i, m, l, d) {
+                    if a >= x0 && a <= x1 {
+                        v.push((a, l * 1e9));
+                    }
                 }
             }
             v
         };
+        let mut orders: Vec<i32> = out
+            .peaks
+            .iter()
+            .map(|p| p.order)
+            .filter(|&m| m != 0)
+            .collect();
+        orders.sort();
+        orders.dedup();
+        if orders.is_empty() {
+            orders.push(order);
+        }
         let est = out.period_m;
-        chart
-            .draw_series(LineSeries::new(curve(est), RED.stroke_width(3)))
-            .map_err(perr)?
-            .label(format!(
-                "grating equation, m = {order}, d = {:.2} nm (estimated)",
-                est * 1e9
-            ))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], RED.stroke_width(3)));
+        let what = if out.orders.found {
+            "orders found"
+        } else {
+            "order assumed"
+        };
+        for (i, &m) in orders.iter().enumerate() {
+            let c = curve(est, m);
+            let s = chart
+                .draw_series(LineSeries::new(c.clone(), RED.stroke_width(2)))
+                .map_err(perr)?;
+            if i == 0 {
+                s.label(format!(
+                    "grating equation, d = {:.2} nm (estimated; {what}: m = {})",
+                    est * 1e9,
+                    orders
+                        .iter()
+                        .map(|m| m.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], RED.stroke_width(2)));
+            }
+            if let Some(&(a, l)) = c.first() {
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        format!("m={m}"),
+                        (a, l),
+                        ("sans-serif", 16).into_font().color(&RED),
+                    )))
+                    .map_err(perr)?;
+            }
+        }
         if let Some(d) = true_period {
-            chart
-                .draw_series(DashedLineSeries::new(curve(d), 8, 6, WHITE.stroke_width(2)))
-                .map_err(perr)?
-                .label(format!("grating equation, d = {:.2} nm (true)", d * 1e9))
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(2))
-                });
+            for (i, &m) in orders.iter().enumerate() {
+                let s = chart
+                    .draw_series(DashedLineSeries::new(
+                        curve(d, m),
+                        8,
+                        6,
+                        WHITE.stroke_width(1),
+                    ))
+                    .map_err(perr)?;
+                if i == 0 {
+                    s.label(format!("grating equation, d = {:.2} nm (true)", d * 1e9))
+                        .legend(|(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(2))
+                        });
+                }
+            }
         }
         chart
             .draw_series(
-                out.peaks.iter().map(|p| {
-                    Cross::new((p.theta_r_deg, p.lambda_m * 1e9), 6, WHITE.stroke_width(2))
+                out.peaks.iter().filter(|p| p.order != 0).map(|p| {
+                    Cross::new((p.theta_r_deg, p.lambda_m * 1e9), 5, WHITE.stroke_width(2))
                 }),
             )
             .map_err(perr)?
-            .label("peak of R per wavelength")
-            .legend(|(x, y)| Cross::new((x + 12, y), 6, BLACK.stroke_width(2)));
+            .label("peaks of R with an order (on the m curves)")
+            .legend(|(x, y)| Cross::new((x + 12, y), 5, BLACK.stroke_width(2)));
+        if out.peaks.iter().any(|p| p.order == 0) {
+            chart
+                .draw_series(out.peaks.iter().filter(|p| p.order == 0).map(|p| {
+                    Circle::new(
+                        (p.theta_r_deg, p.lambda_m * 1e9),
+                        4,
+                        MAGENTA.stroke_width(2),
+                    )
+                }))
+                .map_err(perr)?
+                .label("peaks without an order (not in the fit)")
+                .legend(|(x, y)| Circle::new((x + 12, y), 4, MAGENTA.stroke_width(2)));
+        }
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)

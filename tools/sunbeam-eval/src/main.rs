@@ -177,7 +177,7 @@ struct GratingArgs {
     /// Viewing-angle step of the scan (peaks are then refined on the continuous R).
     #[arg(long, default_value = "0.1deg")]
     angle_step: String,
-    /// Diffraction order assumed for the peaks.
+    /// Order of the brightest peaks when the orders cannot be told apart (one order visible).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     order: i32,
     /// Ignore peaks whose period (1/|f|) is longer than this (default: outside the specular lobe).
@@ -337,6 +337,9 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
         grating_plot::draw(p, &out, theta_i, a.order, &title, true_period)?;
     }
     let rel = true_period.map(|d| (out.period_m - d) / d);
+    if !out.orders.found && !quiet {
+        eprintln!("sunbeam-eval: grating: {name}: {}", out.orders.note);
+    }
     if a.json {
         let report = json!({
             "input": name,
@@ -355,15 +358,23 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
             "peaks": out.peaks.iter().map(|p| json!([p.lambda_m, p.theta_r_deg])).collect::<Vec<_>>(),
             "peak_r": out.peaks.iter().map(|p| p.r).collect::<Vec<_>>(),
             "peak_f_per_m": out.peaks.iter().map(|p| p.f).collect::<Vec<_>>(),
+            "peak_order": out.peaks.iter().map(|p| p.order).collect::<Vec<_>>(),
+            "peak_brightest": out.peaks.iter().map(|p| p.brightest).collect::<Vec<_>>(),
+            "peak_in_fit": out.peaks.iter().map(|p| p.in_fit).collect::<Vec<_>>(),
+            "orders_found": out.orders.found,
+            "orders_note": out.orders.note,
+            "fundamental_f_per_m": out.orders.f0,
         });
         println!("{report}");
     } else if !quiet {
         println!(
-            "{name}: period {:.3} nm (least squares over {} wavelengths; mean {:.3} nm, sd {:.3} nm){}",
+            "{name}: period {:.3} nm (least squares over {} peaks at {} wavelengths; mean {:.3} nm, sd {:.3} nm; {}){}",
             out.period_m * 1e9,
-            out.peaks.len(),
+            out.peaks.iter().filter(|p| p.in_fit).count(),
+            out.peaks.iter().filter(|p| p.brightest).count(),
             out.period_mean_m * 1e9,
             out.period_std_m * 1e9,
+            out.orders.note,
             rel.map(|r| format!(", {:+.4} % from the true period", r * 100.0)).unwrap_or_default()
         );
     }
