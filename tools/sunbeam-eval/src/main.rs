@@ -226,43 +226,34 @@ pub struct RenderArgs {
 }
 
 fn main() {
-    sunbeam_common::error::run_main("sunbeam-eval", || {
-        let cli = match Cli::try_parse() {
-            Ok(c) => c,
-            Err(e) => {
-                use clap::error::ErrorKind;
-                if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
-                    print!("{e}");
-                    return Ok(());
-                }
-                return Err(Error::usage(e.to_string().trim_end().to_string()));
-            }
-        };
-        match cli.cmd {
-            Cmd::Probe(a) => {
-                let src = Source::open(&a.input, &a.heights, &a.model, a.truth)?;
-                probe::run(&src, &a.points)
-            }
-            Cmd::Grating(a) => grating_cmd(a, cli.quiet),
-            Cmd::Compare(a) => compare_cmd(a),
-            Cmd::Brdf(a) => brdf_cmd(a),
-            Cmd::Bench(a) => {
-                let snake = a.snake.clone().or_else(|| {
-                    sunbeam_common::testdata::shared_data()
-                        .map(|d| d.join("snake"))
-                        .filter(|d| d.is_dir())
-                });
-                bench::run(&bench::Options {
-                    snake_dir: snake,
-                    out_dir: a.output,
-                    points: a.points.max(10),
-                    quick: a.quick,
-                })
-            }
-            Cmd::Render(a) => render::run(&a),
-            Cmd::Sheet(a) => sheet::run(&a.output, &a.inputs, a.columns),
+    sunbeam_common::cli::main("sunbeam-eval", run)
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.cmd {
+        Cmd::Probe(a) => {
+            let src = Source::open(&a.input, &a.heights, &a.model, a.truth)?;
+            probe::run(&src, &a.points)
         }
-    })
+        Cmd::Grating(a) => grating_cmd(a, cli.quiet),
+        Cmd::Compare(a) => compare_cmd(a),
+        Cmd::Brdf(a) => brdf_cmd(a),
+        Cmd::Bench(a) => {
+            let snake = a.snake.clone().or_else(|| {
+                sunbeam_common::testdata::shared_data()
+                    .map(|d| d.join("snake"))
+                    .filter(|d| d.is_dir())
+            });
+            bench::run(&bench::Options {
+                snake_dir: snake,
+                out_dir: a.output,
+                points: a.points.max(10),
+                quick: a.quick,
+            })
+        }
+        Cmd::Render(a) => render::run(&a),
+        Cmd::Sheet(a) => sheet::run(&a.output, &a.inputs, a.columns),
+    }
 }
 
 fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
@@ -466,13 +457,11 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         println!("{}", if pass { "PASS" } else { "FAIL" });
     }
     if !pass {
-        use std::io::Write;
-        let _ = std::io::stdout().flush();
-        eprintln!(
-            "sunbeam-eval: compare: above tolerance (max |dR| {:.3e} vs {:.1e}, p99 dE00 {:.3} vs {:.2})",
+        // Exit 5 (docs/EVAL.md), printed as `sunbeam-eval: compare: ...`.
+        return Err(Error::check_failed(format!(
+            "compare: above tolerance (max |dR| {:.3e} vs {:.1e}, p99 dE00 {:.3} vs {:.2})",
             spec.max_abs, a.tolerance, p99, a.de_tolerance
-        );
-        std::process::exit(5);
+        )));
     }
     Ok(())
 }
