@@ -86,7 +86,7 @@ impl std::error::Error for Error {}
 /// Run a tool's main body: print the error to stderr as `TOOL: error: ...` and
 /// exit with its code. A panic (a bug) exits 4 through the default hook's code
 /// path being replaced here. This is the one exit path of every tool; tools call
-/// it through [`crate::cli::main`], which parses the command line first.
+/// it through `sunbeam_common::cli::main`, which parses the command line first.
 pub fn run_main(tool: &str, body: impl FnOnce() -> Result<()>) -> ! {
     let tool_name = tool.to_string();
     std::panic::set_hook(Box::new(move |info| {
