@@ -119,6 +119,17 @@ pub fn pixel_size(s: &str) -> Result<PixelSize> {
     }
 }
 
+/// clap value parser for an enum of named values (`--model window|tiled`):
+/// `names` are shown in `--help` and checked by clap, then parsed with `T::from_str`.
+pub fn one_of<T>(names: &'static [&'static str]) -> impl clap::builder::TypedValueParser<Value = T>
+where
+    T: std::str::FromStr<Err = Error> + Clone + Send + Sync + 'static,
+{
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(names.iter().map(|n| PossibleValue::new(*n)))
+        .try_map(|s: String| s.parse::<T>())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

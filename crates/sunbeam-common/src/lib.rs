@@ -7,6 +7,7 @@ pub mod depfile;
 pub mod error;
 pub mod magic;
 pub mod output;
+pub mod rng;
 pub mod testdata;
 pub mod units;
 

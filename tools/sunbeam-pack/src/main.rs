@@ -21,12 +21,6 @@ enum BasisArg {
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
-enum ModelArg {
-    Window,
-    Tiled,
-}
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
 enum PrecisionArg {
     F32,
     F16,
@@ -45,8 +39,8 @@ struct Cli {
     #[arg(long, value_enum, default_value = "chebyshev")]
     basis: BasisArg,
     /// Model of what lies beyond the patch (PHYSICS.md 2).
-    #[arg(long, value_enum, default_value = "window")]
-    model: ModelArg,
+    #[arg(long, default_value = "window", value_parser = sunbeam_common::cli::one_of::<Model>(&Model::NAMES))]
+    model: Model,
     /// Spatial coherence length of the light.
     #[arg(long, default_value = "65um", value_parser = positive_length)]
     coherence: f64,
@@ -161,10 +155,7 @@ fn run(cli: Cli) -> Result<()> {
         notes.extend(b.notes.iter().cloned());
     }
 
-    let model = match cli.model {
-        ModelArg::Window => Model::Window,
-        ModelArg::Tiled => Model::Tiled,
-    };
+    let model = cli.model;
     let basis = match cli.basis {
         BasisArg::Chebyshev => Basis::Chebyshev,
         BasisArg::Taylor => Basis::Taylor,
