@@ -154,9 +154,10 @@ fn top_modules(src: &Path) -> BTreeSet<String> {
         for e in rd.flatten() {
             let p = e.path();
             let stem = p.file_stem().unwrap().to_string_lossy().into_owned();
-            if p.is_dir() && stem != "bin" {
-                m.insert(stem);
-            } else if p.extension().is_some_and(|x| x == "rs") && stem != "lib" && stem != "main" {
+            let dir_module = p.is_dir() && stem != "bin";
+            let file_module =
+                p.extension().is_some_and(|x| x == "rs") && stem != "lib" && stem != "main";
+            if dir_module || file_module {
                 m.insert(stem);
             }
         }

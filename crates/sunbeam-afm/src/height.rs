@@ -276,8 +276,8 @@ pub fn check_plausible(field: &HeightField, channel: &str, o: &HeightOptions) ->
             (a.min(v), b.max(v))
         });
     let range = hi - lo;
-    // Also catches a range that overflows to Inf.
-    if hi >= lo && !(range <= MAX_PLAUSIBLE_RANGE_M) {
+    // `range` is Inf when the difference overflows: refused too.
+    if hi >= lo && (range > MAX_PLAUSIBLE_RANGE_M || range.is_nan()) {
         return Err(Error::input(format!(
             "channel '{channel}': heights span {lo:.3e} m .. {hi:.3e} m, a range of {range:.3e} m; \
              no AFM measures more than {} (a damaged file or a wrong unit?): \

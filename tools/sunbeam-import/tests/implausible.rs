@@ -26,15 +26,7 @@ fn damaged_gwy(dir: &Path) -> Option<PathBuf> {
         .position(|w| w == b"data\0D")
         .expect("a GwyDataField data array");
     let start = at + 6 + 4 + 8192;
-    let mut s: u64 = 14;
-    let mut noise = Vec::with_capacity(4096);
-    while noise.len() < 4096 {
-        s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = s;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        noise.extend_from_slice(&(z ^ (z >> 31)).to_le_bytes());
-    }
+    let noise = sunbeam_common::rng::SplitMix64::new(14).bytes(4096);
     b[start..start + 4096].copy_from_slice(&noise);
     let p = dir.join("damaged.gwy");
     std::fs::write(&p, b).unwrap();
