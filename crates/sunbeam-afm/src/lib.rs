@@ -17,6 +17,8 @@ use sunbeam_field::HeightField;
 
 mod util;
 
+pub mod height;
+
 mod ascii;
 mod gsf;
 mod gwy;
@@ -237,7 +239,7 @@ pub fn detect(bytes: &[u8]) -> Option<Format> {
     if bytes.starts_with(b"BM") && bytes.len() >= 26 {
         return Some(Format::Bmp);
     }
-    if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+    if sunbeam_common::magic::is_exr(bytes) {
         return Some(Format::Exr);
     }
     if ibw::detect(bytes) {
@@ -281,7 +283,7 @@ pub fn read_bytes(bytes: &[u8], opts: &ReadOptions) -> Result<Vec<Channel>> {
         Format::Bmp => image::read_bmp(bytes, opts)?,
         Format::Ascii => ascii::read(bytes, opts)?,
         Format::Xyz => xyz::read(bytes, opts)?,
-        Format::Exr => vec![read_exr(bytes)?],
+        Format::Exr => vec![height::exr_channel(bytes, opts.pixel_size)?.0],
         Format::Nid => nid::read(bytes)?,
         Format::Mi => mi::read(bytes)?,
         Format::Wsxm => wsxm::read(bytes)?,
@@ -294,27 +296,6 @@ pub fn read_bytes(bytes: &[u8], opts: &ReadOptions) -> Result<Vec<Channel>> {
         )));
     }
     Ok(chans)
-}
-
-/// A height field EXR written by sunbeam-import (sunbeam_field::io::exr).
-fn read_exr(bytes: &[u8]) -> Result<Channel> {
-    let mut field = sunbeam_field::io::exr::decode(bytes)?;
-    let name = if field.provenance.channel.is_empty() {
-        "Height".to_string()
-    } else {
-        field.provenance.channel.clone()
-    };
-    if field.provenance.source_format.is_empty() {
-        field.provenance.source_format = Format::Exr.name().to_string();
-    }
-    Ok(Channel {
-        name,
-        z_unit: "m".into(),
-        is_height: true,
-        field,
-        xy_unit: "m".into(),
-        offset: (0.0, 0.0),
-    })
 }
 
 /// Read every image channel of a file. Error messages start with "FILE: ".

@@ -4,7 +4,8 @@ use std::fmt;
 use std::path::Path;
 
 /// Documented exit codes: 0 ok, 1 usage, 2 input unreadable or invalid,
-/// 3 output could not be written, 4 internal.
+/// 3 output could not be written, 4 internal; 5 a check the tool was asked to
+/// make did not pass (`sunbeam-eval compare` above its tolerance: docs/EVAL.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ExitCode {
     Ok = 0,
@@ -12,6 +13,7 @@ pub enum ExitCode {
     Input = 2,
     Output = 3,
     Internal = 4,
+    CheckFailed = 5,
 }
 
 /// An error with a message meant for a person and the exit code it maps to.
@@ -55,6 +57,14 @@ impl Error {
             message: msg.into(),
         }
     }
+    /// A verdict, not a failure to run: the tool did its work and the check failed
+    /// (exit 5). Printed as `TOOL: MESSAGE`, without `error:`.
+    pub fn check_failed(msg: impl Into<String>) -> Self {
+        Self {
+            code: ExitCode::CheckFailed,
+            message: msg.into(),
+        }
+    }
     /// Prefix the message with context, keeping the code.
     pub fn context(mut self, ctx: impl fmt::Display) -> Self {
         self.message = format!("{ctx}: {}", self.message);
@@ -75,7 +85,8 @@ impl std::error::Error for Error {}
 
 /// Run a tool's main body: print the error to stderr as `TOOL: error: ...` and
 /// exit with its code. A panic (a bug) exits 4 through the default hook's code
-/// path being replaced here.
+/// path being replaced here. This is the one exit path of every tool; tools call
+/// it through `sunbeam_common::cli::main`, which parses the command line first.
 pub fn run_main(tool: &str, body: impl FnOnce() -> Result<()>) -> ! {
     let tool_name = tool.to_string();
     std::panic::set_hook(Box::new(move |info| {
@@ -83,6 +94,12 @@ pub fn run_main(tool: &str, body: impl FnOnce() -> Result<()>) -> ! {
     }));
     let code = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(body)) {
         Ok(Ok(())) => 0,
+        Ok(Err(e)) if e.code == ExitCode::CheckFailed => {
+            use std::io::Write;
+            let _ = std::io::stdout().flush();
+            eprintln!("{tool}: {e}");
+            e.exit_code()
+        }
         Ok(Err(e)) => {
             eprintln!("{tool}: error: {e}");
             e.exit_code()

@@ -29,7 +29,7 @@ fn main() {
     std::fs::create_dir_all(&out).unwrap();
     let p = SnakeParams::with_detail(detail);
     let doc = snake::generate(&p);
-    let prim = sunbeam_mesh::scene::read_primitive(&doc, 0, 0, 0)
+    let prim = sunbeam_mesh::nodes::read_primitive(&doc, 0, 0, 0)
         .unwrap()
         .unwrap();
     let uv = prim.uvs.unwrap();

@@ -18,8 +18,8 @@
 use crate::bvh::Bvh;
 use crate::geom::{add, any_perpendicular, cross, dot, normalize, project, scale, Mat4, Xform, V3};
 use crate::gltf::Document;
+use crate::nodes::{self, Prim};
 use crate::orient::{AxialField, AxialValue, Interp, SampleAt, Source, UvAxis};
-use crate::scene::{self, Prim};
 use serde::Serialize;
 use serde_json::json;
 use std::collections::{BTreeMap, HashMap};
@@ -139,7 +139,7 @@ pub struct Baked {
 
 /// Gather the triangle primitives of `doc` with their world frames.
 pub fn prepare(doc: &Document, uv_set: usize, report: &mut Report) -> Result<Vec<Work>> {
-    let insts = scene::instances(doc);
+    let insts = nodes::instances(doc);
     let mut first: HashMap<usize, Mat4> = HashMap::new();
     let mut count: HashMap<usize, (usize, bool)> = HashMap::new();
     for i in &insts {
@@ -173,7 +173,7 @@ pub fn prepare(doc: &Document, uv_set: usize, report: &mut Report) -> Result<Vec
             .and_then(|p| p.as_array())
             .map_or(0, |a| a.len());
         for k in 0..nprim {
-            let Some(p) = scene::read_primitive(doc, m, k, uv_set)? else {
+            let Some(p) = nodes::read_primitive(doc, m, k, uv_set)? else {
                 report.skipped_primitives.push(format!(
                     "meshes[{m}].primitives[{k}]: not triangles (points/lines), left as is"
                 ));

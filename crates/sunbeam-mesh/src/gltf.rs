@@ -722,7 +722,7 @@ pub(crate) fn sniff_mime(b: &[u8]) -> Option<&'static str> {
         Some("image/jpeg")
     } else if b.len() > 12 && &b[0..4] == b"RIFF" && &b[8..12] == b"WEBP" {
         Some("image/webp")
-    } else if b.starts_with(b"\xABKTX 20") {
+    } else if sunbeam_common::magic::is_ktx2(b) {
         Some("image/ktx2")
     } else {
         None

@@ -42,9 +42,9 @@ pub mod bake;
 pub mod bvh;
 pub mod geom;
 pub mod gltf;
+pub mod nodes;
 pub mod obj;
 pub mod orient;
-pub mod scene;
 pub mod snake;
 pub mod texture;
 
@@ -134,7 +134,7 @@ pub fn load_document(path: &Path) -> Result<Document> {
 
 /// Normals of a local primitive: the file's (normalised) or angle-weighted.
 /// Zero or missing normals are replaced by computed ones.
-pub(crate) fn local_normals(p: &scene::Prim) -> Vec<V3> {
+pub(crate) fn local_normals(p: &nodes::Prim) -> Vec<V3> {
     let computed = || geom::angle_weighted_normals(&p.positions, &p.triangles).0;
     match &p.normals {
         Some(n) => {
@@ -174,9 +174,9 @@ pub fn scene_mesh(doc: &Document) -> Result<TriMesh> {
         has_uvs: true,
         ..Default::default()
     };
-    let mut cache: std::collections::HashMap<(usize, usize), Option<scene::Prim>> =
+    let mut cache: std::collections::HashMap<(usize, usize), Option<nodes::Prim>> =
         Default::default();
-    for inst in scene::instances(doc) {
+    for inst in nodes::instances(doc) {
         let nprim = doc
             .array("meshes")
             .get(inst.mesh)
@@ -189,7 +189,7 @@ pub fn scene_mesh(doc: &Document) -> Result<TriMesh> {
         let mirror = if x.det < 0.0 { -1.0 } else { 1.0 };
         for k in 0..nprim {
             if let std::collections::hash_map::Entry::Vacant(e) = cache.entry((inst.mesh, k)) {
-                e.insert(scene::read_primitive(doc, inst.mesh, k, 0)?);
+                e.insert(nodes::read_primitive(doc, inst.mesh, k, 0)?);
             }
             let Some(p) = cache[&(inst.mesh, k)].as_ref() else {
                 continue;

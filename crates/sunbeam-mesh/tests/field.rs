@@ -48,7 +48,7 @@ fn check_stored(doc: &mut sunbeam_mesh::gltf::Document) {
         sunbeam_mesh::gltf::Document::from_bytes(&glb, std::path::Path::new("out.glb")).unwrap();
     for (m, mesh) in back.array("meshes").iter().enumerate() {
         for (k, _) in mesh["primitives"].as_array().unwrap().iter().enumerate() {
-            let p = sunbeam_mesh::scene::read_primitive(&back, m, k, 0)
+            let p = sunbeam_mesh::nodes::read_primitive(&back, m, k, 0)
                 .unwrap()
                 .unwrap();
             let n = p.normals.unwrap();

@@ -15,3 +15,5 @@ mod cie_data;
 pub mod colour;
 pub mod gain;
 pub mod truth;
+
+pub use truth::Model;

@@ -29,14 +29,25 @@ use std::f64::consts::PI;
 use sunbeam_common::{Error, Result};
 use sunbeam_field::HeightField;
 
-/// What lies beyond the measured patch (PHYSICS.md 2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// What lies beyond the measured patch (PHYSICS.md 2): the one enum for it
+/// where the crates meet (the ground truth, the pack manifest as
+/// `sunbeam_pack::Model`, the tools' `--model window|tiled`; serialised
+/// `"window"` / `"tiled"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Model {
-    /// A Gaussian coherence window over one patch (the default).
+    /// A Gaussian coherence window over one patch, amplitudes interpolated in
+    /// the pack (NUFFT). The default.
     #[default]
     Window,
-    /// The patch repeated periodically (the thesis).
+    /// The patch repeated periodically (the thesis): power per DFT bin,
+    /// broadened by a Gaussian.
     Tiled,
+}
+
+impl Model {
+    /// The names `--model` accepts, in `Model` order.
+    pub const NAMES: [&'static str; 2] = ["window", "tiled"];
 }
 
 impl Model {

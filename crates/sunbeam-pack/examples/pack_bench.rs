@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 use sunbeam_pack::build::{self, BuildOptions, FieldRef};
-use sunbeam_pack::io::{write_pack, OutputKind};
+use sunbeam_pack::formats::{write_pack, OutputKind};
 
 /// The synthetic field both implementations use (same formula in bench_numpy.py).
 pub fn height(c: usize, r: usize, dx: f64) -> f64 {

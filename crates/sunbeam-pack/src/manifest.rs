@@ -11,15 +11,8 @@ pub const FORMAT_VERSION: u32 = 1;
 /// KTX2 key/value key and EXR header attribute holding the manifest JSON.
 pub const MANIFEST_KEY: &str = "sunbeam.manifest";
 
-/// What lies beyond the measured patch (PHYSICS.md 2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Model {
-    /// Gaussian coherence window over one patch, amplitudes interpolated (NUFFT). Default.
-    Window,
-    /// Periodic patch (the thesis): power per DFT bin, broadened by a Gaussian.
-    Tiled,
-}
+/// What lies beyond the measured patch (PHYSICS.md 2): the ground truth's enum.
+pub use sunbeam_optics::Model;
 
 /// The basis of the height expansion (PHYSICS.md 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -3,7 +3,6 @@
 use crate::kernel;
 use crate::manifest::{Manifest, Model};
 use crate::series;
-use std::path::Path;
 use sunbeam_common::{Error, Result};
 
 /// A diffraction term pack: the manifest plus the complex terms.
@@ -22,26 +21,6 @@ struct Taps {
 }
 
 impl Pack {
-    /// Read a pack (KTX2 or EXR, detected from the content).
-    pub fn read(path: &Path) -> Result<Pack> {
-        let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, e))?;
-        if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-            return crate::exr_io::read_path(path, &bytes);
-        }
-        Self::from_bytes(&bytes).map_err(|e| e.context(path.display()))
-    }
-
-    /// Parse a pack from bytes (KTX2 or single-file EXR).
-    pub fn from_bytes(bytes: &[u8]) -> Result<Pack> {
-        if bytes.starts_with(&crate::ktx2::IDENTIFIER) {
-            crate::ktx2::decode(bytes)
-        } else if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-            crate::exr_io::decode(bytes)
-        } else {
-            Err(Error::input("not a KTX2 or EXR pack"))
-        }
-    }
-
     /// Checks shared by the readers: sizes and finiteness.
     pub fn new(manifest: Manifest, terms: Vec<f32>) -> Result<Pack> {
         manifest.validate()?;

@@ -4,7 +4,7 @@
 mod common;
 use common::*;
 use sunbeam_pack::build::BuildOptions;
-use sunbeam_pack::io::{write_pack, OutputKind};
+use sunbeam_pack::formats::{write_pack, OutputKind};
 use sunbeam_pack::{exr_io, ktx2, Pack, Precision};
 
 fn u32at(b: &[u8], o: usize) -> u32 {

@@ -3,11 +3,12 @@
 //! `sunbeam.response` (and `KTXwriter`). Hand-written rather than through a
 //! crate because the `ktx2` crate only reads, and the layout is a few fixed
 //! fields (KTX 2.0 spec sections 3-4; the same rules as sunbeam-pack's
-//! 2D-array writer, which this mirrors for a 3D, four-channel texture).
+//! 2D-array writer, which this mirrors for a 3D, four-channel texture; the
+//! identifier comes from `sunbeam_common::magic`).
 
 use crate::{Info, Response, INFO_KEY};
+use sunbeam_common::magic::KTX2 as IDENTIFIER;
 use sunbeam_common::{Error, Result};
-use sunbeam_pack::ktx2::IDENTIFIER;
 
 /// VK_FORMAT_R16G16B16A16_SFLOAT.
 pub const VK_R16G16B16A16_SFLOAT: u32 = 97;

@@ -7,6 +7,7 @@
 
 pub mod camera;
 pub mod geometry;
+pub mod reach;
 
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

@@ -9,6 +9,7 @@
 //! (finger-like) profile, gentle waviness, finger breaks along the ridge, and
 //! a little band-limited roughness. They are stand-ins, not measurements.
 
+use sunbeam_common::rng::SplitMix64;
 use sunbeam_common::{Error, Result};
 use sunbeam_field::{HeightField, Provenance};
 
@@ -204,22 +205,6 @@ fn smooth_noise(w: usize, h: usize, passes: usize, rng: &mut SplitMix64) -> Vec<
         a.iter_mut().for_each(|v| *v /= rms);
     }
     a
-}
-
-/// SplitMix64: tiny, fast, and the same on every platform (byte-identical outputs).
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 #[cfg(test)]

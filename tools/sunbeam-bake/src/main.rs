@@ -106,15 +106,7 @@ struct Cli {
 }
 
 fn main() {
-    let cli = match Cli::try_parse() {
-        Ok(c) => c,
-        Err(e) => {
-            let code = if e.use_stderr() { 1 } else { 0 };
-            let _ = e.print();
-            std::process::exit(code);
-        }
-    };
-    sunbeam_common::error::run_main("sunbeam-bake", || run(cli))
+    sunbeam_common::cli::main("sunbeam-bake", run)
 }
 
 fn run(cli: Cli) -> Result<()> {

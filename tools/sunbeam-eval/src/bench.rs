@@ -133,15 +133,12 @@ fn eval_time_ns(p: &Pack, pts: &[[f64; 4]]) -> f64 {
 }
 
 fn load_snake(dir: &Path, name: &str, z: f64) -> Result<HeightField> {
-    let path = dir.join(name);
-    let opts = sunbeam_afm::ReadOptions {
+    let opts = sunbeam_afm::height::HeightOptions {
         pixel_size: Some((65e-9, 65e-9)),
         z_range: Some(z),
         ..Default::default()
     };
-    let ch = sunbeam_afm::read_file(&path, &opts)?;
-    let c = sunbeam_afm::select_channel(&ch, None)?;
-    Ok(c.field.clone())
+    Ok(sunbeam_afm::height::read_height_field(&dir.join(name), &opts)?.field)
 }
 
 pub fn run(o: &Options) -> Result<()> {

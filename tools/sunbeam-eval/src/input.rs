@@ -3,102 +3,47 @@
 //! Sunbeam manifest).
 
 use std::path::Path;
-use sunbeam_common::{units, Error, Result};
+use sunbeam_afm::height::{self, HeightOptions};
+use sunbeam_common::{cli, Error, Result};
 use sunbeam_field::HeightField;
 
-/// How to read a height field (options for files without calibration).
+/// How to read a height field (the one reader, `sunbeam_afm::height`).
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct HeightArgs {
     /// Pixel size for files that do not record one (images): `65nm` or `65nm,70nm` (dx,dy).
-    #[arg(long, value_name = "LEN[,LEN]")]
-    pub pixel_size: Option<String>,
+    #[arg(long, value_name = "LEN[,LEN]", value_parser = cli::pixel_size)]
+    pub pixel_size: Option<cli::PixelSize>,
     /// Height of the full grey range of an uncalibrated image, e.g. `375nm`.
-    #[arg(long, value_name = "LEN")]
-    pub z_range: Option<String>,
+    #[arg(long, value_name = "LEN", value_parser = cli::positive_length)]
+    pub z_range: Option<f64>,
     /// Channel to use (name or index); default: the first height channel.
     #[arg(long)]
     pub channel: Option<String>,
+    /// Accept NaN/Inf heights or a height range beyond 1 mm (docs/IMPORT.md).
+    #[arg(long)]
+    pub allow_implausible: bool,
 }
 
 impl HeightArgs {
-    pub fn read_options(&self) -> Result<sunbeam_afm::ReadOptions> {
-        let mut o = sunbeam_afm::ReadOptions::default();
-        if let Some(s) = &self.pixel_size {
-            let (a, b) = match s.split_once(',') {
-                Some((a, b)) => (
-                    units::parse_positive_length(a)?,
-                    units::parse_positive_length(b)?,
-                ),
-                None => {
-                    let a = units::parse_positive_length(s)?;
-                    (a, a)
-                }
-            };
-            o.pixel_size = Some((a, b));
+    pub fn options(&self) -> HeightOptions {
+        HeightOptions {
+            channel: self.channel.clone(),
+            pixel_size: self.pixel_size.map(cli::PixelSize::pair),
+            z_range: self.z_range,
+            allow_implausible: self.allow_implausible,
+            ..HeightOptions::default()
         }
-        if let Some(s) = &self.z_range {
-            o.z_range = Some(units::parse_positive_length(s)?);
-        }
-        Ok(o)
     }
 }
 
 /// A KTX2 file, or an EXR whose header carries the `sunbeam.manifest` attribute.
 pub fn is_pack(path: &Path) -> Result<bool> {
-    use std::io::Read;
-    let mut f = std::fs::File::open(path)
-        .map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
-    let mut head = Vec::with_capacity(1 << 16);
-    f.by_ref()
-        .take(1 << 16)
-        .read_to_end(&mut head)
-        .map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
-    const KTX2: &[u8] = b"\xABKTX 20\xBB\r\n\x1A\n";
-    if head.starts_with(KTX2) {
-        return Ok(true);
-    }
-    if head.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        return Ok(head.windows(16).any(|w| w == b"sunbeam.manifest"));
-    }
-    Ok(false)
+    sunbeam_pack::formats::is_pack(path)
 }
 
-/// Read a height field in metres: EXR height fields through sunbeam-field,
-/// everything else through sunbeam-afm.
+/// Read a height field in metres (`sunbeam_afm::height`, the rules of docs/IMPORT.md).
 pub fn read_height(path: &Path, args: &HeightArgs) -> Result<HeightField> {
-    let bytes =
-        std::fs::read(path).map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
-    if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        return sunbeam_field::io::read(path);
-    }
-    let opts = args.read_options()?;
-    let chans = sunbeam_afm::read_bytes(&bytes, &opts).map_err(|e| e.context(path.display()))?;
-    let ch = sunbeam_afm::select_channel(&chans, args.channel.as_deref())
-        .map_err(|e| e.context(path.display()))?;
-    if ch.z_unit != "m" {
-        return Err(Error::input_file(
-            path,
-            format!(
-                "channel '{}' has values in '{}', not heights in metres (give --z-range for an uncalibrated image)",
-                ch.name, ch.z_unit
-            ),
-        ));
-    }
-    if ch.xy_unit != "m" {
-        return Err(Error::input_file(
-            path,
-            format!(
-                "channel '{}' has no lateral calibration (give --pixel-size)",
-                ch.name
-            ),
-        ));
-    }
-    let mut f = ch.field.clone();
-    f.provenance.source_file = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    Ok(f)
+    Ok(height::read_height_field(path, &args.options())?.field)
 }
 
 /// Replicate a height field `nx` x `ny` times (a periodic patch seen by a

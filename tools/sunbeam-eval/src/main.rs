@@ -19,7 +19,7 @@ use clap::{Parser, Subcommand};
 use serde_json::json;
 use source::{Source, TruthArgs};
 use std::path::PathBuf;
-use sunbeam_common::{units, Error, Result};
+use sunbeam_common::{cli, units, Error, Result};
 
 #[derive(Parser)]
 #[command(
@@ -169,11 +169,11 @@ struct GratingArgs {
     #[arg(long, default_value = "0deg", allow_hyphen_values = true)]
     azimuth: String,
     /// Wavelength range.
-    #[arg(long, default_value = "380nm..780nm")]
-    lambda: String,
+    #[arg(long, default_value = "380nm..780nm", value_parser = cli::length_range)]
+    lambda: (f64, f64),
     /// Wavelength step.
-    #[arg(long, default_value = "10nm")]
-    lambda_step: String,
+    #[arg(long, default_value = "10nm", value_parser = cli::positive_length)]
+    lambda_step: f64,
     /// Viewing-angle step of the scan (peaks are then refined on the continuous R).
     #[arg(long, default_value = "0.1deg")]
     angle_step: String,
@@ -181,14 +181,14 @@ struct GratingArgs {
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     order: i32,
     /// Ignore peaks whose period (1/|f|) is longer than this (default: outside the specular lobe).
-    #[arg(long, value_name = "LEN")]
-    max_period: Option<String>,
+    #[arg(long, value_name = "LEN", value_parser = cli::positive_length)]
+    max_period: Option<f64>,
     /// Replicate the height field NxM times first (a periodic patch seen by a wider window).
     #[arg(long, value_name = "NxM")]
     tile: Option<String>,
     /// The true period, if known: drawn in the plot and compared in the report.
-    #[arg(long, value_name = "LEN")]
-    true_period: Option<String>,
+    #[arg(long, value_name = "LEN", value_parser = cli::positive_length)]
+    true_period: Option<f64>,
     /// Write the plot of peaks against the grating equation.
     #[arg(long, value_name = "OUT.png")]
     plot: Option<PathBuf>,
@@ -229,61 +229,43 @@ pub struct RenderArgs {
 }
 
 fn main() {
-    sunbeam_common::error::run_main("sunbeam-eval", || {
-        let cli = match Cli::try_parse() {
-            Ok(c) => c,
-            Err(e) => {
-                use clap::error::ErrorKind;
-                if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
-                    print!("{e}");
-                    return Ok(());
-                }
-                return Err(Error::usage(e.to_string().trim_end().to_string()));
-            }
-        };
-        match cli.cmd {
-            Cmd::Probe(a) => {
-                let src = Source::open(&a.input, &a.heights, &a.model, a.truth)?;
-                probe::run(&src, &a.points)
-            }
-            Cmd::Grating(a) => grating_cmd(a, cli.quiet),
-            Cmd::Compare(a) => compare_cmd(a),
-            Cmd::Brdf(a) => brdf_cmd(a),
-            Cmd::Bench(a) => {
-                let snake = a.snake.clone().or_else(|| {
-                    sunbeam_common::testdata::shared_data()
-                        .map(|d| d.join("snake"))
-                        .filter(|d| d.is_dir())
-                });
-                bench::run(&bench::Options {
-                    snake_dir: snake,
-                    out_dir: a.output,
-                    points: a.points.max(10),
-                    quick: a.quick,
-                })
-            }
-            Cmd::Render(a) => render::run(&a),
-            Cmd::Sheet(a) => sheet::run(&a.output, &a.inputs, a.columns),
+    sunbeam_common::cli::main("sunbeam-eval", run)
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.cmd {
+        Cmd::Probe(a) => {
+            let src = Source::open(&a.input, &a.heights, &a.model, a.truth)?;
+            probe::run(&src, &a.points)
         }
-    })
+        Cmd::Grating(a) => grating_cmd(a, cli.quiet),
+        Cmd::Compare(a) => compare_cmd(a),
+        Cmd::Brdf(a) => brdf_cmd(a),
+        Cmd::Bench(a) => {
+            let snake = a.snake.clone().or_else(|| {
+                sunbeam_common::testdata::shared_data()
+                    .map(|d| d.join("snake"))
+                    .filter(|d| d.is_dir())
+            });
+            bench::run(&bench::Options {
+                snake_dir: snake,
+                out_dir: a.output,
+                points: a.points.max(10),
+                quick: a.quick,
+            })
+        }
+        Cmd::Render(a) => render::run(&a),
+        Cmd::Sheet(a) => sheet::run(&a.output, &a.inputs, a.columns),
+    }
 }
 
 fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
     let theta_i = units::parse_angle(&a.theta_i)?;
     let azimuth = units::parse_angle(&a.azimuth)?;
-    let (lmin, lmax) = units::parse_length_range(&a.lambda)?;
-    let lstep = units::parse_positive_length(&a.lambda_step)?;
+    let (lmin, lmax) = a.lambda;
+    let lstep = a.lambda_step;
     let astep = units::parse_angle(&a.angle_step)?;
-    let max_period = a
-        .max_period
-        .as_deref()
-        .map(units::parse_positive_length)
-        .transpose()?;
-    let true_period = a
-        .true_period
-        .as_deref()
-        .map(units::parse_positive_length)
-        .transpose()?;
+    let (max_period, true_period) = (a.max_period, a.true_period);
     let params = a.model.params()?;
     let src = if input::is_pack(&a.input)? {
         if a.tile.is_some() {
@@ -480,13 +462,11 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         println!("{}", if pass { "PASS" } else { "FAIL" });
     }
     if !pass {
-        use std::io::Write;
-        let _ = std::io::stdout().flush();
-        eprintln!(
-            "sunbeam-eval: compare: above tolerance (max |dR| {:.3e} vs {:.1e}, p99 dE00 {:.3} vs {:.2})",
+        // Exit 5 (docs/EVAL.md), printed as `sunbeam-eval: compare: ...`.
+        return Err(Error::check_failed(format!(
+            "compare: above tolerance (max |dR| {:.3e} vs {:.1e}, p99 dE00 {:.3} vs {:.2})",
             spec.max_abs, a.tolerance, p99, a.de_tolerance
-        );
-        std::process::exit(5);
+        )));
     }
     Ok(())
 }

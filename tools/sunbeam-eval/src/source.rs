@@ -3,7 +3,7 @@
 
 use crate::input::{self, HeightArgs};
 use std::path::Path;
-use sunbeam_common::{units, Error, Result};
+use sunbeam_common::{Error, Result};
 use sunbeam_field::HeightField;
 use sunbeam_optics::truth::{Model, Params, Truth};
 
@@ -11,18 +11,18 @@ use sunbeam_optics::truth::{Model, Params, Truth};
 #[derive(Debug, Clone, clap::Args)]
 pub struct TruthArgs {
     /// What lies beyond the patch: `window` (default) or `tiled` (the thesis).
-    #[arg(long, default_value = "window")]
-    pub model: String,
+    #[arg(long, default_value = "window", value_parser = sunbeam_common::cli::one_of::<Model>(&Model::NAMES))]
+    pub model: Model,
     /// Spatial coherence length of the light.
-    #[arg(long, default_value = "65um", value_name = "LEN")]
-    pub coherence: String,
+    #[arg(long, default_value = "65um", value_name = "LEN", value_parser = sunbeam_common::cli::positive_length)]
+    pub coherence: f64,
 }
 
 impl TruthArgs {
     pub fn params(&self) -> Result<Params> {
         Ok(Params {
-            model: self.model.parse::<Model>()?,
-            coherence_m: units::parse_positive_length(&self.coherence)?,
+            model: self.model,
+            coherence_m: self.coherence,
         })
     }
 }

@@ -4,8 +4,10 @@
 
 use clap::Parser;
 use std::path::{Path, PathBuf};
-use sunbeam_afm::{Channel, ChannelInfo, Format, ReadOptions};
-use sunbeam_common::units::{format_length, parse_positive_length, parse_size};
+use sunbeam_afm::height::{self, HeightOptions};
+use sunbeam_afm::{Channel, ChannelInfo, Format};
+use sunbeam_common::cli::{pixel_size, positive_length, PixelSize};
+use sunbeam_common::units::{format_length, parse_size};
 use sunbeam_common::{Error, Result};
 use sunbeam_field::align::AlignRows;
 use sunbeam_field::geom::CropSpec;
@@ -13,7 +15,6 @@ use sunbeam_field::io::{self, Kind};
 use sunbeam_field::pipeline::{self, FlipAxis, Level, Step};
 use sunbeam_field::resample::Target;
 use sunbeam_field::stats::Stats;
-use sunbeam_field::HeightField;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -49,6 +50,10 @@ struct Cli {
     /// Replace NaN/Inf values by Laplace interpolation.
     #[arg(long)]
     fill_nonfinite: bool,
+    /// Accept heights no instrument measures: NaN/Inf kept (without
+    /// --fill-nonfinite) or a range beyond 1 mm (docs/IMPORT.md).
+    #[arg(long)]
+    allow_implausible: bool,
     /// Shift the mean height to zero.
     #[arg(long)]
     zero_mean: bool,
@@ -68,26 +73,26 @@ struct Cli {
     /// ASCII matrices, EXRs from other tools) it IS the calibration; for
     /// calibrated files it resamples to square pixels of this size.
     /// Give `DX,DY` to calibrate non-square pixels.
-    #[arg(long, value_name = "LEN")]
-    pixel_size: Option<String>,
+    #[arg(long, value_name = "LEN", value_parser = pixel_size)]
+    pixel_size: Option<PixelSize>,
     /// Resample to square pixels of this size (always resamples, never calibrates).
-    #[arg(long, value_name = "LEN", conflicts_with = "size")]
-    resample_to: Option<String>,
+    #[arg(long, value_name = "LEN", conflicts_with = "size", value_parser = positive_length)]
+    resample_to: Option<f64>,
     /// Resample to WxH pixels (square pixels; the longer side is cropped if the aspect differs).
     #[arg(long, value_name = "WxH")]
     size: Option<String>,
     /// Calibration for uncalibrated images: height of the full grey range.
-    #[arg(long, value_name = "LEN")]
-    z_range: Option<String>,
+    #[arg(long, value_name = "LEN", value_parser = positive_length)]
+    z_range: Option<f64>,
     /// Calibration for uncalibrated data: metres per grey level / per number.
-    #[arg(long, value_name = "LEN")]
-    z_scale: Option<String>,
+    #[arg(long, value_name = "LEN", value_parser = positive_length)]
+    z_scale: Option<f64>,
     /// `synthetic:NAME` inputs: the field's size in pixels (square).
     #[arg(long, value_name = "N", default_value_t = 256)]
     synthetic_size: usize,
     /// `synthetic:NAME` inputs: the pixel size.
-    #[arg(long, value_name = "LEN", default_value = "25nm")]
-    synthetic_pixel: String,
+    #[arg(long, value_name = "LEN", default_value = "25nm", value_parser = positive_length)]
+    synthetic_pixel: f64,
     /// Also write a false-colour PNG preview with a scale bar.
     #[arg(long, value_name = "PNG")]
     preview: Option<PathBuf>,
@@ -108,19 +113,9 @@ struct Cli {
 /// Everything parsed and checked before the input is touched.
 struct Plan {
     steps: Vec<Step>,
-    /// --pixel-size: calibration or resampling target, decided once the file is read.
-    pixel_size: Option<(f64, f64)>,
-    read: ReadOptions,
-}
-
-fn parse_pixel_size(s: &str) -> Result<(f64, f64)> {
-    match s.split_once(',') {
-        Some((a, b)) => Ok((parse_positive_length(a)?, parse_positive_length(b)?)),
-        None => {
-            let p = parse_positive_length(s)?;
-            Ok((p, p))
-        }
-    }
+    /// How the input is read (the one reader, sunbeam_afm::height); its
+    /// --pixel-size is calibration or a resampling target, decided once the file is read.
+    read: HeightOptions,
 }
 
 fn plan(cli: &Cli) -> Result<Plan> {
@@ -155,22 +150,14 @@ fn plan(cli: &Cli) -> Result<Plan> {
     if let Some(f) = &cli.flip {
         steps.push(Step::Flip(f.parse::<FlipAxis>().map_err(ctx("--flip"))?));
     }
-    if let Some(r) = &cli.resample_to {
-        steps.push(Step::Resample(Target::PixelSize(
-            parse_positive_length(r).map_err(ctx("--resample-to"))?,
-        )));
+    if let Some(r) = cli.resample_to {
+        steps.push(Step::Resample(Target::PixelSize(r)));
     }
     if let Some(s) = &cli.size {
         let (w, h) = parse_size(s).map_err(ctx("--size"))?;
         steps.push(Step::Resample(Target::Size(w, h)));
     }
     steps.sort_by_key(Step::canonical_order);
-    let pixel_size = cli
-        .pixel_size
-        .as_deref()
-        .map(parse_pixel_size)
-        .transpose()
-        .map_err(ctx("--pixel-size"))?;
     let format = cli
         .format
         .as_deref()
@@ -179,18 +166,6 @@ fn plan(cli: &Cli) -> Result<Plan> {
                 .ok_or_else(|| Error::usage(format!("--format {f}: unknown format")))
         })
         .transpose()?;
-    let z_range = cli
-        .z_range
-        .as_deref()
-        .map(parse_positive_length)
-        .transpose()
-        .map_err(ctx("--z-range"))?;
-    let z_scale = cli
-        .z_scale
-        .as_deref()
-        .map(parse_positive_length)
-        .transpose()
-        .map_err(ctx("--z-scale"))?;
     if let Some(o) = &cli.output {
         Kind::from_path(o)?;
         if same_file(o, &cli.input) {
@@ -211,12 +186,14 @@ fn plan(cli: &Cli) -> Result<Plan> {
     }
     Ok(Plan {
         steps,
-        pixel_size,
-        read: ReadOptions {
+        read: HeightOptions {
             format,
-            pixel_size: None,
-            z_range,
-            z_scale,
+            channel: cli.channel.clone(),
+            pixel_size: cli.pixel_size.map(PixelSize::pair),
+            z_range: cli.z_range,
+            z_scale: cli.z_scale,
+            fill_nonfinite: cli.fill_nonfinite,
+            allow_implausible: cli.allow_implausible,
         },
     })
 }
@@ -226,93 +203,6 @@ fn same_file(a: &Path, b: &Path) -> bool {
         (Ok(x), Ok(y)) => x == y,
         _ => a == b,
     }
-}
-
-/// A channel of an EXR height field (read here: sunbeam-afm leaves EXR to sunbeam-field).
-fn read_exr(bytes: &[u8], pixel_size: Option<(f64, f64)>) -> Result<(Vec<Channel>, bool)> {
-    let raw = io::exr::decode_raw(bytes)?;
-    let (dx, dy, xy_unit, calibrated_by_user) = match (raw.dx, raw.dy, pixel_size) {
-        (Some(dx), dy, _) => (dx, dy.unwrap_or(dx), "m", false),
-        (None, _, Some((dx, dy))) => (dx, dy, "m", true),
-        (None, _, None) => (1.0, 1.0, "", false),
-    };
-    let z_unit = raw.z_unit.clone().unwrap_or_else(|| "m".into());
-    let mut field = HeightField::new(raw.width, raw.height, dx, dy, raw.data)?;
-    field.provenance = raw.provenance;
-    let name = if field.provenance.channel.is_empty() {
-        raw.channel_name
-    } else {
-        field.provenance.channel.clone()
-    };
-    Ok((
-        vec![Channel {
-            name,
-            is_height: z_unit == "m",
-            z_unit,
-            field,
-            xy_unit: xy_unit.into(),
-            offset: (0.0, 0.0),
-        }],
-        calibrated_by_user,
-    ))
-}
-
-/// Read all channels; returns them, the format, and whether --pixel-size served as calibration.
-fn read_channels(bytes: &[u8], plan: &Plan) -> Result<(Vec<Channel>, Format, bool)> {
-    let format = plan.read.format.or_else(|| sunbeam_afm::detect(bytes));
-    if format == Some(Format::Exr) {
-        let (c, cal) = read_exr(bytes, plan.pixel_size)?;
-        return Ok((c, Format::Exr, cal));
-    }
-    let fmt = format.unwrap_or(Format::Ascii);
-    // XYZ points: the pixel size is the grid the points are sampled onto.
-    if fmt == Format::Xyz && plan.pixel_size.is_some() {
-        let opts = ReadOptions {
-            pixel_size: plan.pixel_size,
-            ..plan.read.clone()
-        };
-        return Ok((sunbeam_afm::read_bytes(bytes, &opts)?, fmt, true));
-    }
-    match sunbeam_afm::read_bytes(bytes, &plan.read) {
-        Ok(c) => Ok((c, fmt, false)),
-        Err(e) => match plan.pixel_size {
-            // Files without calibration refuse to load without a pixel size.
-            Some(p) => {
-                let opts = ReadOptions {
-                    pixel_size: Some(p),
-                    ..plan.read.clone()
-                };
-                Ok((sunbeam_afm::read_bytes(bytes, &opts)?, fmt, true))
-            }
-            None => Err(e),
-        },
-    }
-}
-
-/// The channels of the input without processing them. Nanoscope files list
-/// from the header alone (so files with damaged data still list).
-fn list_infos(bytes: &[u8], plan: &Plan) -> Result<(Vec<ChannelInfo>, Format)> {
-    let format = plan.read.format.or_else(|| sunbeam_afm::detect(bytes));
-    if format == Some(Format::Exr) {
-        let (chans, _) = read_exr(bytes, plan.pixel_size)?;
-        let infos = chans
-            .iter()
-            .enumerate()
-            .map(|(index, c)| ChannelInfo::of(index, c, Format::Exr))
-            .collect();
-        return Ok((infos, Format::Exr));
-    }
-    let opts = ReadOptions {
-        pixel_size: plan.pixel_size,
-        ..plan.read.clone()
-    };
-    let infos = sunbeam_afm::list_channels_bytes(bytes, &opts)?;
-    let fmt = infos
-        .first()
-        .map(|i| i.format)
-        .or(format)
-        .unwrap_or(Format::Ascii);
-    Ok((infos, fmt))
 }
 
 fn list(cli: &Cli, chans: &[ChannelInfo], fmt: Format) {
@@ -376,9 +266,7 @@ fn synthetic(cli: &Cli, name: &str) -> Result<Vec<Channel>> {
             cli.synthetic_size
         )));
     }
-    let pixel =
-        parse_positive_length(&cli.synthetic_pixel).map_err(|e| e.context("--synthetic-pixel"))?;
-    let field = sunbeam_synth::preset(name, cli.synthetic_size, pixel)?;
+    let field = sunbeam_synth::preset(name, cli.synthetic_size, cli.synthetic_pixel)?;
     Ok(vec![Channel {
         name: "Height".into(),
         z_unit: "m".into(),
@@ -394,7 +282,7 @@ fn run(cli: Cli) -> Result<()> {
     let input = &cli.input;
     let synth = synthetic_name(input);
     let in_file = |e: Error| e.context(input.display());
-    let (chans, fmt, calibrated_by_user) = if let Some(name) = synth {
+    let read = if let Some(name) = synth {
         if plan.read.format.is_some() || plan.read.z_range.is_some() || plan.read.z_scale.is_some()
         {
             return Err(Error::usage(format!(
@@ -404,77 +292,31 @@ fn run(cli: Cli) -> Result<()> {
         }
         let chans = synthetic(&cli, name)?;
         if cli.list {
-            let c = &chans[0];
-            let info = ChannelInfo {
-                index: 0,
-                name: c.name.clone(),
-                z_unit: c.z_unit.clone(),
-                xy_unit: c.xy_unit.clone(),
-                is_height: true,
-                width: c.field.width,
-                height: c.field.height,
-                size: (c.field.size_x(), c.field.size_y()),
-                format: Format::Exr,
-            };
+            let info = ChannelInfo::of(0, &chans[0], Format::Exr);
             list(&cli, &[info], Format::Exr);
             return Ok(());
         }
-        (chans, Format::Exr, false)
+        height::from_channels(&chans, Format::Exr, false, &plan.read).map_err(in_file)?
     } else {
         let bytes = std::fs::read(input)
             .map_err(|e| Error::input_file(input, format!("cannot read: {e}")))?;
         if cli.list {
-            let (infos, fmt) = list_infos(&bytes, &plan).map_err(in_file)?;
+            let (infos, fmt) = height::list(&bytes, &plan.read).map_err(in_file)?;
             list(&cli, &infos, fmt);
             return Ok(());
         }
-        read_channels(&bytes, &plan).map_err(in_file)?
+        height::read_height_bytes(&bytes, &plan.read).map_err(in_file)?
     };
-    let ch = sunbeam_afm::select_channel(&chans, cli.channel.as_deref()).map_err(in_file)?;
-    // A channel without a z unit: --z-scale (metres per unit) calibrates it.
-    let unitless_scale = match (ch.z_unit.is_empty(), plan.read.z_scale) {
-        (true, Some(s)) => Some(s),
-        _ => None,
-    };
-    if ch.z_unit != "m" && unitless_scale.is_none() {
-        return Err(in_file(Error::input(format!(
-            "channel '{}' is in '{}', not metres: not a height field (pick a height channel with --channel, --list shows them; a channel without unit takes --z-scale)",
-            ch.name,
-            if ch.z_unit.is_empty() { "no unit" } else { &ch.z_unit }
-        ))));
-    }
-    let mut field = ch.field.clone();
-    let mut processing = Vec::new();
-    if let Some(sc) = unitless_scale {
-        field.data.iter_mut().for_each(|v| *v *= sc);
-        let d = format!("calibrate z scale {} per unit", format_length(sc));
-        field.provenance.processing.push(d.clone());
-        processing.push(d);
-    }
+    let (mut field, fmt, channel) = (read.field, read.format, read.channel);
+    let mut processing = read.processing;
     let mut steps = plan.steps.clone();
-    let pixel_size_role;
-    if ch.xy_unit != "m" {
-        match plan.pixel_size {
-            Some((dx, dy)) => {
-                field.dx = dx;
-                field.dy = dy;
-                pixel_size_role = "calibration";
-            }
-            None => {
-                return Err(in_file(Error::input(format!(
-                    "channel '{}' has no lateral calibration (unit '{}'): give --pixel-size",
-                    ch.name, ch.xy_unit
-                ))))
-            }
-        }
-    } else if let Some((dx, dy)) = plan.pixel_size {
-        if calibrated_by_user {
-            pixel_size_role = "calibration";
-        } else {
-            if dx != dy {
+    let pixel_size_role = match cli.pixel_size {
+        _ if read.pixel_size_calibrated => "calibration",
+        // A calibrated file: --pixel-size resamples.
+        Some(p) => {
+            if p.dx != p.dy {
                 return Err(Error::usage(format!(
-                    "--pixel-size {}: the file is calibrated, so --pixel-size resamples, to square pixels: give one length",
-                    cli.pixel_size.as_deref().unwrap_or("")
+                    "--pixel-size {p}: the file is calibrated, so --pixel-size resamples, to square pixels: give one length"
                 )));
             }
             if steps.iter().any(|s| matches!(s, Step::Resample(_))) {
@@ -482,21 +324,11 @@ fn run(cli: Cli) -> Result<()> {
                     "the file is calibrated, so --pixel-size would resample; it cannot be combined with --resample-to/--size",
                 ));
             }
-            steps.push(Step::Resample(Target::PixelSize(dx)));
-            pixel_size_role = "resample";
+            steps.push(Step::Resample(Target::PixelSize(p.dx)));
+            "resample"
         }
-    } else {
-        pixel_size_role = "none";
-    }
-    if pixel_size_role == "calibration" {
-        let d = format!(
-            "calibrate pixel size {} x {}",
-            format_length(field.dx),
-            format_length(field.dy)
-        );
-        field.provenance.processing.push(d.clone());
-        processing.push(d);
-    }
+        None => "none",
+    };
     let source_format = if synth.is_some() {
         "synthetic"
     } else {
@@ -507,13 +339,13 @@ fn run(cli: Cli) -> Result<()> {
         fmt.name()
     };
     field.provenance.source_format = source_format.to_string();
-    field.provenance.channel = ch.name.clone();
+    field.provenance.channel = channel.clone();
     if cli.verbose {
         eprintln!(
             "sunbeam-import: {}: {} channel '{}', {}x{} px of {} x {}",
             input.display(),
             source_format,
-            ch.name,
+            channel,
             field.width,
             field.height,
             format_length(field.dx),
@@ -566,7 +398,7 @@ fn run(cli: Cli) -> Result<()> {
         };
         let report = serde_json::json!({
             "input": input, "output": output, "preview": cli.preview,
-            "source_format": source_format, "channel": ch.name,
+            "source_format": source_format, "channel": channel,
             "width": field.width, "height": field.height, "dx_m": field.dx, "dy_m": field.dy,
             "size_x_m": field.size_x(), "size_y_m": field.size_y(),
             "z_min_m": num(st.min), "z_max_m": num(st.max), "z_mean_m": num(st.mean), "z_rms_m": num(st.rms),
@@ -592,17 +424,5 @@ fn run(cli: Cli) -> Result<()> {
 }
 
 fn main() {
-    let cli = match Cli::try_parse() {
-        Ok(c) => c,
-        Err(e) => {
-            use clap::error::ErrorKind;
-            let code = match e.kind() {
-                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => 0,
-                _ => 1,
-            };
-            let _ = e.print();
-            std::process::exit(code);
-        }
-    };
-    sunbeam_common::error::run_main("sunbeam-import", || run(cli))
+    sunbeam_common::cli::main("sunbeam-import", run)
 }

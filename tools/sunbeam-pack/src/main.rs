@@ -2,11 +2,13 @@
 
 use clap::{Parser, ValueEnum};
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
-use sunbeam_common::{depfile, units, Error, Result};
+use sunbeam_afm::height::{read_height_field, HeightOptions};
+use sunbeam_common::cli::{length_range, pixel_size, positive_length, PixelSize};
+use sunbeam_common::{depfile, Result};
 use sunbeam_pack::build::{self, BuildOptions, FieldRef};
-use sunbeam_pack::io::{read_height, write_pack, InputOptions, OutputKind};
+use sunbeam_pack::formats::{write_pack, OutputKind};
 use sunbeam_pack::manifest::Source;
 use sunbeam_pack::{Basis, Model, Precision};
 
@@ -16,12 +18,6 @@ const TOOL: &str = "sunbeam-pack";
 enum BasisArg {
     Chebyshev,
     Taylor,
-}
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-enum ModelArg {
-    Window,
-    Tiled,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -43,14 +39,14 @@ struct Cli {
     #[arg(long, value_enum, default_value = "chebyshev")]
     basis: BasisArg,
     /// Model of what lies beyond the patch (PHYSICS.md 2).
-    #[arg(long, value_enum, default_value = "window")]
-    model: ModelArg,
+    #[arg(long, default_value = "window", value_parser = sunbeam_common::cli::one_of::<Model>(&Model::NAMES))]
+    model: Model,
     /// Spatial coherence length of the light.
-    #[arg(long, default_value = "65um")]
-    coherence: String,
+    #[arg(long, default_value = "65um", value_parser = positive_length)]
+    coherence: f64,
     /// Wavelength range.
-    #[arg(long, default_value = "380nm..780nm")]
-    lambda: String,
+    #[arg(long, default_value = "380nm..780nm", value_parser = length_range)]
+    lambda: (f64, f64),
     /// Bound on max |dR| that picks the term count.
     #[arg(long, conflicts_with = "terms")]
     max_error: Option<f64>,
@@ -79,14 +75,17 @@ struct Cli {
     #[arg(long, default_value_t = 6)]
     taps: usize,
     /// Pixel size for files without calibration (e.g. 65nm or 65nm,70nm).
-    #[arg(long)]
-    pixel_size: Option<String>,
+    #[arg(long, value_parser = pixel_size)]
+    pixel_size: Option<PixelSize>,
     /// Height of the full grey range for uncalibrated images (e.g. 375nm).
-    #[arg(long)]
-    z_range: Option<String>,
+    #[arg(long, value_parser = positive_length)]
+    z_range: Option<f64>,
     /// Channel to use (name or index) in multi-channel AFM files.
     #[arg(long)]
     channel: Option<String>,
+    /// Accept NaN/Inf heights or a height range beyond 1 mm (docs/IMPORT.md).
+    #[arg(long)]
+    allow_implausible: bool,
     /// Worker threads (the output does not depend on it).
     #[arg(long)]
     threads: Option<usize>,
@@ -117,17 +116,8 @@ struct Cli {
     verbose: bool,
 }
 
-fn parse_pixel_size(s: &str) -> Result<(f64, f64)> {
-    match s.split_once(',') {
-        Some((a, b)) => Ok((
-            units::parse_positive_length(a)?,
-            units::parse_positive_length(b)?,
-        )),
-        None => {
-            let v = units::parse_positive_length(s)?;
-            Ok((v, v))
-        }
-    }
+fn main() {
+    sunbeam_common::cli::main(TOOL, run)
 }
 
 /// `NAME.response.ktx2` beside the pack `NAME.ktx2` / `NAME.exr` (what the player looks for).
@@ -153,55 +143,37 @@ fn parse_bytes(s: &str) -> Result<usize> {
     .unwrap_or((t, 1));
     match num.parse::<f64>() {
         Ok(v) if v.is_finite() && v >= 1.0 => Ok((v * mult as f64) as usize),
-        _ => Err(Error::usage(format!(
+        _ => Err(sunbeam_common::Error::usage(format!(
             "--response-budget '{s}': give a size such as 64MiB"
         ))),
     }
 }
 
-fn main() {
-    sunbeam_common::error::run_main(TOOL, || {
-        let cli = match Cli::try_parse() {
-            Ok(c) => c,
-            Err(e) => {
-                use clap::error::ErrorKind;
-                if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
-                    print!("{e}");
-                    return Ok(());
-                }
-                return Err(Error::usage(e.to_string().trim_end().to_string()));
-            }
-        };
-        run(cli)
-    })
+/// The triangles of a scene's mesh file (for `--scene`).
+fn mesh_triangles(path: &Path) -> Result<sunbeam_scene::reach::Triangles> {
+    let m = sunbeam_mesh::load_scene_mesh(path)?;
+    Ok((m.positions, m.indices))
 }
 
 fn run(cli: Cli) -> Result<()> {
     let t0 = Instant::now();
     let kind = OutputKind::from_path(&cli.output, cli.split, cli.atlas)?;
-    let coherence = units::parse_positive_length(&cli.coherence)?;
-    let (mut lmin, mut lmax) = units::parse_length_range(&cli.lambda)?;
-    let pixel_size = cli
-        .pixel_size
-        .as_deref()
-        .map(parse_pixel_size)
-        .transpose()?;
-    let z_range = cli
-        .z_range
-        .as_deref()
-        .map(units::parse_positive_length)
-        .transpose()?;
+    let coherence = cli.coherence;
+    let (mut lmin, mut lmax) = cli.lambda;
     let mut warnings: Vec<String> = vec![];
     let mut notes: Vec<String> = vec![];
 
-    let field = read_height(
+    let field = read_height_field(
         &cli.height,
-        &InputOptions {
-            pixel_size,
-            z_range,
+        &HeightOptions {
             channel: cli.channel.clone(),
+            pixel_size: cli.pixel_size.map(PixelSize::pair),
+            z_range: cli.z_range,
+            allow_implausible: cli.allow_implausible,
+            ..HeightOptions::default()
         },
-    )?;
+    )?
+    .field;
     let fr = FieldRef {
         width: field.width,
         height: field.height,
@@ -214,7 +186,7 @@ fn run(cli: Cli) -> Result<()> {
     let mut freq_limit = None;
     let mut inputs = vec![cli.height.clone()];
     if let Some(sp) = &cli.scene {
-        let b = sunbeam_pack::scene::bound_scene(sp, max_w)?;
+        let b = sunbeam_scene::reach::reach_of_file(sp, max_w, mesh_triangles)?;
         inputs.extend(b.inputs.iter().cloned());
         if let Some((a, z)) = b.lambda {
             lmin = lmin.max(a);
@@ -225,10 +197,7 @@ fn run(cli: Cli) -> Result<()> {
         notes.extend(b.notes.iter().cloned());
     }
 
-    let model = match cli.model {
-        ModelArg::Window => Model::Window,
-        ModelArg::Tiled => Model::Tiled,
-    };
+    let model = cli.model;
     let basis = match cli.basis {
         BasisArg::Chebyshev => Basis::Chebyshev,
         BasisArg::Taylor => Basis::Taylor,

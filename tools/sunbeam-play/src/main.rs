@@ -317,17 +317,5 @@ fn run(cli: Cli) -> Result<()> {
 }
 
 fn main() {
-    sunbeam_common::error::run_main("sunbeam-play", || {
-        let cli = Cli::try_parse().map_err(|e| {
-            if matches!(
-                e.kind(),
-                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion
-            ) {
-                let _ = e.print();
-                std::process::exit(0);
-            }
-            Error::usage(e.to_string())
-        })?;
-        run(cli)
-    })
+    sunbeam_common::cli::main("sunbeam-play", run)
 }

@@ -16,7 +16,7 @@ use crate::{HeightField, Provenance, MAX_SIDE};
 use sunbeam_common::{Error, Result};
 
 /// OpenEXR magic number.
-pub const MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
+pub const MAGIC: [u8; 4] = sunbeam_common::magic::EXR;
 
 /// Attribute names (shared with the readers of other crates).
 pub const ATTR_DX: &str = "sunbeam_dx_m";

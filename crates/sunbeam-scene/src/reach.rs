@@ -1,5 +1,10 @@
-//! `--scene`: bound the directions a scene can produce, so a pack built for it
-//! needs fewer terms and a smaller crop.
+//! The reach of a scene: a bound on the directions `(u, v, w) = wi + wr` its
+//! lights and camera can produce over its visible meshes, so a pack built for
+//! it (`sunbeam-pack --scene`) needs fewer terms and a smaller crop.
+//!
+//! This crate does not load meshes: the caller passes a loader for mesh files
+//! (sunbeam-pack's tool uses `sunbeam_mesh::load_scene_mesh`); built-in meshes
+//! (`builtin:quad`, `builtin:sphere`) are handled here.
 //!
 //! For a directional light `l` (unit, towards the light) and a surface point `p`
 //! seen from the eye `e`, `wr = (e - p)/|e - p|` and `|(u, v, w)| = |wi + wr| =
@@ -10,13 +15,16 @@
 //! angular size (every point of a triangle sees the eye within that angle of a
 //! vertex). Conservative: no occlusion, no normals, no back-face culling.
 
+use crate::Scene;
 use std::path::{Path, PathBuf};
 use sunbeam_common::{Error, Result};
-use sunbeam_scene::Scene;
 
-/// What a scene allows.
+/// A mesh's triangles: positions and indices (three per triangle).
+pub type Triangles = (Vec<[f32; 3]>, Vec<u32>);
+
+/// What a scene can reach.
 #[derive(Debug, Clone)]
-pub struct SceneBound {
+pub struct Reach {
     /// Wavelength range the lights emit, if narrower than the default.
     pub lambda: Option<(f64, f64)>,
     /// Bound on |w| (and on |u|, |v|).
@@ -29,7 +37,7 @@ pub struct SceneBound {
     pub notes: Vec<String>,
 }
 
-impl SceneBound {
+impl Reach {
     /// Largest |fx|, |fy| at the shortest wavelength.
     pub fn freq_limit(&self, lambda_min: f64) -> [f64; 2] {
         [self.max_uv / lambda_min, self.max_uv / lambda_min]
@@ -47,24 +55,36 @@ fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
         .acos()
 }
 
-/// Triangles of a scene mesh (positions, indices).
-fn mesh_triangles(path: &Path) -> Result<(Vec<[f32; 3]>, Vec<u32>)> {
-    if let Some(m) = sunbeam_scene::geometry::Mesh::builtin(path) {
+/// Triangles of a scene mesh: built-in here, files through `load`.
+fn mesh_triangles(
+    path: &Path,
+    load: &mut impl FnMut(&Path) -> Result<Triangles>,
+) -> Result<Triangles> {
+    if let Some(m) = crate::geometry::Mesh::builtin(path) {
         let m = m.map_err(Error::input)?;
         return Ok((m.positions, m.indices));
     }
-    let m = sunbeam_mesh::load_scene_mesh(path)?;
-    Ok((m.positions, m.indices))
+    load(path)
 }
 
-/// Bound a scene (see the module docs). `max_w` is the caller's own bound.
-pub fn bound_scene(path: &Path, max_w: f64) -> Result<SceneBound> {
+/// The reach of the scene in file `path` (see the module docs); `max_w` is
+/// the caller's own bound, `load` reads a mesh file's triangles.
+pub fn reach_of_file(
+    path: &Path,
+    max_w: f64,
+    load: impl FnMut(&Path) -> Result<Triangles>,
+) -> Result<Reach> {
     let scene = Scene::load(path)?;
-    bound(&scene, path, max_w)
+    reach(&scene, path, max_w, load)
 }
 
-/// [`bound_scene`] on a loaded scene.
-pub fn bound(scene: &Scene, path: &Path, max_w: f64) -> Result<SceneBound> {
+/// [`reach_of_file`] on a loaded scene (`path`: the scene's file, for depfiles and messages).
+pub fn reach(
+    scene: &Scene,
+    path: &Path,
+    max_w: f64,
+    mut load: impl FnMut(&Path) -> Result<Triangles>,
+) -> Result<Reach> {
     let mut inputs = vec![path.to_path_buf()];
     let vp = scene.camera.view_proj(scene.size[0], scene.size[1]);
     let eye = scene.camera.eye;
@@ -76,15 +96,14 @@ pub fn bound(scene: &Scene, path: &Path, max_w: f64) -> Result<SceneBound> {
     let mut theta_min = vec![std::f64::consts::PI; lights.len()];
     let (mut kept, mut culled) = (0usize, 0usize);
     for mi in &scene.meshes {
-        if !sunbeam_scene::geometry::is_builtin(&mi.mesh) {
+        if !crate::geometry::is_builtin(&mi.mesh) {
             inputs.push(mi.mesh.clone());
         }
-        let (pos, idx) = mesh_triangles(&mi.mesh).map_err(|e| e.context(path.display()))?;
+        let (pos, idx) =
+            mesh_triangles(&mi.mesh, &mut load).map_err(|e| e.context(path.display()))?;
         let clip: Vec<[f64; 4]> = pos
             .iter()
-            .map(|p| {
-                sunbeam_scene::camera::transform(&vp, [p[0] as f64, p[1] as f64, p[2] as f64, 1.0])
-            })
+            .map(|p| crate::camera::transform(&vp, [p[0] as f64, p[1] as f64, p[2] as f64, 1.0]))
             .collect();
         let dirs: Vec<Option<[f64; 3]>> = pos
             .iter()
@@ -168,7 +187,7 @@ pub fn bound(scene: &Scene, path: &Path, max_w: f64) -> Result<SceneBound> {
              so all directions are kept"
         ));
     }
-    Ok(SceneBound {
+    Ok(Reach {
         lambda: None,
         max_w: bw,
         max_uv,

@@ -1,4 +1,6 @@
-//! Reading primitives and walking the node hierarchy of a [`Document`].
+//! The glTF node walk: reading a mesh primitive's attributes and walking the
+//! default scene's node hierarchy of a [`Document`] into mesh instances with
+//! world transforms. (Not the render scene: that is the sunbeam-scene crate.)
 
 use crate::geom::{Mat4, V3};
 use crate::gltf::Document;

@@ -1,60 +1,59 @@
-//! Reading height fields and writing packs to files (atomic writes).
+//! Pack files: the one place that knows the containers. Reading dispatches on
+//! the content (KTX2 identifier or EXR magic, `sunbeam_common::magic`), writing
+//! on [`OutputKind`] (from the output name). A new container is a new
+//! submodule here plus a branch in [`Pack::from_bytes`] and [`write_pack`]
+//! (docs/dev/ARCHITECTURE.md).
 
-use crate::exr_io;
-use crate::ktx2;
+pub mod exr_io;
+pub mod ktx2;
+
 use crate::pack::Pack;
 use std::path::{Path, PathBuf};
+use sunbeam_common::magic;
 use sunbeam_common::output::{write_atomic, write_atomic_with};
 use sunbeam_common::{Error, Result};
-use sunbeam_field::HeightField;
 
-/// Options for reading a height field (uncalibrated images need a pixel size and z range).
-#[derive(Debug, Clone, Default)]
-pub struct InputOptions {
-    pub pixel_size: Option<(f64, f64)>,
-    pub z_range: Option<f64>,
-    pub channel: Option<String>,
+impl Pack {
+    /// Read a pack (KTX2 or EXR, detected from the content).
+    pub fn read(path: &Path) -> Result<Pack> {
+        let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, e))?;
+        if magic::is_exr(&bytes) {
+            return exr_io::read_path(path, &bytes);
+        }
+        Self::from_bytes(&bytes).map_err(|e| e.context(path.display()))
+    }
+
+    /// Parse a pack from bytes (KTX2 or single-file EXR).
+    pub fn from_bytes(bytes: &[u8]) -> Result<Pack> {
+        if magic::is_ktx2(bytes) {
+            ktx2::decode(bytes)
+        } else if magic::is_exr(bytes) {
+            exr_io::decode(bytes)
+        } else {
+            Err(Error::input("not a KTX2 or EXR pack"))
+        }
+    }
 }
 
-/// Read a height field from anything sunbeam-import reads (EXR/GSF height fields,
-/// AFM files, images with a pixel size and z range). Heights must be metres.
-pub fn read_height(path: &Path, o: &InputOptions) -> Result<HeightField> {
-    let ro = sunbeam_afm::ReadOptions {
-        format: None,
-        pixel_size: o.pixel_size,
-        z_range: o.z_range,
-        z_scale: None,
-    };
-    let chans = sunbeam_afm::read_file(path, &ro)?;
-    let ch = sunbeam_afm::select_channel(&chans, o.channel.as_deref())
-        .map_err(|e| e.context(path.display()))?;
-    if ch.z_unit != "m" {
-        return Err(Error::input_file(
-            path,
-            format!(
-                "channel '{}' has values in '{}', not metres: pick a height channel (--channel) or give --z-range for an image",
-                ch.name, ch.z_unit
-            ),
-        ));
+/// Whether a file is a pack: a KTX2 file, or an EXR whose header carries the
+/// manifest attribute. Reads at most the first 64 KiB.
+pub fn is_pack(path: &Path) -> Result<bool> {
+    use std::io::Read;
+    let mut f = std::fs::File::open(path)
+        .map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
+    let mut head = Vec::with_capacity(1 << 16);
+    f.by_ref()
+        .take(1 << 16)
+        .read_to_end(&mut head)
+        .map_err(|e| Error::input_file(path, format!("cannot read: {e}")))?;
+    if magic::is_ktx2(&head) {
+        return Ok(true);
     }
-    if ch.xy_unit != "m" {
-        return Err(Error::input_file(
-            path,
-            "the file records no lateral size in metres: give --pixel-size",
-        ));
+    if magic::is_exr(&head) {
+        let key = crate::manifest::MANIFEST_KEY.as_bytes();
+        return Ok(head.windows(key.len()).any(|w| w == key));
     }
-    let mut f = ch.field.clone();
-    if f.provenance.channel.is_empty() {
-        f.provenance.channel = ch.name.clone();
-    }
-    let bad = f.count_nonfinite();
-    if bad > 0 {
-        return Err(Error::input_file(
-            path,
-            format!("{bad} heights are NaN/Inf: fill them first (sunbeam-import --fill-nonfinite)"),
-        ));
-    }
-    Ok(f)
+    Ok(false)
 }
 
 /// Output container and layout.

@@ -7,9 +7,7 @@ use crate::pack::Pack;
 use sunbeam_common::{Error, Result};
 
 /// The 12-byte file identifier «KTX 20»\r\n\x1A\n.
-pub const IDENTIFIER: [u8; 12] = [
-    0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A,
-];
+pub const IDENTIFIER: [u8; 12] = sunbeam_common::magic::KTX2;
 /// VK_FORMAT_R32G32_SFLOAT.
 pub const VK_R32G32_SFLOAT: u32 = 103;
 /// VK_FORMAT_R16G16_SFLOAT.
