@@ -72,7 +72,7 @@ rule import
   deps = gcc
   description = import \${name}
 rule pack
-  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-pack \$in -o \${target} $(esc "$PACK_FLAGS") --depfile \${target}.d \$q
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-pack \$in -o \${target} --response $(esc "$PACK_FLAGS") --depfile \${target}.d \$q
   depfile = \${target}.d
   deps = gcc
   description = pack \${target}
@@ -131,7 +131,8 @@ EOF
       IFS=: read -r ext rule from tool <<<"$s"
       sep=.; [ "$rule" = pack ] || sep=-
       t="$OUT/$m$sep$ext"
-      echo "build $(path "$t"): $rule $o/$m.$from | $(path "$BIN/$tool")"
+      extra=; [ "$rule" = pack ] && extra=" | $o/$m.response.ktx2"
+      echo "build $(path "$t")$extra: $rule $o/$m.$from | $(path "$BIN/$tool")"
       echo "  target = $(esc "$t")"
       echo "  tidy = $(esc "$OUT/.$m$sep$ext").tmp.*"
     done
@@ -139,7 +140,7 @@ EOF
     echo "  target = $o/$m-scene.json"
     echo "  name = $m"
     echo "  tidy = $(esc "$OUT/.$m-scene.json").tmp.*"
-    echo "build $o/$m-frame.png: play $o/$m-scene.json | $o/$m.ktx2 $o/snake.glb $(path "$BIN/sunbeam-play")"
+    echo "build $o/$m-frame.png: play $o/$m-scene.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/snake.glb $(path "$BIN/sunbeam-play")"
     echo "  target = $(esc "$OUT/$m-frame.png")"
     echo "  tidy = $(esc "$OUT/.$m-frame.png").tmp.*"
     sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png"

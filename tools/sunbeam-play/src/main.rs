@@ -182,6 +182,9 @@ fn inputs(p: &Prepared, cli: &Cli) -> Vec<PathBuf> {
             v.push(m.mesh.clone());
         }
         v.extend(m.pack.iter().cloned());
+        // The default mode reads the response map beside the pack when it is there.
+        let side = m.pack.as_deref().map(sunbeam_render::response::sidecar);
+        v.extend(side.filter(|s| s.is_file()));
     }
     v.dedup();
     v
