@@ -11,6 +11,8 @@
 # (--mode table: the baseline, built at start-up) against it: CIEDE2000 over lit
 # pixels, and the player's start-up. One CSV row per size on stdout and in
 # OUT_DIR/realscale.csv. Needs a release build (cargo build --release --workspace).
+# Environment: RES (reference and frame size, default 128), PACK_FLAGS (e.g.
+# "--model tiled"), SUNBEAM_BIN (the folder of the binaries).
 set -euo pipefail
 out=${1:?usage: realscale.sh OUT_DIR [SIZE:PIXEL ...]}
 shift
@@ -28,7 +30,8 @@ for sp in "${sizes[@]}"; do
   n=${sp%%:*}; px=${sp#*:}
   d="$out/$n-$px"; mkdir -p "$d"
   "$bin/sunbeam-import" synthetic:xenopeltis --synthetic-size "$n" --synthetic-pixel "$px" -o "$d/h.exr" -q
-  pj=$("$bin/sunbeam-pack" "$d/h.exr" -o "$d/p.ktx2" --response --json -q)
+  # shellcheck disable=SC2086
+  pj=$("$bin/sunbeam-pack" "$d/h.exr" -o "$d/p.ktx2" --response --json -q ${PACK_FLAGS:-})
   cat > "$d/scene.json" <<JSON
 { "camera": { "eye": [0, 0, 1.6], "target": [0, 0, 0], "fov_y_deg": 35 },
   "lights": [ { "direction": [0.15, 0.1, 1], "intensity": 1 } ],
