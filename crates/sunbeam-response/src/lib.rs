@@ -10,9 +10,11 @@
 //! ([`build::build`]); the player only loads it.
 //!
 //! Files: KTX2 (a 3D texture, `VK_FORMAT_R16G16B16A16_SFLOAT`, the [`Info`] JSON
-//! under the key `sunbeam.response`), see [`ktx2`].
+//! under the key `sunbeam.response`), see [`ktx2`]; an OpenEXR atlas of the same
+//! texels for DCC tools, see [`exr`].
 
 pub mod build;
+pub mod exr;
 pub mod grid;
 pub mod ktx2;
 

@@ -144,3 +144,60 @@ fn ktx2_round_trip_and_bad_files() {
     b[n - 8..n - 6].copy_from_slice(&half::f16::NAN.to_bits().to_le_bytes());
     assert!(ktx2::decode(&b).is_err());
 }
+
+#[test]
+fn exr_atlas_holds_the_same_texels() {
+    use exr::prelude::*;
+    let pack = ridge_pack(Model::Window, 32, 40e-9);
+    let o = Options {
+        lambda_samples: 8,
+        grid: Some(Grid {
+            n_theta: 16,
+            n_rho: 8,
+            n_s: 4,
+            r0: 0.02,
+        }),
+        ..Default::default()
+    };
+    let map = build(&pack, &o);
+    let bytes = sunbeam_response::exr::encode(&map).unwrap();
+    assert_eq!(bytes, sunbeam_response::exr::encode(&map).unwrap());
+    // Read with the exr crate's generic reader (not our writer's code).
+    let img = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .unwrap();
+    let layer = &img.layer_data;
+    assert_eq!(layer.size, Vec2(16, 8 * 4));
+    assert!(layer
+        .attributes
+        .other
+        .contains_key(&Text::new_or_panic("sunbeam.response")));
+    let chan = |name: &str| -> Vec<f32> {
+        let c = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name == Text::new_or_panic(name))
+            .unwrap();
+        c.sample_data.values_as_f32().collect()
+    };
+    let (r, g, b) = (chan("R"), chan("G"), chan("B"));
+    for k in 0..4 {
+        for j in 0..8 {
+            for i in 0..16 {
+                let t = map.texel(i, j, k);
+                let p = (k * 8 + j) * 16 + i;
+                assert_eq!(
+                    [r[p] as f64, g[p] as f64, b[p] as f64],
+                    t,
+                    "texel {i} {j} {k}"
+                );
+            }
+        }
+    }
+}

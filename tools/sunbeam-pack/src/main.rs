@@ -96,6 +96,9 @@ struct Cli {
     /// Where to write the response map (implies --response).
     #[arg(long, value_name = "FILE.ktx2")]
     response_out: Option<PathBuf>,
+    /// Also write the response map as an OpenEXR atlas for DCC tools (implies --response).
+    #[arg(long, value_name = "FILE.exr")]
+    response_exr: Option<PathBuf>,
     /// Wavelength samples of the response map's colour integral.
     #[arg(long, default_value_t = sunbeam_response::build::DEFAULT_LAMBDA_SAMPLES)]
     response_lambda: usize,
@@ -285,10 +288,9 @@ fn run(cli: Cli) -> Result<()> {
     };
     let pack = build::run(fr, &plan, o.threads, &mut progress)?;
     let pack_secs = t0.elapsed().as_secs_f64();
-    let response_path = cli
-        .response_out
-        .clone()
-        .or_else(|| cli.response.then(|| sunbeam_response_path(&cli.output)));
+    let response_path = cli.response_out.clone().or_else(|| {
+        (cli.response || cli.response_exr.is_some()).then(|| sunbeam_response_path(&cli.output))
+    });
     let response = match &response_path {
         Some(_) => {
             let t = Instant::now();
@@ -307,6 +309,11 @@ fn run(cli: Cli) -> Result<()> {
         let bytes = sunbeam_response::ktx2::encode(r);
         sunbeam_common::output::write_atomic(rp, &bytes)?;
         files.push((rp.clone(), bytes.len() as u64));
+        if let Some(ep) = &cli.response_exr {
+            let bytes = sunbeam_response::exr::encode(r)?;
+            sunbeam_common::output::write_atomic(ep, &bytes)?;
+            files.push((ep.clone(), bytes.len() as u64));
+        }
     }
     let mut bytes: u64 = files.iter().map(|f| f.1).sum();
     if let Some(mp) = &cli.manifest {

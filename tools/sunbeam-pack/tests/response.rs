@@ -51,6 +51,8 @@ fn response_map_is_written_beside_the_pack() {
         "--response",
         "--response-lambda",
         "16",
+        "--response-exr",
+        d.join("skin.response.exr").to_str().unwrap(),
         "--depfile",
         dep.to_str().unwrap(),
         "--json",
@@ -69,6 +71,9 @@ fn response_map_is_written_beside_the_pack() {
     );
     let depfile = std::fs::read_to_string(&dep).unwrap();
     assert!(depfile.contains("skin.response.ktx2"), "{depfile}");
+    assert!(depfile.contains("skin.response.exr"), "{depfile}");
+    let exr = std::fs::read(d.join("skin.response.exr")).unwrap();
+    assert_eq!(exr, sunbeam_response::exr::encode(&map).unwrap());
     // Deterministic, whatever the thread count.
     let first = std::fs::read(&side).unwrap();
     let out2 = d.join("again.ktx2");
