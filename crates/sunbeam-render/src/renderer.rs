@@ -243,22 +243,8 @@ impl Renderer {
     ) -> Result<Renderer> {
         let device = &gpu.device;
         let mut warnings = Vec::new();
-        let samples = match settings.mode {
-            Mode::Thesis => Samples::stepped(380, 780, 5),
-            _ => Samples::uniform(settings.lambda_samples.max(1), cie::DEFAULT_RANGE_NM),
-        };
-        let spec: Vec<[f32; 4]> = samples
-            .0
-            .iter()
-            .map(|s| {
-                [
-                    s.weight[0] as f32,
-                    s.weight[1] as f32,
-                    s.weight[2] as f32,
-                    (1e-6 / s.lambda_m) as f32,
-                ]
-            })
-            .collect();
+        let samples = spectral_samples(settings);
+        let spec = spectrum_table(&samples);
         let lambda_min = samples
             .0
             .iter()
@@ -275,55 +261,7 @@ impl Renderer {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let storage_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let uniform_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let gl0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("globals"),
-            entries: &[uniform_entry(0), storage_entry(1)],
-        });
-        let gl1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("material"),
-            entries: &[
-                uniform_entry(0),
-                storage_entry(1),
-                storage_entry(2),
-                storage_entry(3),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D3,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
+        let [gl0, gl1] = bind_group_layouts(device);
         // Response maps: angle repeats, radius and s clamp, trilinear.
         let resp_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("response map"),
@@ -357,30 +295,7 @@ impl Renderer {
         let mut pack_bufs: Vec<(*const Pack, Arc<wgpu::Buffer>, usize)> = Vec::new();
         let mut meshes = Vec::new();
         for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
-            let mut verts: Vec<Vertex> = (0..mesh.positions.len())
-                .map(|i| Vertex {
-                    pos: mesh.positions[i],
-                    normal: mesh.normals[i],
-                    tangent: mesh.tangents[i],
-                })
-                .collect();
-            if verts.is_empty() {
-                verts.push(Vertex::zeroed());
-            }
-            let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("vertices"),
-                contents: bytemuck::cast_slice(&verts),
-                usage: wgpu::BufferUsages::VERTEX,
-            });
-            let ibuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("indices"),
-                contents: bytemuck::cast_slice(if mesh.indices.is_empty() {
-                    &[0u32][..]
-                } else {
-                    &mesh.indices
-                }),
-                usage: wgpu::BufferUsages::INDEX,
-            });
+            let (vbuf, ibuf) = mesh_buffers(device, mesh);
             let mut mu = MaterialU {
                 base: [
                     mat.base_color[0] as f32,
@@ -451,50 +366,7 @@ impl Renderer {
                             b
                         }
                     };
-                    let h = m.height_half_range_m;
-                    let t_max = 4.0 * std::f64::consts::PI * h / lambda_min;
-                    let tol = settings
-                        .term_tolerance
-                        .unwrap_or_else(|| {
-                            m.error.tolerance.unwrap_or(0.0).max(m.error.series_bound)
-                        })
-                        .max(1e-12);
-                    let (table, dt) = term_table(pack, t_max, tol);
-                    let w = m.kernel.taps as f64;
-                    mu.has_pack = 1;
-                    mu.basis = match m.basis {
-                        Basis::Chebyshev => 0,
-                        Basis::Taylor => 1,
-                    };
-                    mu.model = match m.model {
-                        Model::Window => 0,
-                        Model::Tiled => 1,
-                    };
-                    mu.taps = m.kernel.taps as u32;
-                    mu.crop_w = m.crop.width as u32;
-                    mu.crop_h = m.crop.height as u32;
-                    mu.kx = m.crop.kx as i32;
-                    mu.ky = m.crop.ky as i32;
-                    mu.terms = used as u32;
-                    mu.fixed_terms = if settings.mode == Mode::Thesis {
-                        THESIS_TERMS
-                    } else {
-                        0
-                    };
-                    mu.n_table = table.len() as u32;
-                    mu.bin_scale_um = [
-                        (m.bin_scale_m[0] * 1e6) as f32,
-                        (m.bin_scale_m[1] * 1e6) as f32,
-                    ];
-                    mu.half_range_um = (h * 1e6) as f32;
-                    mu.beta = m.kernel.beta as f32;
-                    mu.sigma_bins = [m.kernel.sigma_bins[0] as f32, m.kernel.sigma_bins[1] as f32];
-                    mu.kb_norm = if m.kernel.beta > 0.0 {
-                        (m.kernel.beta / (w * m.kernel.beta.sinh())) as f32
-                    } else {
-                        0.0
-                    };
-                    mu.table_dt = dt as f32;
+                    let (table, dt) = pack_uniforms(&mut mu, pack, used, settings, lambda_min);
                     if settings.mode == Mode::Default {
                         let path = p.scene.meshes.get(mi).and_then(|m| m.pack.as_deref());
                         let t0 = std::time::Instant::now();
@@ -625,64 +497,7 @@ impl Renderer {
             });
         }
 
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("diffraction.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("diffraction"),
-            bind_group_layouts: &[Some(&gl0), Some(&gl1)],
-            immediate_size: 0,
-        });
-        let vlayout = wgpu::VertexBufferLayout {
-            array_stride: std::mem::size_of::<Vertex>() as u64,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4],
-        };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("diffraction"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(vlayout)],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: Some(wgpu::Face::Back),
-                front_face: wgpu::FrontFace::Ccw,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState {
-                count: settings.msaa.max(1),
-                ..Default::default()
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(Error::internal(format!(
-                "shader/pipeline creation failed: {e}"
-            )));
-        }
+        let pipeline = render_pipeline(device, [&gl0, &gl1], format, settings.msaa)?;
         Ok(Renderer {
             pipeline,
             globals,
@@ -831,6 +646,240 @@ impl Renderer {
             rp.draw_indexed(0..m.count, 0, 0..1);
         }
     }
+}
+
+/// The pack's part of a material's uniforms (series, crop, kernel, per-|t| term
+/// table; docs/PACK_FORMAT.md "Evaluation"): the term table and its |t| step.
+fn pack_uniforms(
+    mu: &mut MaterialU,
+    pack: &Pack,
+    used: usize,
+    settings: &Settings,
+    lambda_min: f64,
+) -> (Vec<u32>, f64) {
+    let m = &pack.manifest;
+    let h = m.height_half_range_m;
+    let t_max = 4.0 * std::f64::consts::PI * h / lambda_min;
+    let tol = settings
+        .term_tolerance
+        .unwrap_or_else(|| m.error.tolerance.unwrap_or(0.0).max(m.error.series_bound))
+        .max(1e-12);
+    let (table, dt) = term_table(pack, t_max, tol);
+    let w = m.kernel.taps as f64;
+    mu.has_pack = 1;
+    mu.basis = match m.basis {
+        Basis::Chebyshev => 0,
+        Basis::Taylor => 1,
+    };
+    mu.model = match m.model {
+        Model::Window => 0,
+        Model::Tiled => 1,
+    };
+    mu.taps = m.kernel.taps as u32;
+    mu.crop_w = m.crop.width as u32;
+    mu.crop_h = m.crop.height as u32;
+    mu.kx = m.crop.kx as i32;
+    mu.ky = m.crop.ky as i32;
+    mu.terms = used as u32;
+    mu.fixed_terms = if settings.mode == Mode::Thesis {
+        THESIS_TERMS
+    } else {
+        0
+    };
+    mu.n_table = table.len() as u32;
+    mu.bin_scale_um = [
+        (m.bin_scale_m[0] * 1e6) as f32,
+        (m.bin_scale_m[1] * 1e6) as f32,
+    ];
+    mu.half_range_um = (h * 1e6) as f32;
+    mu.beta = m.kernel.beta as f32;
+    mu.sigma_bins = [m.kernel.sigma_bins[0] as f32, m.kernel.sigma_bins[1] as f32];
+    mu.kb_norm = if m.kernel.beta > 0.0 {
+        (m.kernel.beta / (w * m.kernel.beta.sinh())) as f32
+    } else {
+        0.0
+    };
+    mu.table_dt = dt as f32;
+    (table, dt)
+}
+
+/// Wavelength samples of a mode: the thesis' 5 nm steps, else `lambda_samples` midpoints.
+fn spectral_samples(settings: &Settings) -> Samples {
+    match settings.mode {
+        Mode::Thesis => Samples::stepped(380, 780, 5),
+        _ => Samples::uniform(settings.lambda_samples.max(1), cie::DEFAULT_RANGE_NM),
+    }
+}
+
+/// The spectrum buffer of the shader: XYZ weight and 1 / lambda in 1/um per sample.
+fn spectrum_table(samples: &Samples) -> Vec<[f32; 4]> {
+    samples
+        .0
+        .iter()
+        .map(|s| {
+            [
+                s.weight[0] as f32,
+                s.weight[1] as f32,
+                s.weight[2] as f32,
+                (1e-6 / s.lambda_m) as f32,
+            ]
+        })
+        .collect()
+}
+
+/// Bind group layouts: 0 = globals and spectrum, 1 = one material (uniforms,
+/// terms, term table, response table, response map and its sampler).
+fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 2] {
+    let storage_entry = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let uniform_entry = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let gl0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("globals"),
+        entries: &[uniform_entry(0), storage_entry(1)],
+    });
+    let gl1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("material"),
+        entries: &[
+            uniform_entry(0),
+            storage_entry(1),
+            storage_entry(2),
+            storage_entry(3),
+            wgpu::BindGroupLayoutEntry {
+                binding: 4,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D3,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 5,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ],
+    });
+    [gl0, gl1]
+}
+
+/// Vertex and index buffers of a mesh (one dummy element when empty).
+fn mesh_buffers(
+    device: &wgpu::Device,
+    mesh: &sunbeam_raster::Mesh,
+) -> (wgpu::Buffer, wgpu::Buffer) {
+    let mut verts: Vec<Vertex> = (0..mesh.positions.len())
+        .map(|i| Vertex {
+            pos: mesh.positions[i],
+            normal: mesh.normals[i],
+            tangent: mesh.tangents[i],
+        })
+        .collect();
+    if verts.is_empty() {
+        verts.push(Vertex::zeroed());
+    }
+    let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("vertices"),
+        contents: bytemuck::cast_slice(&verts),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let ibuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("indices"),
+        contents: bytemuck::cast_slice(if mesh.indices.is_empty() {
+            &[0u32][..]
+        } else {
+            &mesh.indices
+        }),
+        usage: wgpu::BufferUsages::INDEX,
+    });
+    (vbuf, ibuf)
+}
+
+/// The pipeline of shaders/diffraction.wgsl for a colour format and sample count.
+fn render_pipeline(
+    device: &wgpu::Device,
+    layouts: [&wgpu::BindGroupLayout; 2],
+    format: wgpu::TextureFormat,
+    msaa: u32,
+) -> Result<wgpu::RenderPipeline> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("diffraction.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("diffraction"),
+        bind_group_layouts: &[Some(layouts[0]), Some(layouts[1])],
+        immediate_size: 0,
+    });
+    let vlayout = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4],
+    };
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("diffraction"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(vlayout)],
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: Some(wgpu::Face::Back),
+            front_face: wgpu::FrontFace::Ccw,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState {
+            count: msaa.max(1),
+            ..Default::default()
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(Error::internal(format!(
+            "shader/pipeline creation failed: {e}"
+        )));
+    }
+    Ok(pipeline)
 }
 
 /// A 3D RGBA16F texture holding a response map.
