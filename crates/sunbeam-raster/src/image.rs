@@ -163,22 +163,5 @@ pub fn compare(a: &Image, b: &Image) -> Result<ColourDiff> {
         .zip(&b.rgb)
         .map(|(p, q)| colour::ciede2000_xyz(display_to_xyz(*p), display_to_xyz(*q)))
         .collect();
-    let n = d.len();
-    if n == 0 {
-        return Ok(ColourDiff {
-            mean: 0.0,
-            p99: 0.0,
-            max: 0.0,
-            pixels: 0,
-        });
-    }
-    let mean = d.iter().sum::<f64>() / n as f64;
-    d.sort_by(|x, y| x.total_cmp(y));
-    let p99 = d[((n as f64 * 0.99).ceil() as usize).clamp(1, n) - 1];
-    Ok(ColourDiff {
-        mean,
-        p99,
-        max: d[n - 1],
-        pixels: n,
-    })
+    Ok(crate::linear::stats(&mut d))
 }
