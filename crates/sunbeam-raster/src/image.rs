@@ -5,6 +5,8 @@ use std::path::Path;
 use sunbeam_common::{Error, Result};
 use sunbeam_optics::colour;
 
+use crate::diff::ColourDiff;
+
 /// An image of display values: sRGB-encoded, each channel in [0, 1], row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Image {
@@ -125,25 +127,6 @@ impl Image {
     }
 }
 
-/// CIEDE2000 statistics between two images of the same size.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ColourDiff {
-    pub mean: f64,
-    pub p99: f64,
-    pub max: f64,
-    pub pixels: usize,
-}
-
-impl std::fmt::Display for ColourDiff {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "CIEDE2000 mean {:.3} p99 {:.3} max {:.3} over {} px",
-            self.mean, self.p99, self.max, self.pixels
-        )
-    }
-}
-
 /// Decode a display pixel to XYZ (sRGB EOTF, then the sRGB matrix).
 pub fn display_to_xyz(p: [f32; 3]) -> [f64; 3] {
     colour::linear_srgb_to_xyz(p.map(|v| colour::srgb_eotf(v as f64)))
@@ -163,5 +146,5 @@ pub fn compare(a: &Image, b: &Image) -> Result<ColourDiff> {
         .zip(&b.rgb)
         .map(|(p, q)| colour::ciede2000_xyz(display_to_xyz(*p), display_to_xyz(*q)))
         .collect();
-    Ok(crate::linear::stats(&mut d))
+    Ok(crate::diff::stats(&mut d))
 }

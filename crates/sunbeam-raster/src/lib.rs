@@ -14,6 +14,7 @@
 //!
 //! `render(&Scene)` is what `sunbeam-eval render` calls.
 
+pub mod diff;
 pub mod fixtures;
 pub mod image;
 pub mod linear;
@@ -21,7 +22,8 @@ pub mod raster;
 pub mod shade;
 pub mod spectral;
 
-pub use image::{compare, ColourDiff, Image};
+pub use diff::ColourDiff;
+pub use image::{compare, Image};
 pub use linear::{compare_linear, LinearImage};
 pub use sunbeam_scene::geometry::Mesh;
 

@@ -12,7 +12,7 @@ use std::path::Path;
 use sunbeam_common::{Error, Result};
 use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
 
-use crate::image::ColourDiff;
+use crate::diff::{stats, ColourDiff};
 use crate::Image;
 
 /// Linear sRGB values (exposure applied), row 0 at the top.
@@ -162,28 +162,6 @@ pub fn compare_linear(a: &LinearImage, reference: &LinearImage) -> Result<Colour
         })
         .collect();
     Ok(stats(&mut d))
-}
-
-/// Mean, 99th percentile and max of a list of differences.
-pub fn stats(d: &mut [f64]) -> ColourDiff {
-    let n = d.len();
-    if n == 0 {
-        return ColourDiff {
-            mean: 0.0,
-            p99: 0.0,
-            max: 0.0,
-            pixels: 0,
-        };
-    }
-    let mean = d.iter().sum::<f64>() / n as f64;
-    d.sort_by(|x, y| x.total_cmp(y));
-    let p99 = d[((n as f64 * 0.99).ceil() as usize).clamp(1, n) - 1];
-    ColourDiff {
-        mean,
-        p99,
-        max: d[n - 1],
-        pixels: n,
-    }
 }
 
 #[cfg(test)]
