@@ -579,7 +579,12 @@ impl Renderer {
             curve: self.settings.curve,
         };
         let mut e = colour::display_encode(state.background, &tm);
-        if self.format.is_srgb() {
+        if self.format == OFFSCREEN_FORMAT {
+            // Offscreen targets hold linear light times the exposure (the shader's
+            // output 2); the display transform follows on the CPU.
+            let k = state.exposure.exp2();
+            e = state.background.map(|v| (v * k).max(0.0));
+        } else if self.format.is_srgb() {
             e = e.map(colour::srgb_eotf);
         }
         wgpu::Color {

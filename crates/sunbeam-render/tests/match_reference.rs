@@ -225,3 +225,21 @@ fn response_map_5um_patch_matches_antialiased_reference() {
 fn response_map_20um_patch_matches_antialiased_reference() {
     response_map_at_scale("map-20um", 640, 31e-9);
 }
+
+/// The background goes through the display transform once: a mesh-free frame
+/// of a grey background equals the CPU reference (regression: the offscreen
+/// target is linear, and its clear colour was display-encoded twice).
+#[test]
+fn background_matches_reference() {
+    let Some(gpu) = gpu() else { return };
+    let (mut scene, mesh) = fixtures::quad_scene([16, 16]);
+    scene.background = [0.004, 0.004, 0.005];
+    scene.exposure = 1.5;
+    scene.camera.eye = [0.0, 0.0, -5.0]; // behind the quad: back face culled, background only
+    let p = fixtures::prepared(scene, mesh, None);
+    let frame: Image =
+        sunbeam_render::render_headless(&gpu, &p, &Settings::default(), None, 1).unwrap();
+    let reference = sunbeam_raster::render_prepared(&p, &Options::default());
+    let d = sunbeam_raster::compare(&frame, &reference).unwrap();
+    assert!(d.max < 0.5, "background: {d}");
+}
