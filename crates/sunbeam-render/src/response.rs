@@ -5,20 +5,14 @@
 //! and was built from the same pack (the embedded manifests are equal); else it
 //! builds the map itself, which takes seconds for large packs, and says so.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use sunbeam_common::Result;
 use sunbeam_pack::Pack;
 use sunbeam_response::{ktx2, Response};
 
 /// `dir/NAME.response.ktx2` for a pack `dir/NAME.ext`.
-pub fn sidecar(pack: &Path) -> PathBuf {
-    let stem = pack
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    pack.with_file_name(format!("{stem}.response.ktx2"))
-}
+pub use sunbeam_response::sidecar_path as sidecar;
 
 /// The map of `pack` (read from `path`'s sidecar, or built), and a note for the
 /// user when it had to be built.

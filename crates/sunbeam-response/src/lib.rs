@@ -49,6 +49,16 @@ pub struct Info {
     pub pack: Manifest,
 }
 
+/// Where the map of a pack lives: `dir/NAME.response.ktx2` for `dir/NAME.ext`
+/// (what `sunbeam-pack --response` writes and the player looks for).
+pub fn sidecar_path(pack: &std::path::Path) -> std::path::PathBuf {
+    let stem = pack
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    pack.with_file_name(format!("{stem}.response.ktx2"))
+}
+
 /// A response map in memory: `data` holds f16 bits, RGBA, texel
 /// `(i, j, k)` (angle, radius, s) at `4 * ((k * n_rho + j) * n_theta + i)`.
 #[derive(Debug, Clone, PartialEq)]

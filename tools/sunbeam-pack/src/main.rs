@@ -123,15 +123,6 @@ fn main() {
     sunbeam_common::cli::main(TOOL, run)
 }
 
-/// `NAME.response.ktx2` beside the pack `NAME.ktx2` / `NAME.exr` (what the player looks for).
-fn sunbeam_response_path(pack: &std::path::Path) -> PathBuf {
-    let stem = pack
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    pack.with_file_name(format!("{stem}.response.ktx2"))
-}
-
 /// A byte count with an optional KiB/MiB/GiB suffix.
 fn parse_bytes(s: &str) -> Result<usize> {
     let t = s.trim();
@@ -289,7 +280,8 @@ fn run(cli: Cli) -> Result<()> {
     let pack = build::run(fr, &plan, o.threads, &mut progress)?;
     let pack_secs = t0.elapsed().as_secs_f64();
     let response_path = cli.response_out.clone().or_else(|| {
-        (cli.response || cli.response_exr.is_some()).then(|| sunbeam_response_path(&cli.output))
+        (cli.response || cli.response_exr.is_some())
+            .then(|| sunbeam_response::sidecar_path(&cli.output))
     });
     let response = match &response_path {
         Some(_) => {
