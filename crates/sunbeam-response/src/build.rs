@@ -3,7 +3,8 @@
 //! coefficients, kernel taps and model), summed with the colour weights.
 //!
 //! Arranged so that each (texel column, wavelength) interpolates the N terms
-//! once (Kaiser-Bessel or Gaussian taps, PACK_FORMAT.md) and then evaluates
+//! once (Kaiser-Bessel or Gaussian taps, PACK_FORMAT.md), for the column half
+//! a turn away too (the terms are Hermitian, see [`build`]), and then evaluates
 //! every `w` of the column from those N complex values: `t` changes with `w`
 //! but the frequency does not. The coefficients `c_n(t)` depend only on the
 //! radius row, the wavelength and `s`, so they are tabulated per row. Rows run
@@ -182,152 +183,78 @@ fn axpy(y: &mut [f32], a: f32, x: &[f32]) {
     }
 }
 
-/// Dot product with eight partial sums (so that it vectorises; fixed order, so
-/// the result does not depend on the machine's thread count).
-#[inline]
-fn dot(a: &[f32], b: &[f32]) -> f32 {
-    let mut acc = [0.0f32; 8];
-    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for k in 0..8 {
-            acc[k] += x[k] * y[k];
+/// `|A(f)|^2` (into `p`) and `|A(-f)|^2` (into `q`) for every `s` of a
+/// column at once: `cl` holds the coefficients term-major (`cl[n ns + k]`),
+/// so each term is one `axpy` over the column, which vectorises. The four
+/// half sums are explained at [`build`].
+struct Powers {
+    ge: Vec<f32>,
+    go: Vec<f32>,
+    he: Vec<f32>,
+    ho: Vec<f32>,
+}
+
+impl Powers {
+    fn new(ns: usize) -> Powers {
+        Powers {
+            ge: vec![0.0; ns],
+            go: vec![0.0; ns],
+            he: vec![0.0; ns],
+            ho: vec![0.0; ns],
         }
     }
-    let mut s = 0.0;
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
+
+    fn eval(&mut self, cl: &[f32], g: &[f32], h: &[f32], ne: usize) {
+        let ns = self.ge.len();
+        for v in [&mut self.ge, &mut self.go, &mut self.he, &mut self.ho] {
+            v.iter_mut().for_each(|x| *x = 0.0);
+        }
+        for (n, c) in cl.chunks_exact(ns).enumerate() {
+            let (gs, hs) = if n < ne {
+                (&mut self.ge, &mut self.he)
+            } else {
+                (&mut self.go, &mut self.ho)
+            };
+            axpy(gs, g[n], c);
+            axpy(hs, h[n], c);
+        }
     }
-    acc.iter().sum::<f32>() + s
+
+    /// `(|A(f)|^2, |A(-f)|^2)` of row `k` after [`Powers::eval`].
+    #[inline]
+    fn at(&self, k: usize) -> (f32, f32) {
+        let (ge, go, he, ho) = (self.ge[k], self.go[k], self.he[k], self.ho[k]);
+        let (a, b) = (ge + go, he + ho);
+        let (am, bm) = (ge - go, ho - he);
+        (a * a + b * b, am * am + bm * bm)
+    }
 }
 
 /// Build the response map of `pack`.
+///
+/// Angles come in pairs: `theta + pi` samples `-f` where `theta` samples `f`,
+/// and the terms of a real height field are Hermitian, `F_n(-f) = conj F_n(f)`
+/// (the crop and the kernel are symmetric, so the taps mirror too). With the
+/// sums split by the parity of `n` (`G_e, G_o, H_e, H_o` below), `A(f) =
+/// (G_e + G_o) + i (H_e + H_o)` and `A(-f) = (G_e - G_o) + i (H_o - H_e)`: one
+/// interpolation and one set of dot products give both texels, half the work.
 pub fn build(pack: &Pack, o: &Options) -> Response {
     let m = &pack.manifest;
     let g = o.grid.unwrap_or_else(|| auto_grid(pack, o.budget_bytes));
-    let nt = m.terms;
-    let (cw, ch) = (m.crop.width, m.crop.height);
-    // Terms tap-major (the N values of one texel contiguous), rearranged so that
-    // c_n F_n = i^n a_n F_n becomes two real dot products: A = a.G + i a.H with
-    // G_n = Re F_n, H_n = Im F_n for even n and G_n = -Im F_n, H_n = Re F_n for odd n.
-    let mut tg = vec![0.0f32; cw * ch * nt];
-    let mut th_ = vec![0.0f32; cw * ch * nt];
-    for n in 0..nt {
-        for ty in 0..ch {
-            for tx in 0..cw {
-                let [re, im] = pack.texel(n, tx, ty);
-                let o = (ty * cw + tx) * nt + n;
-                (tg[o], th_[o]) = if n % 2 == 0 { (re, im) } else { (-im, re) };
-            }
-        }
-    }
     let lw = wavelength_weights(o.lambda_samples);
-    let h = m.height_half_range_m;
-    let ntaps = m.kernel.taps;
-    let kb = KbTable::new(ntaps, m.kernel.beta);
-    let rows: Vec<Vec<f32>> = (0..g.n_rho)
-        .into_par_iter()
-        .map(|j| {
-            let r = g.r_at(j);
-            let wmax = (4.0 - r * r).max(0.0).sqrt();
-            // c_n(t) = i^n a_n with a_n real (both bases), for every (wavelength, s).
-            let mut coef = vec![0.0f32; lw.len() * g.n_s * nt];
-            for (l, (lambda, _)) in lw.iter().enumerate() {
-                for k in 0..g.n_s {
-                    let w = -g.s_at(k) * wmax;
-                    let t = std::f64::consts::TAU / lambda * w * h;
-                    let c = series::coefficients_f64(m.basis, t, nt);
-                    let base = (l * g.n_s + k) * nt;
-                    for (n, cn) in c.iter().enumerate() {
-                        coef[base + n] = if n % 2 == 0 { cn[0] } else { cn[1] } as f32;
-                    }
-                }
-            }
-            let mut out = vec![0.0f32; g.n_theta * g.n_s * 3];
-            let (mut ix, mut iy) = (vec![0usize; ntaps], vec![0usize; ntaps]);
-            let (mut wx, mut wy) = (vec![0.0f32; ntaps], vec![0.0f32; ntaps]);
-            let (mut gr, mut hi) = (vec![0.0f32; nt], vec![0.0f32; nt]);
-            let mut rs = vec![0.0f32; g.n_s];
-            for i in 0..g.n_theta {
-                let th = g.theta_at(i);
-                let (cu, su) = (r * th.cos(), r * th.sin());
-                for (l, (lambda, wt)) in lw.iter().enumerate() {
-                    let kx = -cu / lambda * m.bin_scale_m[0];
-                    let ky = -su / lambda * m.bin_scale_m[1];
-                    if !taps(pack, &kb, kx, 0, &mut ix, &mut wx)
-                        || !taps(pack, &kb, ky, 1, &mut iy, &mut wy)
-                    {
-                        continue;
-                    }
-                    let cl = &coef[l * g.n_s * nt..(l + 1) * g.n_s * nt];
-                    match m.model {
-                        Model::Window => {
-                            gr.iter_mut().for_each(|v| *v = 0.0);
-                            hi.iter_mut().for_each(|v| *v = 0.0);
-                            for (a, &yy) in iy.iter().enumerate() {
-                                if wy[a] == 0.0 {
-                                    continue;
-                                }
-                                for (b, &xx) in ix.iter().enumerate() {
-                                    let wgt = wy[a] * wx[b];
-                                    if wgt == 0.0 {
-                                        continue;
-                                    }
-                                    let o = (yy * cw + xx) * nt;
-                                    axpy(&mut gr, wgt, &tg[o..o + nt]);
-                                    axpy(&mut hi, wgt, &th_[o..o + nt]);
-                                }
-                            }
-                            for (k, rk) in rs.iter_mut().enumerate() {
-                                let c = &cl[k * nt..(k + 1) * nt];
-                                let (are, aim) = (dot(c, &gr), dot(c, &hi));
-                                *rk = are * are + aim * aim;
-                            }
-                        }
-                        Model::Tiled => {
-                            rs.iter_mut().for_each(|v| *v = 0.0);
-                            for (a, &yy) in iy.iter().enumerate() {
-                                for (b, &xx) in ix.iter().enumerate() {
-                                    let wgt = wy[a] * wx[b];
-                                    if wgt == 0.0 {
-                                        continue;
-                                    }
-                                    let o = (yy * cw + xx) * nt;
-                                    let (sg, sh) = (&tg[o..o + nt], &th_[o..o + nt]);
-                                    for (k, rk) in rs.iter_mut().enumerate() {
-                                        let c = &cl[k * nt..(k + 1) * nt];
-                                        let (are, aim) = (dot(c, sg), dot(c, sh));
-                                        *rk += wgt * (are * are + aim * aim);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    let wt = wt.map(|v| v as f32);
-                    for (k, rk) in rs.iter().enumerate() {
-                        let o = (k * g.n_theta + i) * 3;
-                        out[o] += rk * wt[0];
-                        out[o + 1] += rk * wt[1];
-                        out[o + 2] += rk * wt[2];
-                    }
-                }
-            }
-            out
+    let terms = Terms::new(pack);
+    let coef = coefficients(pack, &g, &lw, &terms);
+    let xyz = match m.model {
+        Model::Window => window_by_rays(pack, &g, &lw, &terms, &coef),
+        Model::Tiled => tiled_by_rows(pack, &g, &lw, &terms, &coef),
+    };
+    let data = xyz
+        .chunks_exact(3)
+        .flat_map(|c| {
+            let h = |v: f32| half::f16::from_f32(v.max(0.0)).to_bits();
+            [h(c[0]), h(c[1]), h(c[2]), half::f16::ONE.to_bits()]
         })
         .collect();
-    let mut data = vec![0u16; g.texels() * 4];
-    for (j, row) in rows.iter().enumerate() {
-        for k in 0..g.n_s {
-            for i in 0..g.n_theta {
-                let src = (k * g.n_theta + i) * 3;
-                let dst = ((k * g.n_rho + j) * g.n_theta + i) * 4;
-                for c in 0..3 {
-                    data[dst + c] = half::f16::from_f32(row[src + c].max(0.0)).to_bits();
-                }
-                data[dst + 3] = half::f16::ONE.to_bits();
-            }
-        }
-    }
     Response {
         info: Info {
             format: FORMAT.to_string(),
@@ -342,4 +269,320 @@ pub fn build(pack: &Pack, o: &Options) -> Response {
         },
         data,
     }
+}
+
+/// The pack's terms tap-major (the N values of one texel contiguous, even `n`
+/// first), rearranged so that `c_n F_n = i^n a_n F_n` becomes two real dot
+/// products: `A = a.G + i a.H` with `G_n = Re F_n, H_n = Im F_n` for even `n`
+/// and `G_n = -Im F_n, H_n = Re F_n` for odd `n`.
+struct Terms {
+    g: Vec<f32>,
+    h: Vec<f32>,
+    /// Number of terms, and of even ones.
+    nt: usize,
+    ne: usize,
+}
+
+impl Terms {
+    fn new(pack: &Pack) -> Terms {
+        let m = &pack.manifest;
+        let (nt, cw, ch) = (m.terms, m.crop.width, m.crop.height);
+        let ne = nt.div_ceil(2);
+        let (mut g, mut h) = (vec![0.0f32; cw * ch * nt], vec![0.0f32; cw * ch * nt]);
+        for n in 0..nt {
+            for ty in 0..ch {
+                for tx in 0..cw {
+                    let [re, im] = pack.texel(n, tx, ty);
+                    let o = (ty * cw + tx) * nt + Self::slot(n, ne);
+                    (g[o], h[o]) = if n % 2 == 0 { (re, im) } else { (-im, re) };
+                }
+            }
+        }
+        Terms { g, h, nt, ne }
+    }
+
+    fn slot(n: usize, ne: usize) -> usize {
+        if n.is_multiple_of(2) {
+            n / 2
+        } else {
+            ne + n / 2
+        }
+    }
+
+    /// `G` and `H` interpolated at bin coordinates `(kx, ky)` (zero outside the crop).
+    #[allow(clippy::too_many_arguments)]
+    fn interpolate(
+        &self,
+        pack: &Pack,
+        kb: &KbTable,
+        (kx, ky): (f64, f64),
+        t: &mut TapBuf,
+        gr: &mut [f32],
+        hi: &mut [f32],
+    ) {
+        gr.iter_mut().for_each(|v| *v = 0.0);
+        hi.iter_mut().for_each(|v| *v = 0.0);
+        if !taps(pack, kb, kx, 0, &mut t.ix, &mut t.wx)
+            || !taps(pack, kb, ky, 1, &mut t.iy, &mut t.wy)
+        {
+            return;
+        }
+        let (nt, cw) = (self.nt, pack.manifest.crop.width);
+        for (a, &yy) in t.iy.iter().enumerate() {
+            if t.wy[a] == 0.0 {
+                continue;
+            }
+            for (b, &xx) in t.ix.iter().enumerate() {
+                let wgt = t.wy[a] * t.wx[b];
+                if wgt == 0.0 {
+                    continue;
+                }
+                let o = (yy * cw + xx) * nt;
+                axpy(gr, wgt, &self.g[o..o + nt]);
+                axpy(hi, wgt, &self.h[o..o + nt]);
+            }
+        }
+    }
+}
+
+/// Scratch for one point's taps.
+struct TapBuf {
+    ix: Vec<usize>,
+    iy: Vec<usize>,
+    wx: Vec<f32>,
+    wy: Vec<f32>,
+}
+
+impl TapBuf {
+    fn new(n: usize) -> TapBuf {
+        TapBuf {
+            ix: vec![0; n],
+            iy: vec![0; n],
+            wx: vec![0.0; n],
+            wy: vec![0.0; n],
+        }
+    }
+}
+
+/// `c_n(t) = i^n a_n` (`a_n` real in both bases) for every (radius row,
+/// wavelength, `s`), terms in [`Terms`]' order: `[j][l][n][k]`.
+fn coefficients(pack: &Pack, g: &Grid, lw: &[(f64, [f64; 3])], terms: &Terms) -> Vec<f32> {
+    let m = &pack.manifest;
+    let (nt, ne) = (terms.nt, terms.ne);
+    (0..g.n_rho)
+        .into_par_iter()
+        .flat_map_iter(|j| {
+            let r = g.r_at(j);
+            let wmax = (4.0 - r * r).max(0.0).sqrt();
+            let mut coef = vec![0.0f32; lw.len() * g.n_s * nt];
+            for (l, (lambda, _)) in lw.iter().enumerate() {
+                for k in 0..g.n_s {
+                    let w = -g.s_at(k) * wmax;
+                    let t = std::f64::consts::TAU / lambda * w * m.height_half_range_m;
+                    let c = series::coefficients_f64(m.basis, t, nt);
+                    for (n, cn) in c.iter().enumerate() {
+                        coef[(l * nt + Terms::slot(n, ne)) * g.n_s + k] =
+                            if n % 2 == 0 { cn[0] } else { cn[1] } as f32;
+                    }
+                }
+            }
+            coef
+        })
+        .collect()
+}
+
+/// Ray samples per bin along a ray: the window's lobes are about a bin wide, and
+/// four-point Lagrange interpolation at 1/8 bin keeps the ray's error below
+/// the map's f16 rounding (tests/build.rs checks the map against the pack's
+/// own evaluator at texel centres).
+const RAY_SAMPLES_PER_BIN: f64 = 8.0;
+
+/// The window model, one angle pair at a time. Every texel of angle `theta`
+/// samples the terms at `f = -q (cos theta, sin theta)` with `q = r / lambda`:
+/// one ray of the frequency plane. So the terms are interpolated (Kaiser-Bessel,
+/// as the pack defines them) once at fine steps along the ray, and every
+/// (radius, wavelength) pair reads that ray with a four-point Lagrange
+/// interpolation: 36 taps per point become 4.
+fn window_by_rays(
+    pack: &Pack,
+    g: &Grid,
+    lw: &[(f64, [f64; 3])],
+    terms: &Terms,
+    coef: &[f32],
+) -> Vec<f32> {
+    let m = &pack.manifest;
+    let (nt, ne, ns, nl) = (terms.nt, terms.ne, g.n_s, lw.len());
+    let kb = KbTable::new(m.kernel.taps, m.kernel.beta);
+    let paired = g.n_theta.is_multiple_of(2);
+    let n_direct = if paired { g.n_theta / 2 } else { g.n_theta };
+    let lambda_min = lw.iter().map(|l| l.0).fold(f64::INFINITY, f64::min);
+    let cols: Vec<(Vec<f32>, Vec<f32>)> = (0..n_direct)
+        .into_par_iter()
+        .map(|i| {
+            let th = g.theta_at(i);
+            // Bin coordinates per unit of q along this ray.
+            let a = (-th.cos() * m.bin_scale_m[0], -th.sin() * m.bin_scale_m[1]);
+            let len = a.0.hypot(a.1).max(1e-30);
+            let dq = 1.0 / (RAY_SAMPLES_PER_BIN * len);
+            let n_q = (2.0 / lambda_min / dq).ceil() as usize + 4;
+            // Samples at q = (p - 1) dq, p = 0..n_q (one before zero for the stencil).
+            let mut ray_g = vec![0.0f32; n_q * nt];
+            let mut ray_h = vec![0.0f32; n_q * nt];
+            let mut tb = TapBuf::new(m.kernel.taps);
+            for p in 0..n_q {
+                let q = (p as f64 - 1.0) * dq;
+                let (gs, hs) = (
+                    &mut ray_g[p * nt..(p + 1) * nt],
+                    &mut ray_h[p * nt..(p + 1) * nt],
+                );
+                terms.interpolate(pack, &kb, (a.0 * q, a.1 * q), &mut tb, gs, hs);
+            }
+            let mut col = vec![0.0f32; g.n_rho * ns * 3];
+            let mut col_m = vec![0.0f32; if paired { g.n_rho * ns * 3 } else { 0 }];
+            let (mut gr, mut hi) = (vec![0.0f32; nt], vec![0.0f32; nt]);
+            let mut pw = Powers::new(ns);
+            for j in 0..g.n_rho {
+                let r = g.r_at(j);
+                for (l, (lambda, wt)) in lw.iter().enumerate() {
+                    let x = r / lambda / dq + 1.0;
+                    let p0 = (x.floor() as usize).max(1);
+                    if p0 + 2 >= n_q {
+                        continue;
+                    }
+                    let f = (x - p0 as f64) as f32;
+                    let lag = [
+                        -f * (f - 1.0) * (f - 2.0) / 6.0,
+                        (f + 1.0) * (f - 1.0) * (f - 2.0) / 2.0,
+                        -(f + 1.0) * f * (f - 2.0) / 2.0,
+                        (f + 1.0) * f * (f - 1.0) / 6.0,
+                    ];
+                    gr.iter_mut().for_each(|v| *v = 0.0);
+                    hi.iter_mut().for_each(|v| *v = 0.0);
+                    for (d, &wv) in lag.iter().enumerate() {
+                        let o = (p0 - 1 + d) * nt;
+                        axpy(&mut gr, wv, &ray_g[o..o + nt]);
+                        axpy(&mut hi, wv, &ray_h[o..o + nt]);
+                    }
+                    let cl = &coef[(j * nl + l) * ns * nt..(j * nl + l + 1) * ns * nt];
+                    let wt = wt.map(|v| v as f32);
+                    pw.eval(cl, &gr, &hi, ne);
+                    for k in 0..ns {
+                        let (p, q) = pw.at(k);
+                        let o = (j * ns + k) * 3;
+                        for c in 0..3 {
+                            col[o + c] += p * wt[c];
+                        }
+                        if paired {
+                            for c in 0..3 {
+                                col_m[o + c] += q * wt[c];
+                            }
+                        }
+                    }
+                }
+            }
+            (col, col_m)
+        })
+        .collect();
+    let mut xyz = vec![0.0f32; g.texels() * 3];
+    for (i, (col, col_m)) in cols.iter().enumerate() {
+        for j in 0..g.n_rho {
+            for k in 0..ns {
+                let src = (j * ns + k) * 3;
+                let at = |i: usize| ((k * g.n_rho + j) * g.n_theta + i) * 3;
+                xyz[at(i)..at(i) + 3].copy_from_slice(&col[src..src + 3]);
+                if paired {
+                    xyz[at(i + n_direct)..at(i + n_direct) + 3]
+                        .copy_from_slice(&col_m[src..src + 3]);
+                }
+            }
+        }
+    }
+    xyz
+}
+
+/// The tiled model (a Gaussian-weighted sum of per-bin powers, not an
+/// interpolated amplitude), one radius row at a time, each (texel, wavelength)
+/// from its own taps.
+fn tiled_by_rows(
+    pack: &Pack,
+    g: &Grid,
+    lw: &[(f64, [f64; 3])],
+    terms: &Terms,
+    coef: &[f32],
+) -> Vec<f32> {
+    let m = &pack.manifest;
+    let (nt, ne, ns, nl) = (terms.nt, terms.ne, g.n_s, lw.len());
+    let cw = m.crop.width;
+    let kb = KbTable::new(m.kernel.taps, m.kernel.beta);
+    let paired = g.n_theta.is_multiple_of(2);
+    let n_direct = if paired { g.n_theta / 2 } else { g.n_theta };
+    let rows: Vec<Vec<f32>> = (0..g.n_rho)
+        .into_par_iter()
+        .map(|j| {
+            let r = g.r_at(j);
+            let mut out = vec![0.0f32; g.n_theta * ns * 3];
+            let mut tb = TapBuf::new(m.kernel.taps);
+            let (mut rs, mut rm) = (vec![0.0f32; ns], vec![0.0f32; ns]);
+            let mut pw = Powers::new(ns);
+            for i in 0..n_direct {
+                let th = g.theta_at(i);
+                let (cu, su) = (r * th.cos(), r * th.sin());
+                for (l, (lambda, wt)) in lw.iter().enumerate() {
+                    let kx = -cu / lambda * m.bin_scale_m[0];
+                    let ky = -su / lambda * m.bin_scale_m[1];
+                    if !taps(pack, &kb, kx, 0, &mut tb.ix, &mut tb.wx)
+                        || !taps(pack, &kb, ky, 1, &mut tb.iy, &mut tb.wy)
+                    {
+                        continue;
+                    }
+                    let cl = &coef[(j * nl + l) * ns * nt..(j * nl + l + 1) * ns * nt];
+                    rs.iter_mut().for_each(|v| *v = 0.0);
+                    rm.iter_mut().for_each(|v| *v = 0.0);
+                    for (a, &yy) in tb.iy.iter().enumerate() {
+                        for (b, &xx) in tb.ix.iter().enumerate() {
+                            let wgt = tb.wy[a] * tb.wx[b];
+                            if wgt == 0.0 {
+                                continue;
+                            }
+                            let o = (yy * cw + xx) * nt;
+                            let (sg, sh) = (&terms.g[o..o + nt], &terms.h[o..o + nt]);
+                            pw.eval(cl, sg, sh, ne);
+                            for k in 0..ns {
+                                let (p, q) = pw.at(k);
+                                rs[k] += wgt * p;
+                                rm[k] += wgt * q;
+                            }
+                        }
+                    }
+                    let wt = wt.map(|v| v as f32);
+                    let mut add = |i: usize, rr: &[f32]| {
+                        for (k, rk) in rr.iter().enumerate() {
+                            let o = (k * g.n_theta + i) * 3;
+                            for c in 0..3 {
+                                out[o + c] += rk * wt[c];
+                            }
+                        }
+                    };
+                    add(i, &rs);
+                    if paired {
+                        add(i + n_direct, &rm);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    let mut xyz = vec![0.0f32; g.texels() * 3];
+    for (j, row) in rows.iter().enumerate() {
+        for k in 0..ns {
+            for i in 0..g.n_theta {
+                let (src, dst) = (
+                    (k * g.n_theta + i) * 3,
+                    ((k * g.n_rho + j) * g.n_theta + i) * 3,
+                );
+                xyz[dst..dst + 3].copy_from_slice(&row[src..src + 3]);
+            }
+        }
+    }
+    xyz
 }
