@@ -60,9 +60,20 @@ pub fn lobe_width(pack: &Pack) -> f64 {
     w.clamp(1e-4, 0.05)
 }
 
+/// Radial texels per unit of `asinh(r / r0)`: steps of 2 % in `r` beyond the
+/// knee. The colour changes along a ray about as fast as the wavelength (a
+/// lobe of order m sits at `r = m lambda / period`), so this step is what holds
+/// the hue; measured on a 5 um ridge patch (docs/bench/play.md), 25 per unit
+/// gave CIEDE2000 p99 1.03 and 50 gave 0.50 (twice the angle or `s`: no gain).
+const RHO_PER_UNIT: f64 = 50.0;
+/// The radial density below which the budget takes angle texels first.
+const RHO_PER_UNIT_MIN: f64 = 25.0;
+
 /// The grid for a pack: two texels per lobe width across `(u, v)` at radius 1
-/// (angle), steps of 1/25 in `asinh(r / r0)` along the radius, about three per
-/// unit of `|t|` along `w`; then shrunk to the budget (angle last).
+/// (angle), [`RHO_PER_UNIT`] steps per unit of `asinh(r / r0)` along the
+/// radius, about three per unit of `|t|` along `w`; then shrunk to the budget:
+/// `s` to 16, the radius to [`RHO_PER_UNIT_MIN`], the angle to 128, the radius
+/// to 64, in that order.
 pub fn auto_grid(pack: &Pack, budget_bytes: usize) -> Grid {
     let m = &pack.manifest;
     let lobe = lobe_width(pack);
@@ -73,17 +84,22 @@ pub fn auto_grid(pack: &Pack, budget_bytes: usize) -> Grid {
         n_s: 0,
         r0: lobe,
     };
-    g.n_rho = ((g.rho_scale() * 25.0).ceil() as usize + 1).clamp(32, 192);
+    let scale = g.rho_scale();
+    let rho_at = |per_unit: f64| ((scale * per_unit).ceil() as usize + 1).clamp(32, 400);
+    g.n_rho = rho_at(RHO_PER_UNIT);
+    let rho_floor = rho_at(RHO_PER_UNIT_MIN);
     let t_max = 4.0 * std::f64::consts::PI * m.height_half_range_m / LAMBDA_MIN;
     g.n_s = ((3.0 * t_max).ceil() as usize + 2).clamp(8, 40);
     let max_texels = (budget_bytes / 8).max(128 * 32 * 8);
     while g.texels() > max_texels {
         if g.n_s > 16 {
             g.n_s = (g.n_s * 7 / 8).max(16);
-        } else if g.n_rho > 64 {
-            g.n_rho = (g.n_rho * 7 / 8).max(64);
+        } else if g.n_rho > rho_floor {
+            g.n_rho = (g.n_rho * 7 / 8).max(rho_floor);
         } else if g.n_theta > 128 {
             g.n_theta = (g.n_theta / 2).max(128);
+        } else if g.n_rho > 64 {
+            g.n_rho = (g.n_rho * 7 / 8).max(64);
         } else {
             break;
         }

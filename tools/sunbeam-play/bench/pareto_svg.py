@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Pareto plot of the response map: CIEDE2000 p99 against map size (MiB), one
-point per budget (budget.sh CSV), with the former table's error as a line.
+point per budget (budget.sh CSV), with the former table's error as a line;
+each point is labelled with its grid and its frame time at 512 x 512 as a
+multiple of the Lambert mode's in the same run (budget.sh's frame_ms / lambert_ms).
 Plain SVG, no dependencies:
 
     python3 tools/sunbeam-play/bench/pareto_svg.py BUDGET.csv TABLE_P99 TITLE > out.svg
@@ -39,6 +41,9 @@ pts = sorted(zip(xs, ys, rows))
 o.append('<polyline fill="none" stroke="#236" points="' + " ".join(f"{px(x):.1f},{py(y):.1f}" for x, y, _ in pts) + '"/>')
 for x, y, r in pts:
     o.append(f'<circle cx="{px(x):.1f}" cy="{py(y):.1f}" r="4" fill="#236"/>')
-    o.append(f'<text x="{px(x)+6:.1f}" y="{py(y)-6:.1f}">{r["grid"]}</text>')
+    label = r["grid"]
+    if r.get("frame_ms") and r.get("lambert_ms"):
+        label += f', {float(r["frame_ms"]) / float(r["lambert_ms"]):.2f}x Lambert'
+    o.append(f'<text x="{px(x)+6:.1f}" y="{py(y)-6:.1f}">{label}</text>')
 o.append("</svg>")
 print("\n".join(o))

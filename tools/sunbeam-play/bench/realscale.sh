@@ -12,7 +12,9 @@
 # pixels, and the player's start-up. One CSV row per size on stdout and in
 # OUT_DIR/realscale.csv. Needs a release build (cargo build --release --workspace).
 # Environment: RES (reference and frame size, default 128), PACK_FLAGS (e.g.
-# "--model tiled"), SUNBEAM_BIN (the folder of the binaries).
+# "--model tiled", "--coherence 20um"), TABLE=0 (skip the table baseline: its
+# start-up takes minutes at the large sizes), REF_SAMPLES (default 16),
+# SUNBEAM_BIN (the folder of the binaries).
 set -euo pipefail
 out=${1:?usage: realscale.sh OUT_DIR [SIZE:PIXEL ...]}
 shift
@@ -39,12 +41,16 @@ for sp in "${sizes[@]}"; do
   "exposure": 0, "size": [$res, $res] }
 JSON
   t0=$(date +%s.%N)
-  "$bin/sunbeam-eval" render "$d/scene.json" --samples 16 -o "$d/ref.exr"
+  "$bin/sunbeam-eval" render "$d/scene.json" --samples "${REF_SAMPLES:-16}" -o "$d/ref.exr"
   t1=$(date +%s.%N)
   cmp() { "$bin/sunbeam-play" "$d/scene.json" --headless -o "$d/$1.exr" --compare "$d/ref.exr" --json -q "${@:2}"; }
   m1=$(cmp map1)
   m2=$(cmp map2 --supersample 2)
-  tb=$(cmp table1 --mode table)
+  if [ "${TABLE:-1}" = 0 ]; then
+    tb='{"setup_ms": -1, "ciede2000": {"mean": -1, "p99": -1, "max": -1}}'  # -1: not run
+  else
+    tb=$(cmp table1 --mode table)
+  fi
   patch=$(python3 -c "import re; v=float(re.match(r'[0-9.]+','$px').group()); print(round($n*v/1000,2))")
   row="$n,$px,$patch,$(echo "$pj" | j 'd["bytes_written"]-d["response"]["bytes"]'),$(echo "$pj" | j 'round(d["pack_time_s"],2)'),$(echo "$pj" | j '"x".join(map(str,d["response"]["grid"]))'),$(echo "$pj" | j 'd["response"]["bytes"]'),$(echo "$pj" | j 'round(d["response"]["time_s"],2)'),$(python3 -c "print(round($t1-$t0,1))")"
   row="$row,$(echo "$m1" | j 'round(d["setup_ms"])'),$(echo "$tb" | j 'round(d["setup_ms"])')"
