@@ -39,11 +39,14 @@ o.append(f'<text x="{W-R-4}" y="{py(table)-6:.1f}" text-anchor="end" fill="#c33"
 o.append(f'<line x1="{L}" y1="{py(1):.1f}" x2="{W-R}" y2="{py(1):.1f}" stroke="#393" stroke-dasharray="2 3"/>')
 pts = sorted(zip(xs, ys, rows))
 o.append('<polyline fill="none" stroke="#236" points="' + " ".join(f"{px(x):.1f},{py(y):.1f}" for x, y, _ in pts) + '"/>')
-for x, y, r in pts:
+for idx, (x, y, r) in enumerate(pts):
     o.append(f'<circle cx="{px(x):.1f}" cy="{py(y):.1f}" r="4" fill="#236"/>')
     label = r["grid"]
     if r.get("frame_ms") and r.get("lambert_ms"):
         label += f', {float(r["frame_ms"]) / float(r["lambert_ms"]):.2f}x Lambert'
-    o.append(f'<text x="{px(x)+6:.1f}" y="{py(y)-6:.1f}">{label}</text>')
+    right = px(x) > 0.6 * W  # label to the left of points near the right edge
+    dy = 18 if right and idx % 2 == 1 else -8  # alternate below/above where labels crowd
+    o.append(f'<text x="{px(x) + (-6 if right else 6):.1f}" y="{py(y) + dy:.1f}"'
+             f' text-anchor="{"end" if right else "start"}">{label}</text>')
 o.append("</svg>")
 print("\n".join(o))
