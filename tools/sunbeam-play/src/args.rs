@@ -1,0 +1,90 @@
+//! Command line of sunbeam-play (clap).
+
+use clap::Parser;
+use std::path::PathBuf;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "sunbeam-play",
+    version,
+    about = "Diffraction colour from term packs: window or headless frames"
+)]
+pub(crate) struct Cli {
+    /// Scene file (JSON, docs/SCENE.md). Or use --mesh and --pack.
+    pub(crate) scene: Option<PathBuf>,
+    /// Mesh (GLB/glTF/OBJ, or builtin:quad / builtin:sphere) for the default scene.
+    #[arg(long)]
+    pub(crate) mesh: Option<PathBuf>,
+    /// Pack (KTX2/EXR) for the default scene.
+    #[arg(long)]
+    pub(crate) pack: Option<PathBuf>,
+    /// Render offscreen (no window) and write -o.
+    #[arg(long)]
+    pub(crate) headless: bool,
+    /// Output FRAME.png (display values) or FRAME.exr (headless: linear light, exposure
+    /// applied), or the PNG screenshot of the window (with --frames).
+    #[arg(short, long)]
+    pub(crate) output: Option<PathBuf>,
+    /// Multisample anti-aliasing of silhouettes: 1 (off) or 4.
+    #[arg(long, default_value_t = 4)]
+    pub(crate) msaa: u32,
+    /// Headless: render K x K times the size and box-filter in linear light.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) supersample: u32,
+    /// Default mode: read the response map at the pixel centre only (no footprint filter).
+    #[arg(long)]
+    pub(crate) no_footprint: bool,
+    /// Frame size WxH (headless: default the scene's size; window: initial size).
+    #[arg(long)]
+    pub(crate) size: Option<String>,
+    /// Headless: frames rendered (the last one is written). Window: exit after N frames.
+    #[arg(long)]
+    pub(crate) frames: Option<u32>,
+    /// Window: seconds to keep showing after --frames.
+    #[arg(long, default_value_t = 0.0)]
+    pub(crate) hold_secs: f64,
+    /// GPU backend.
+    #[arg(long, default_value = "auto")]
+    pub(crate) backend: String,
+    /// Shading: default (response map), table (the former Cartesian table, built at load),
+    /// direct (per-fragment sum), thesis (39 terms, 5 nm, nearest bin), lambert (base colour only).
+    #[arg(long, default_value = "default")]
+    pub(crate) mode: String,
+    /// Same as --mode thesis.
+    #[arg(long)]
+    pub(crate) thesis: bool,
+    /// Same as --mode lambert.
+    #[arg(long)]
+    pub(crate) lambert: bool,
+    /// Wavelength samples of the default mode.
+    #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES)]
+    pub(crate) lambda_samples: usize,
+    /// Truncation bound on |dR| per fragment (default: the pack's).
+    #[arg(long)]
+    pub(crate) term_tolerance: Option<f64>,
+    /// Tone curve after exposure: clamp or reinhard.
+    #[arg(long, default_value = "clamp")]
+    pub(crate) tone: String,
+    /// Exposure in stops (overrides the scene's).
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) exposure: Option<f64>,
+    /// Render with the CPU reference (sunbeam-raster) instead of the GPU.
+    #[arg(long)]
+    pub(crate) cpu: bool,
+    /// Compare the frame with a reference: PNG (8-bit, every pixel) or EXR (linear,
+    /// lit pixels): CIEDE2000 mean / p99 / max in the report.
+    #[arg(long)]
+    pub(crate) compare: Option<PathBuf>,
+    /// Headless benchmark: time --frames frames (default 10) and print the frame times.
+    #[arg(long)]
+    pub(crate) bench: bool,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Write a Make depfile for -o.
+    #[arg(long)]
+    pub(crate) depfile: Option<PathBuf>,
+    /// Less output.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
+}

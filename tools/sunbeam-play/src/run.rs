@@ -1,0 +1,233 @@
+//! What sunbeam-play does with its parsed arguments.
+
+use crate::args::*;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Duration;
+use sunbeam_common::{units, Error, Result};
+use sunbeam_optics::colour::ToneCurve;
+use sunbeam_raster::{Image, LinearImage, Prepared};
+use sunbeam_render::window::{self, WindowOptions};
+use sunbeam_render::{Backend, Gpu, Mode, Settings};
+use sunbeam_scene::Scene;
+
+fn load_scene(cli: &Cli) -> Result<Scene> {
+    let mut scene = match (&cli.scene, &cli.mesh) {
+        (Some(_), Some(_)) => {
+            return Err(Error::usage(
+                "give either SCENE.json or --mesh/--pack, not both",
+            ))
+        }
+        (Some(s), None) => {
+            if cli.pack.is_some() {
+                return Err(Error::usage(
+                    "--pack goes with --mesh (a scene file names its own packs)",
+                ));
+            }
+            Scene::load(s)?
+        }
+        (None, Some(m)) => sunbeam_raster::default_scene(m, cli.pack.as_deref())?,
+        (None, None) => {
+            return Err(Error::usage(
+                "nothing to render: give SCENE.json or --mesh M.glb --pack P.ktx2",
+            ))
+        }
+    };
+    if let Some(ev) = cli.exposure {
+        if !ev.is_finite() {
+            return Err(Error::usage("--exposure must be finite"));
+        }
+        scene.exposure = ev;
+    }
+    if let Some(s) = &cli.size {
+        let (w, h) = units::parse_size(s)?;
+        scene.size = [w as u32, h as u32];
+        scene.validate()?;
+    }
+    Ok(scene)
+}
+
+fn settings(cli: &Cli) -> Result<Settings> {
+    let mut mode: Mode = cli.mode.parse()?;
+    if cli.thesis && cli.lambert {
+        return Err(Error::usage("--thesis and --lambert exclude each other"));
+    }
+    if cli.thesis {
+        mode = Mode::Thesis;
+    }
+    if cli.lambert {
+        mode = Mode::Lambert;
+    }
+    if cli.lambda_samples == 0 || cli.lambda_samples > 4096 {
+        return Err(Error::usage("--lambda-samples must be 1..4096"));
+    }
+    if let Some(t) = cli.term_tolerance {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(Error::usage("--term-tolerance must be positive"));
+        }
+    }
+    let curve: ToneCurve = cli.tone.parse()?;
+    if cli.msaa != 1 && cli.msaa != 4 {
+        return Err(Error::usage("--msaa must be 1 or 4"));
+    }
+    if !(1..=4).contains(&cli.supersample) {
+        return Err(Error::usage("--supersample must be 1..4"));
+    }
+    Ok(Settings {
+        mode,
+        lambda_samples: cli.lambda_samples,
+        curve,
+        term_tolerance: cli.term_tolerance,
+        msaa: cli.msaa,
+        footprint: !cli.no_footprint,
+        ..Default::default()
+    })
+}
+
+fn is_exr(p: &std::path::Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+fn inputs(p: &Prepared, cli: &Cli) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = cli.scene.iter().cloned().collect();
+    for m in &p.scene.meshes {
+        if !sunbeam_scene::geometry::is_builtin(&m.mesh) {
+            v.push(m.mesh.clone());
+        }
+        v.extend(m.pack.iter().cloned());
+        // The default mode reads the response map beside the pack when it is there.
+        let side = m.pack.as_deref().map(sunbeam_render::response::sidecar);
+        v.extend(side.filter(|s| s.is_file()));
+    }
+    v.dedup();
+    v
+}
+
+pub(crate) fn run(cli: Cli) -> Result<()> {
+    let scene = load_scene(&cli)?;
+    let st = settings(&cli)?;
+    let backend: Backend = cli.backend.parse()?;
+    let prepared = sunbeam_raster::prepare(&scene)?;
+    let headless = cli.headless || cli.bench || cli.cpu;
+    if !headless {
+        if cli.compare.is_some() || cli.depfile.is_some() {
+            return Err(Error::usage("--compare and --depfile need --headless"));
+        }
+        let opts = WindowOptions {
+            backend,
+            settings: st,
+            size: scene.size,
+            frames: cli.frames,
+            hold: Duration::from_secs_f64(cli.hold_secs.max(0.0)),
+            screenshot: cli.output.clone(),
+            title: "sunbeam-play".into(),
+        };
+        return window::run(prepared, opts);
+    }
+    if cli.output.is_none() && !cli.bench {
+        return Err(Error::usage("--headless needs -o FRAME.png"));
+    }
+    let size = scene.size;
+    let mut report = serde_json::json!({
+        "tool": "sunbeam-play",
+        "size": size,
+        "mode": format!("{:?}", st.mode).to_lowercase(),
+    });
+    let image: LinearImage = if cli.cpu {
+        let t = std::time::Instant::now();
+        let k = cli.supersample.max(1);
+        let opts = sunbeam_raster::Options {
+            curve: st.curve,
+            samples: k * k,
+            ..Default::default()
+        };
+        let img = sunbeam_raster::render_prepared_linear(&prepared, &opts)?;
+        report["renderer"] = "cpu reference (sunbeam-raster)".into();
+        report["render_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
+        img
+    } else {
+        let gpu = Gpu::headless(backend)?;
+        report["adapter"] = gpu.describe().into();
+        if cli.bench {
+            let frames = cli.frames.unwrap_or(10).max(2);
+            let (times, img) = sunbeam_render::bench_headless(&gpu, &prepared, &st, size, frames)?;
+            report["setup_ms"] = times.setup_ms.into();
+            report["first_frame_ms"] = times.first_ms.into();
+            report["frame_ms_median"] = times.median_ms().into();
+            report["frame_ms_mean"] = times.mean_ms().into();
+            report["frame_ms"] = times.rest_ms.clone().into();
+            report["msaa"] = st.msaa.into();
+            if !cli.json {
+                println!(
+                    "{} {:?} {}x{}: setup {:.0} ms, first frame {:.1} ms, then median {:.2} ms / mean {:.2} ms over {} frames ({:.1} fps)",
+                    gpu.describe(),
+                    st.mode,
+                    size[0],
+                    size[1],
+                    times.setup_ms,
+                    times.first_ms,
+                    times.median_ms(),
+                    times.mean_ms(),
+                    times.rest_ms.len(),
+                    1e3 / times.median_ms().max(1e-6)
+                );
+            }
+            img
+        } else {
+            let t = std::time::Instant::now();
+            let r = sunbeam_render::Renderer::new(
+                &gpu,
+                &prepared,
+                &st,
+                sunbeam_render::OFFSCREEN_FORMAT,
+            )?;
+            for w in &r.warnings {
+                eprintln!("sunbeam-play: warning: {w}");
+            }
+            report["setup_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
+            let k = cli.supersample.max(1);
+            let target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;
+            let state = sunbeam_render::FrameState::from_scene(&prepared);
+            for _ in 1..cli.frames.unwrap_or(1).max(1) {
+                target.draw(&gpu, &r, &state)?;
+            }
+            target.render_linear(&gpu, &r, &state)?.downsample(k)
+        }
+    };
+    if let Some(refp) = &cli.compare {
+        let d = if is_exr(refp) {
+            let reference = LinearImage::read_exr(refp)?;
+            sunbeam_raster::compare_linear(&image, &reference)
+                .map_err(|e| e.context(refp.display()))?
+        } else {
+            let reference = Image::read_png(refp)?;
+            let disp = image.display(st.curve);
+            let q = Image::from_rgba8(disp.width, disp.height, &disp.to_rgba8());
+            sunbeam_raster::compare(&q, &reference).map_err(|e| e.context(refp.display()))?
+        };
+        report["ciede2000"] = serde_json::json!({"mean": d.mean, "p99": d.p99, "max": d.max});
+        if !cli.json && !cli.quiet {
+            println!("against {}: {d}", refp.display());
+        }
+    }
+    if let Some(out) = &cli.output {
+        if is_exr(out) {
+            image.write_exr(out)?;
+        } else {
+            image.display(st.curve).write_png(out)?;
+        }
+        report["output"] = out.display().to_string().into();
+        if let Some(dep) = &cli.depfile {
+            let ins = inputs(&prepared, &cli);
+            let refs: Vec<&std::path::Path> = ins.iter().map(|p| p.as_path()).collect();
+            sunbeam_common::depfile::write(dep, &[out.as_path()], &refs)?;
+        }
+        if !cli.json && !cli.quiet && std::io::stderr().is_terminal() {
+            eprintln!("wrote {}", out.display());
+        }
+    }
+    if cli.json {
+        println!("{report}");
+    }
+    Ok(())
+}
