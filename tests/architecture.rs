@@ -3,7 +3,8 @@
 //! - the physics core `sunbeam-pack` depends on field, optics and common only
 //!   (never on the instrument readers, the glTF loader or the render scene);
 //! - no crate depends on a tool (a package under `tools/`);
-//! - inside a crate, no cycle of `crate::` references between its top modules.
+//! - inside a crate, no cycle of `crate::` references between its top modules;
+//! - every tool's `main.rs` stays under 150 lines.
 //!
 //! The crate graph comes from `cargo metadata`. `SUNBEAM_ARCH_ROOT=DIR` checks
 //! another checkout instead of this one (that is how the check was shown to fail
@@ -287,4 +288,25 @@ fn the_cycle_finder_finds_cycles() {
     };
     assert!(find_cycle(&g(&[("a", "b"), ("b", "c")])).is_none());
     assert!(find_cycle(&g(&[("a", "b"), ("b", "c"), ("c", "a")])).is_some());
+}
+
+/// A tool's `main.rs` is its entry point, not its logic (docs/dev/ARCHITECTURE.md):
+/// the command line goes in `args.rs`, the work in modules and crates.
+#[test]
+fn tool_mains_are_short() {
+    const LIMIT: usize = 150;
+    let mut long = Vec::new();
+    for e in std::fs::read_dir(root().join("tools")).expect("tools/") {
+        let main = e.expect("tools/ entry").path().join("src/main.rs");
+        if let Ok(text) = std::fs::read_to_string(&main) {
+            let n = text.lines().count();
+            if n > LIMIT {
+                long.push(format!("{} ({n} lines)", main.display()));
+            }
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "tool main.rs files over {LIMIT} lines: {long:?}"
+    );
 }

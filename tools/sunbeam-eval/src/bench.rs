@@ -4,12 +4,12 @@
 //! the colour integral; and a stress sweep of |t| up to 60. Writes CSV files,
 //! a Pareto plot and a markdown summary (stdout).
 
-use crate::compare::{colour_vs, spectral_at, truth_colours, SpectralError};
 use crate::plot::{perr, png};
-use crate::sample::Rng;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use sunbeam_analysis::compare::{colour_vs, spectral_at, truth_colours, SpectralError};
+use sunbeam_analysis::sample::Rng;
 use sunbeam_common::{output, Error, Result};
 use sunbeam_field::HeightField;
 use sunbeam_optics::truth::{Model as TModel, Params, Truth};
@@ -49,21 +49,21 @@ fn prec_name(p: Precision) -> &'static str {
     }
 }
 
-/// A synthetic ridge field like the snake scales: ridges 1.2 um apart along y,
-/// wavy along x, with a sharper second harmonic; heights 0..2H.
-pub fn ridge_field(n: usize, dx: f64, half_range: f64) -> HeightField {
-    use std::f64::consts::PI;
-    let mut data = Vec::with_capacity(n * n);
-    for r in 0..n {
-        for c in 0..n {
-            let x = c as f64 * dx;
-            let y = (n - 1 - r) as f64 * dx;
-            let ph = 2.0 * PI * y / 1.2e-6 + 0.8 * (2.0 * PI * x / 3.1e-6).sin();
-            let s = 0.7 * ph.sin() + 0.3 * (2.0 * ph).sin();
-            data.push(half_range * (1.0 + s));
-        }
+/// A synthetic ridge field like the snake scales (sunbeam-synth): ridges 1.2 um
+/// apart, wavy with a 3.1 um wavelength, no roughness), rescaled so that its
+/// heights span exactly `0..2H` (the benchmark sets `|t|` through `H`).
+pub fn ridge_field(n: usize, dx: f64, half_range: f64) -> Result<HeightField> {
+    let mut f = sunbeam_synth::Ridges {
+        period: 1.2e-6,
+        height: 2.0 * half_range,
+        rise: 0.5,
+        wave_amplitude: 0.15e-6,
+        wave_length: 3.1e-6,
+        finger_length: 0.0,
+        roughness: 0.0,
+        seed: 1,
     }
-    let mut f = HeightField::new(n, n, dx, dx, data).expect("valid ridge field");
+    .generate("ridge", n, n, dx)?;
     let (lo, hi) = f.finite_range().unwrap_or((0.0, 0.0));
     let scale = if hi > lo {
         2.0 * half_range / (hi - lo)
@@ -73,7 +73,7 @@ pub fn ridge_field(n: usize, dx: f64, half_range: f64) -> HeightField {
     for v in &mut f.data {
         *v = (*v - lo) * scale;
     }
-    f
+    Ok(f)
 }
 
 fn fref(f: &HeightField) -> FieldRef<'_> {
@@ -153,7 +153,7 @@ pub fn run(o: &Options) -> Result<()> {
     }
     fields.push((
         "ridge".into(),
-        ridge_field(if o.quick { 64 } else { 128 }, 25e-9, 150e-9),
+        ridge_field(if o.quick { 64 } else { 128 }, 25e-9, 150e-9)?,
     ));
     let lam = (380e-9, 780e-9);
 
@@ -170,7 +170,7 @@ pub fn run(o: &Options) -> Result<()> {
         )?;
         let pts = points(o.points, 17, 0.05, lam);
         let t0 = Instant::now();
-        let _ = crate::source::par_map(1, |_| ());
+        let _ = sunbeam_analysis::par_map(1, |_| ());
         let tr: Vec<f64> = pts
             .iter()
             .take(50)
@@ -231,8 +231,8 @@ pub fn run(o: &Options) -> Result<()> {
         // Wavelength samples of the colour integral (default pack) against 1 nm.
         let (p, _) = build(f, Basis::Chebyshev, 1e-4, Precision::F32, 6)?;
         for light in [
-            crate::sample::dir(60f64.to_radians(), 0.0),
-            crate::sample::dir(30f64.to_radians(), std::f64::consts::FRAC_PI_2),
+            sunbeam_analysis::sample::dir(60f64.to_radians(), 0.0),
+            sunbeam_analysis::sample::dir(30f64.to_radians(), std::f64::consts::FRAC_PI_2),
         ] {
             let tc = truth_colours(&truth, &p, light, if o.quick { 16 } else { 32 });
             for samples in [8usize, 16, 32, 40, 64] {
@@ -252,7 +252,7 @@ pub fn run(o: &Options) -> Result<()> {
     };
     for &t in ts {
         let h = t * 380e-9 / (4.0 * std::f64::consts::PI);
-        let f = ridge_field(48, 25e-9, h);
+        let f = ridge_field(48, 25e-9, h)?;
         let truth = Truth::new(
             &f,
             &Params {

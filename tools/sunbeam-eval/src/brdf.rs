@@ -4,10 +4,10 @@
 //! `log10 R` over (viewing angle, wavelength) in the plane of incidence (right).
 
 use crate::plot::{perr, png, viridis};
-use crate::sample::percentile;
-use crate::source::par_map;
 use plotters::prelude::*;
 use std::path::Path;
+use sunbeam_analysis::par_map;
+use sunbeam_analysis::sample::percentile;
 use sunbeam_common::Result;
 use sunbeam_optics::colour::{self, ToneMap};
 use sunbeam_pack::Pack;

@@ -1,10 +1,10 @@
 //! The grating figure: response over (viewing angle, wavelength), peaks, and
 //! the grating equation for the estimated (and, if given, the true) period.
 
-use crate::grating::{grating_angle_deg, Outcome};
 use crate::plot::{perr, png, viridis};
 use plotters::prelude::*;
 use std::path::Path;
+use sunbeam_analysis::grating::{grating_angle_deg, Outcome};
 use sunbeam_common::Result;
 
 pub fn draw(

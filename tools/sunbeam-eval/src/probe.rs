@@ -1,8 +1,8 @@
 //! `sunbeam-eval probe`: R at given points, one value per line (docs/EVAL.md).
 
-use crate::source::{par_map, Source};
 use std::io::Write;
 use std::path::Path;
+use sunbeam_analysis::{par_map, Source};
 use sunbeam_common::{Error, Result};
 
 /// Parse a points file: lines `u,v,w,lambda_m`; `#` comments and blank lines

@@ -8,7 +8,7 @@
 use sunbeam_common::{units, Error, Result};
 use sunbeam_scene::Scene;
 
-pub fn run(a: &crate::RenderArgs) -> Result<()> {
+pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
     let mut scene = match (&a.scene, &a.mesh) {
         (Some(_), Some(_)) => {
             return Err(Error::usage(

@@ -1,31 +1,11 @@
 //! One interface over the two things that give `R(u, v, w, lambda)`: the
 //! float64 ground truth of a height field, and a pack's CPU evaluator.
 
-use crate::input::{self, HeightArgs};
 use std::path::Path;
+use sunbeam_afm::height::{read_height_field, HeightOptions};
 use sunbeam_common::{Error, Result};
 use sunbeam_field::HeightField;
 use sunbeam_optics::truth::{Model, Params, Truth};
-
-/// Model options of the ground truth.
-#[derive(Debug, Clone, clap::Args)]
-pub struct TruthArgs {
-    /// What lies beyond the patch: `window` (default) or `tiled` (the thesis).
-    #[arg(long, default_value = "window", value_parser = sunbeam_common::cli::one_of::<Model>(&Model::NAMES))]
-    pub model: Model,
-    /// Spatial coherence length of the light.
-    #[arg(long, default_value = "65um", value_name = "LEN", value_parser = sunbeam_common::cli::positive_length)]
-    pub coherence: f64,
-}
-
-impl TruthArgs {
-    pub fn params(&self) -> Result<Params> {
-        Ok(Params {
-            model: self.model,
-            coherence_m: self.coherence,
-        })
-    }
-}
 
 pub enum Source {
     Truth {
@@ -40,12 +20,11 @@ impl Source {
     /// else as a height field with its ground truth.
     pub fn open(
         path: &Path,
-        heights: &HeightArgs,
-        truth: &TruthArgs,
+        heights: &HeightOptions,
+        params: &Params,
         force_truth: bool,
     ) -> Result<Source> {
-        let params = truth.params()?;
-        if input::is_pack(path)? {
+        if sunbeam_pack::formats::is_pack(path)? {
             if force_truth {
                 return Err(Error::usage(format!(
                     "{}: is a pack; the ground truth needs the height field it was made from",
@@ -55,8 +34,8 @@ impl Source {
             let p = sunbeam_pack::Pack::read(path)?;
             return Ok(Source::Pack(Box::new(p)));
         }
-        let field = input::read_height(path, heights)?;
-        Self::from_field(field, &params).map_err(|e| e.context(path.display()))
+        let field = read_height_field(path, heights)?.field;
+        Self::from_field(field, params).map_err(|e| e.context(path.display()))
     }
 
     pub fn from_field(field: HeightField, p: &Params) -> Result<Source> {
@@ -112,39 +91,9 @@ impl Source {
     }
 }
 
-/// Evaluate `f(i)` for `i in 0..n` on all cores, in order (deterministic).
-pub fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    let threads = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
-        .clamp(1, 64);
-    if threads == 1 || n < 2 {
-        return (0..n).map(f).collect();
-    }
-    let chunk = n.div_ceil(threads * 4).max(1);
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut parts: Vec<(usize, Vec<T>)> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..threads)
-            .map(|_| {
-                s.spawn(|| {
-                    let mut out = Vec::new();
-                    loop {
-                        let start = next.fetch_add(chunk, std::sync::atomic::Ordering::Relaxed);
-                        if start >= n {
-                            break;
-                        }
-                        let end = (start + chunk).min(n);
-                        out.push((start, (start..end).map(&f).collect::<Vec<T>>()));
-                    }
-                    out
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_default())
-            .collect()
-    });
-    parts.sort_by_key(|p| p.0);
-    parts.into_iter().flat_map(|p| p.1).collect()
+/// Evaluate `f(i)` for `i in 0..n` on all cores, in order (rayon's indexed
+/// collect keeps the order, so results do not depend on the thread count).
+pub fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    use rayon::prelude::*;
+    (0..n).into_par_iter().map(f).collect()
 }

@@ -1,17 +1,18 @@
 //! Deterministic direction and point sampling shared by compare, brdf and bench.
 
-/// xorshift64*: a small deterministic generator (same sequence everywhere).
-pub struct Rng(u64);
+use sunbeam_common::rng::SplitMix64;
+
+/// The project's seeded generator (`sunbeam_common::rng::SplitMix64`, the
+/// same sequence everywhere) with the sampling this crate needs.
+pub struct Rng(SplitMix64);
 
 impl Rng {
     pub fn new(seed: u64) -> Rng {
-        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+        Rng(SplitMix64::new(seed))
     }
+    /// Uniform in [0, 1).
     pub fn next_f64(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+        self.0.unit()
     }
     /// A direction uniform in solid angle on the upper hemisphere with d.n >= min_cos.
     pub fn hemisphere(&mut self, min_cos: f64) -> [f64; 3] {
@@ -43,20 +44,6 @@ pub fn dir(theta: f64, phi: f64) -> [f64; 3] {
         theta.sin() * phi.sin(),
         theta.cos(),
     ]
-}
-
-/// Parse `THETA[,PHI]` (angles with units, e.g. `60deg,90deg`).
-pub fn parse_light(s: &str) -> sunbeam_common::Result<[f64; 3]> {
-    use sunbeam_common::{units, Error};
-    let (a, b) = s.split_once(',').unwrap_or((s, "0deg"));
-    let th = units::parse_angle(a)?;
-    let ph = units::parse_angle(b)?;
-    if !(0.0..89.9f64.to_radians()).contains(&th.abs()) {
-        return Err(Error::usage(format!(
-            "--light '{s}': polar angle must be in [0, 89.9) degrees"
-        )));
-    }
-    Ok(dir(th.abs(), ph))
 }
 
 /// Percentile (0..100) of a slice (nearest rank on a sorted copy).

@@ -1,0 +1,248 @@
+//! Command line of sunbeam-eval (clap).
+
+use crate::input;
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use sunbeam_common::{cli, Result};
+use sunbeam_optics::truth::{Model, Params};
+
+#[derive(Parser)]
+#[command(
+    name = "sunbeam-eval",
+    version,
+    about = "Ground truth, errors, grating check and BRDF pictures for Sunbeam packs"
+)]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    pub(crate) cmd: Cmd,
+    /// Less output.
+    #[arg(short, long, global = true)]
+    pub(crate) quiet: bool,
+    /// More output.
+    #[arg(short, long, global = true)]
+    pub(crate) verbose: bool,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct SheetArgs {
+    /// Output PNG.
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+    /// Pictures per row.
+    #[arg(long, default_value_t = 4)]
+    pub(crate) columns: usize,
+    /// Input PNGs, in order.
+    #[arg(required = true)]
+    pub(crate) inputs: Vec<PathBuf>,
+}
+
+#[derive(Subcommand)]
+pub(crate) enum Cmd {
+    /// R(u, v, w, lambda) at the points of a CSV file, one value per line on stdout (docs/EVAL.md).
+    Probe(ProbeArgs),
+    /// The thesis' grating evaluation: peak viewing angle per wavelength and the period.
+    Grating(GratingArgs),
+    /// Spectral and colour errors of a pack against the ground truth of its height field.
+    Compare(CompareArgs),
+    /// Picture of a pack's reflected colour over the hemisphere and R over (angle, wavelength).
+    Brdf(BrdfArgs),
+    /// Run time against error sweeps (CSV, Pareto plot, markdown summary on stdout).
+    Bench(BenchArgs),
+    /// The CPU reference image of a scene (needs sunbeam-raster).
+    Render(RenderArgs),
+    /// Contact sheet: PNGs on a grid, row by row (the demo's overview picture).
+    Sheet(SheetArgs),
+}
+
+#[derive(clap::Args)]
+pub(crate) struct CompareArgs {
+    /// The pack (KTX2/EXR).
+    pub(crate) pack: PathBuf,
+    /// The height field it was built from.
+    pub(crate) height: PathBuf,
+    /// Random (wi, wr, lambda) points for the spectral error.
+    #[arg(long, default_value_t = 2000)]
+    pub(crate) points: usize,
+    /// View directions per light for the colour error.
+    #[arg(long, default_value_t = 64)]
+    pub(crate) views: usize,
+    /// Light directions `THETA[,PHI]` (repeatable); default 0, 30, 60, 75 deg at phi 0 and 60 deg at phi 90.
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) light: Vec<String>,
+    /// Wavelength samples of the pack's colour integral (the truth uses 1 nm).
+    #[arg(long, default_value_t = 64)]
+    pub(crate) lambda_samples: usize,
+    /// Fail (exit 5) when max |dR| exceeds this.
+    #[arg(long, default_value_t = 1e-3)]
+    pub(crate) tolerance: f64,
+    /// Fail (exit 5) when the 99th percentile CIEDE2000 exceeds this.
+    #[arg(long, default_value_t = 1.0)]
+    pub(crate) de_tolerance: f64,
+    /// Machine-readable report on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+    #[command(flatten)]
+    pub(crate) heights: input::HeightArgs,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct BrdfArgs {
+    /// The pack (KTX2/EXR).
+    pub(crate) pack: PathBuf,
+    /// Light direction `THETA[,PHI]`.
+    #[arg(long, default_value = "60deg,0deg", allow_hyphen_values = true)]
+    pub(crate) light: String,
+    /// Output PNG.
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+    /// Disk resolution in pixels.
+    #[arg(long, default_value_t = 200)]
+    pub(crate) size: usize,
+    /// Wavelength samples of the colour integral.
+    #[arg(long, default_value_t = 32)]
+    pub(crate) lambda_samples: usize,
+    /// Exposure in stops (default: the 95th percentile of Y maps to 1).
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) exposure: Option<f64>,
+    /// Tone curve: clamp or reinhard.
+    #[arg(long, default_value = "clamp")]
+    pub(crate) tone: String,
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct BenchArgs {
+    /// Folder with the snake patches (default: ../shared/data/snake when found).
+    #[arg(long)]
+    pub(crate) snake: Option<PathBuf>,
+    /// Output folder for bench.csv, colour.csv, stress.csv and pareto.png.
+    #[arg(short, long, default_value = "bench-out")]
+    pub(crate) output: PathBuf,
+    /// Random evaluation points per field.
+    #[arg(long, default_value_t = 400)]
+    pub(crate) points: usize,
+    /// Fewer configurations and smaller fields (a smoke run).
+    #[arg(long)]
+    pub(crate) quick: bool,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct ProbeArgs {
+    /// A pack (KTX2/EXR) or a height field (anything sunbeam-import reads).
+    pub(crate) input: PathBuf,
+    /// Points, one `u,v,w,lambda_m` per line.
+    #[arg(long, value_name = "FILE.csv")]
+    pub(crate) points: PathBuf,
+    /// Ground truth of PHYSICS.md 2 (implied for a height field; refused for a pack).
+    #[arg(long)]
+    pub(crate) truth: bool,
+    #[command(flatten)]
+    pub(crate) heights: input::HeightArgs,
+    #[command(flatten)]
+    pub(crate) model: TruthArgs,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct GratingArgs {
+    /// A height field or a pack.
+    pub(crate) input: PathBuf,
+    /// Incidence angle in the plane of incidence.
+    #[arg(long, default_value = "75deg", allow_hyphen_values = true)]
+    pub(crate) theta_i: String,
+    /// Azimuth of the plane of incidence from the patch's +x axis.
+    #[arg(long, default_value = "0deg", allow_hyphen_values = true)]
+    pub(crate) azimuth: String,
+    /// Wavelength range.
+    #[arg(long, default_value = "380nm..780nm", value_parser = cli::length_range)]
+    pub(crate) lambda: (f64, f64),
+    /// Wavelength step.
+    #[arg(long, default_value = "10nm", value_parser = cli::positive_length)]
+    pub(crate) lambda_step: f64,
+    /// Viewing-angle step of the scan (peaks are then refined on the continuous R).
+    #[arg(long, default_value = "0.1deg")]
+    pub(crate) angle_step: String,
+    /// Order of the brightest peaks when the orders cannot be told apart (one order visible).
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
+    pub(crate) order: i32,
+    /// Ignore peaks whose period (1/|f|) is longer than this (default: outside the specular lobe).
+    #[arg(long, value_name = "LEN", value_parser = cli::positive_length)]
+    pub(crate) max_period: Option<f64>,
+    /// Replicate the height field NxM times first (a periodic patch seen by a wider window).
+    #[arg(long, value_name = "NxM")]
+    pub(crate) tile: Option<String>,
+    /// The true period, if known: drawn in the plot and compared in the report.
+    #[arg(long, value_name = "LEN", value_parser = cli::positive_length)]
+    pub(crate) true_period: Option<f64>,
+    /// Write the plot of peaks against the grating equation.
+    #[arg(long, value_name = "OUT.png")]
+    pub(crate) plot: Option<PathBuf>,
+    /// Write the response R over (wavelength, angle) as CSV.
+    #[arg(long, value_name = "OUT.csv")]
+    pub(crate) csv: Option<PathBuf>,
+    /// Machine-readable report on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+    #[command(flatten)]
+    pub(crate) heights: input::HeightArgs,
+    #[command(flatten)]
+    pub(crate) model: TruthArgs,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct RenderArgs {
+    /// Scene JSON (docs/SCENE.md); or give --mesh and --pack for the default scene.
+    pub(crate) scene: Option<PathBuf>,
+    /// Output: FRAME.png (display values) or FRAME.exr (linear light, exposure applied).
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+    /// Samples per pixel: a stratified s x s grid averaged in linear light (1, 4, 9, 16, ...).
+    #[arg(long, default_value_t = 1)]
+    pub(crate) samples: u32,
+    /// Mesh (GLB/glTF/OBJ) for the default scene of sunbeam-play --mesh --pack.
+    #[arg(long)]
+    pub(crate) mesh: Option<PathBuf>,
+    /// Pack for the default scene.
+    #[arg(long)]
+    pub(crate) pack: Option<PathBuf>,
+    /// Frame size WxH (default: the scene's).
+    #[arg(long)]
+    pub(crate) size: Option<String>,
+    /// Exposure in stops (default: the scene's).
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) exposure: Option<f64>,
+}
+
+/// Model options of the ground truth.
+#[derive(Debug, Clone, clap::Args)]
+pub(crate) struct TruthArgs {
+    /// What lies beyond the patch: `window` (default) or `tiled` (the thesis).
+    #[arg(long, default_value = "window", value_parser = sunbeam_common::cli::one_of::<Model>(&Model::NAMES))]
+    pub(crate) model: Model,
+    /// Spatial coherence length of the light.
+    #[arg(long, default_value = "65um", value_name = "LEN", value_parser = sunbeam_common::cli::positive_length)]
+    pub(crate) coherence: f64,
+}
+
+impl TruthArgs {
+    pub(crate) fn params(&self) -> Result<Params> {
+        Ok(Params {
+            model: self.model,
+            coherence_m: self.coherence,
+        })
+    }
+}
+
+/// Parse `THETA[,PHI]` (angles with units, e.g. `60deg,90deg`).
+pub(crate) fn parse_light(s: &str) -> sunbeam_common::Result<[f64; 3]> {
+    use sunbeam_common::{units, Error};
+    let (a, b) = s.split_once(',').unwrap_or((s, "0deg"));
+    let th = units::parse_angle(a)?;
+    let ph = units::parse_angle(b)?;
+    if !(0.0..89.9f64.to_radians()).contains(&th.abs()) {
+        return Err(Error::usage(format!(
+            "--light '{s}': polar angle must be in [0, 89.9) degrees"
+        )));
+    }
+    Ok(sunbeam_analysis::sample::dir(th.abs(), ph))
+}
