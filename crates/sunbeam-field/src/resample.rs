@@ -20,6 +20,8 @@
 //! (flat fields stay exactly flat). Work is split over threads by rows; each
 //! output value is computed by the same arithmetic whatever the thread count.
 
+use rayon::prelude::*;
+
 use crate::{HeightField, MAX_SIDE};
 use sunbeam_common::{Error, Result};
 
@@ -180,63 +182,45 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (s0 + s1) + (s2 + s3) + tail
 }
 
-fn threads() -> usize {
-    std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
-        .min(16)
-}
-
-/// Apply `axis` along rows: `rows` rows of `n_in` values -> rows of `n_out`.
+/// Apply `axis` along rows: `rows` rows of `n_in` values -> rows of `n_out`
+/// (rows in parallel on rayon; each output value is one fixed-order sum).
 fn apply_rows(src: &[f64], n_in: usize, ax: &Axis, n_out: usize) -> Vec<f64> {
     let rows = src.len() / n_in;
     let mut out = vec![0.0; rows * n_out];
-    let per = rows.div_ceil(threads()).max(1);
-    std::thread::scope(|s| {
-        for (chunk_out, chunk_in) in out.chunks_mut(per * n_out).zip(src.chunks(per * n_in)) {
-            s.spawn(move || {
-                for (orow, irow) in chunk_out.chunks_mut(n_out).zip(chunk_in.chunks(n_in)) {
-                    for (k, o) in orow.iter_mut().enumerate() {
-                        let wt = &ax.w[k * ax.taps..(k + 1) * ax.taps];
-                        *o = match ax.contiguous[k] {
-                            Some(first) => dot(&irow[first..first + ax.taps], wt),
-                            None => {
-                                let ix = &ax.idx[k * ax.taps..(k + 1) * ax.taps];
-                                ix.iter().zip(wt).map(|(&j, &w)| irow[j] * w).sum()
-                            }
-                        };
+    out.par_chunks_mut(n_out)
+        .zip(src.par_chunks(n_in))
+        .for_each(|(orow, irow)| {
+            for (k, o) in orow.iter_mut().enumerate() {
+                let wt = &ax.w[k * ax.taps..(k + 1) * ax.taps];
+                *o = match ax.contiguous[k] {
+                    Some(first) => dot(&irow[first..first + ax.taps], wt),
+                    None => {
+                        let ix = &ax.idx[k * ax.taps..(k + 1) * ax.taps];
+                        ix.iter().zip(wt).map(|(&j, &w)| irow[j] * w).sum()
                     }
-                }
-            });
-        }
-    });
+                };
+            }
+        });
     out
 }
 
-/// Apply `axis` along columns: `n_in` rows of `width` -> `n_out` rows.
+/// Apply `axis` along columns: `n_in` rows of `width` -> `n_out` rows (output
+/// rows in parallel on rayon).
 fn apply_cols(src: &[f64], width: usize, ax: &Axis, n_out: usize) -> Vec<f64> {
     let mut out = vec![0.0; n_out * width];
-    let per = n_out.div_ceil(threads()).max(1);
-    std::thread::scope(|s| {
-        for (c, chunk) in out.chunks_mut(per * width).enumerate() {
-            s.spawn(move || {
-                for (r, orow) in chunk.chunks_mut(width).enumerate() {
-                    let k = c * per + r;
-                    let (ix, wt) = (
-                        &ax.idx[k * ax.taps..(k + 1) * ax.taps],
-                        &ax.w[k * ax.taps..(k + 1) * ax.taps],
-                    );
-                    for (&j, &w) in ix.iter().zip(wt) {
-                        if w == 0.0 {
-                            continue;
-                        }
-                        let irow = &src[j * width..(j + 1) * width];
-                        for (o, &v) in orow.iter_mut().zip(irow) {
-                            *o += w * v;
-                        }
-                    }
-                }
-            });
+    out.par_chunks_mut(width).enumerate().for_each(|(k, orow)| {
+        let (ix, wt) = (
+            &ax.idx[k * ax.taps..(k + 1) * ax.taps],
+            &ax.w[k * ax.taps..(k + 1) * ax.taps],
+        );
+        for (&j, &w) in ix.iter().zip(wt) {
+            if w == 0.0 {
+                continue;
+            }
+            let irow = &src[j * width..(j + 1) * width];
+            for (o, &v) in orow.iter_mut().zip(irow) {
+                *o += w * v;
+            }
         }
     });
     out

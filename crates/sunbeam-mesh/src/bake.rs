@@ -619,30 +619,21 @@ pub fn uv_islands(w: &Work) -> (Vec<u32>, usize) {
     (out, id.len())
 }
 
-/// Evaluate a field at many UVs on all cores (results do not depend on the thread count).
+/// Evaluate a field at many UVs on all cores (rayon; chunks of the same size
+/// as before, each with its own evaluator, results in order).
 fn eval_parallel(f: &AxialField, uv: &[[f64; 2]]) -> Vec<AxialValue> {
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .clamp(1, 16);
+    use rayon::prelude::*;
+    let threads = rayon::current_num_threads().clamp(1, 16);
     if threads == 1 || uv.len() < 4096 {
         let mut e = f.evaluator();
         return uv.iter().map(|p| e.eval(*p)).collect();
     }
-    let chunk = uv.len().div_ceil(threads);
-    std::thread::scope(|s| {
-        let hs: Vec<_> = uv
-            .chunks(chunk)
-            .map(|c| {
-                s.spawn(move || {
-                    let mut e = f.evaluator();
-                    c.iter().map(|p| e.eval(*p)).collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        hs.into_iter()
-            .flat_map(|h| h.join().unwrap_or_default())
-            .collect()
-    })
+    uv.par_chunks(uv.len().div_ceil(threads))
+        .flat_map_iter(|c| {
+            let mut e = f.evaluator();
+            c.iter().map(|p| e.eval(*p)).collect::<Vec<_>>()
+        })
+        .collect()
 }
 
 /// Fill vertices without a direction from their neighbours, breadth first.

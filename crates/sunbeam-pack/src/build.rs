@@ -19,6 +19,7 @@ use crate::manifest::{
 };
 use crate::pack::Pack;
 use crate::series;
+use rayon::prelude::*;
 use realfft::RealFftPlanner;
 use rustfft::num_complex::Complex64;
 use rustfft::FftPlanner;
@@ -367,11 +368,12 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
     Ok(Plan { manifest, wx, wy })
 }
 
-fn split_ranges(n: usize, parts: usize) -> Vec<std::ops::Range<usize>> {
-    let parts = parts.clamp(1, n.max(1));
-    (0..parts)
-        .map(|i| (i * n / parts)..((i + 1) * n / parts))
-        .collect()
+/// Run `job` on `pool` (a fixed thread count), or on rayon's global pool.
+fn in_pool<R: Send>(pool: &Option<rayon::ThreadPool>, job: impl FnOnce() -> R + Send) -> R {
+    match pool {
+        Some(p) => p.install(job),
+        None => job(),
+    }
 }
 
 /// Build the pack. `progress(done, total)` is called after each term.
@@ -424,110 +426,89 @@ pub fn run(
     let mut rowbuf = vec![Complex64::new(0.0, 0.0); my * ncols];
     let lt = cw * chh;
     let mut terms = vec![0.0f32; 2 * lt * m.terms];
-    let threads = threads.max(1);
+    // `threads` workers (0: all cores); the output does not depend on it: every
+    // row and column is one task with its own fixed-order arithmetic.
+    let pool = match threads {
+        0 => None,
+        n => rayon::ThreadPoolBuilder::new().num_threads(n).build().ok(),
+    };
 
     for n in 0..m.terms {
-        // 1+2+3: basis term and row FFTs, rows split among threads.
-        let row_ranges = split_ranges(my, threads);
+        // 1+2+3: basis term and row FFTs, one task per row.
         {
-            let mut prev_chunks: Vec<&mut [f64]> = Vec::new();
-            let mut cur_chunks: Vec<&mut [f64]> = Vec::new();
-            let mut row_chunks: Vec<&mut [Complex64]> = Vec::new();
-            let (mut pr, mut cu, mut rb) = (&mut prev[..], &mut cur[..], &mut rowbuf[..]);
-            for r in &row_ranges {
-                let len = r.len();
-                let (a, b) = pr.split_at_mut(len * mx);
-                prev_chunks.push(a);
-                pr = b;
-                let (a, b) = cu.split_at_mut(len * mx);
-                cur_chunks.push(a);
-                cu = b;
-                let (a, b) = rb.split_at_mut(len * ncols);
-                row_chunks.push(a);
-                rb = b;
-            }
-            std::thread::scope(|sc| {
-                for (((range, pv), cv), rbuf) in row_ranges
-                    .iter()
-                    .zip(prev_chunks)
-                    .zip(cur_chunks)
-                    .zip(row_chunks)
-                {
-                    let r2c = r2c.clone();
-                    let wx = &p.wx;
-                    let wy = &p.wy;
-                    let basis = m.basis;
-                    let s_at = &s_at;
-                    sc.spawn(move || {
-                        let mut input = r2c.make_input_vec();
-                        let mut output = r2c.make_output_vec();
-                        let mut scratch = r2c.make_scratch_vec();
-                        for (i, ru) in range.clone().enumerate() {
-                            let pv = &mut pv[i * mx..(i + 1) * mx];
-                            let cv = &mut cv[i * mx..(i + 1) * mx];
-                            for c in 0..mx {
-                                let b = match (basis, n) {
-                                    (_, 0) => 1.0,
-                                    (_, 1) => s_at(ru, c),
-                                    (Basis::Chebyshev, _) => 2.0 * s_at(ru, c) * cv[c] - pv[c],
-                                    (Basis::Taylor, _) => s_at(ru, c) * cv[c],
-                                };
-                                pv[c] = cv[c];
-                                cv[c] = b;
-                                input[c] = b * wx[c] * wy[ru];
-                            }
-                            input[mx..].iter_mut().for_each(|v| *v = 0.0);
-                            r2c.process_with_scratch(&mut input, &mut output, &mut scratch)
-                                .expect("fft sizes");
-                            let out_row = &mut rbuf[i * ncols..(i + 1) * ncols];
-                            for (k, o) in out_row.iter_mut().enumerate() {
-                                let kk = k % nx;
-                                *o = if kk <= nx / 2 {
-                                    output[kk]
-                                } else {
-                                    output[nx - kk].conj()
-                                };
-                            }
+            let basis = m.basis;
+            let (wx, wy) = (&p.wx, &p.wy);
+            let (prev, cur, rowbuf, r2c, s_at) = (&mut prev, &mut cur, &mut rowbuf, &r2c, &s_at);
+            in_pool(&pool, move || {
+                let rows = prev
+                    .par_chunks_mut(mx)
+                    .zip(cur.par_chunks_mut(mx))
+                    .zip(rowbuf.par_chunks_mut(ncols))
+                    .enumerate();
+                rows.for_each_init(
+                    || {
+                        (
+                            r2c.make_input_vec(),
+                            r2c.make_output_vec(),
+                            r2c.make_scratch_vec(),
+                        )
+                    },
+                    |(input, output, scratch), (ru, ((pv, cv), out_row))| {
+                        for c in 0..mx {
+                            let b = match (basis, n) {
+                                (_, 0) => 1.0,
+                                (_, 1) => s_at(ru, c),
+                                (Basis::Chebyshev, _) => 2.0 * s_at(ru, c) * cv[c] - pv[c],
+                                (Basis::Taylor, _) => s_at(ru, c) * cv[c],
+                            };
+                            pv[c] = cv[c];
+                            cv[c] = b;
+                            input[c] = b * wx[c] * wy[ru];
                         }
-                    });
-                }
+                        input[mx..].iter_mut().for_each(|v| *v = 0.0);
+                        r2c.process_with_scratch(input, output, scratch)
+                            .expect("fft sizes");
+                        for (k, o) in out_row.iter_mut().enumerate() {
+                            let kk = k % nx;
+                            *o = if kk <= nx / 2 {
+                                output[kk]
+                            } else {
+                                output[nx - kk].conj()
+                            };
+                        }
+                    },
+                );
             });
         }
-        // 4+5: column FFTs, columns split among threads; scatter serially.
-        let col_ranges = split_ranges(ncols, threads);
-        let results: Vec<Vec<Complex64>> = std::thread::scope(|sc| {
-            let handles: Vec<_> = col_ranges
-                .iter()
-                .map(|range| {
-                    let cfft = cfft.clone();
-                    let rowbuf = &rowbuf;
-                    let (phx, phy) = (&phx, &phy);
-                    let range = range.clone();
-                    sc.spawn(move || {
-                        let mut buf = vec![Complex64::new(0.0, 0.0); ny];
-                        let mut scratch =
-                            vec![Complex64::new(0.0, 0.0); cfft.get_inplace_scratch_len()];
-                        let mut out = Vec::with_capacity(range.len() * chh);
-                        for k in range {
-                            for (ru, b) in buf.iter_mut().enumerate().take(my) {
-                                *b = rowbuf[ru * ncols + k];
-                            }
-                            buf[my..]
-                                .iter_mut()
-                                .for_each(|v| *v = Complex64::new(0.0, 0.0));
-                            cfft.process_with_scratch(&mut buf, &mut scratch);
-                            for (j, kyv) in (-ky..=ky).enumerate() {
-                                let kk = kyv.rem_euclid(ny as i64) as usize;
-                                out.push(buf[kk] * phx[k] * phy[j]);
-                            }
+        // 4+5: column FFTs, one task per column (results in column order); scatter serially.
+        let rowbuf = &rowbuf;
+        let results: Vec<Vec<Complex64>> = in_pool(&pool, || {
+            (0..ncols)
+                .into_par_iter()
+                .map_init(
+                    || {
+                        (
+                            vec![Complex64::new(0.0, 0.0); ny],
+                            vec![Complex64::new(0.0, 0.0); cfft.get_inplace_scratch_len()],
+                        )
+                    },
+                    |(buf, scratch), k| {
+                        for (ru, b) in buf.iter_mut().enumerate().take(my) {
+                            *b = rowbuf[ru * ncols + k];
                         }
-                        out
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().expect("worker"))
+                        buf[my..]
+                            .iter_mut()
+                            .for_each(|v| *v = Complex64::new(0.0, 0.0));
+                        cfft.process_with_scratch(buf, scratch);
+                        (-ky..=ky)
+                            .enumerate()
+                            .map(|(j, kyv)| {
+                                let kk = kyv.rem_euclid(ny as i64) as usize;
+                                buf[kk] * phx[k] * phy[j]
+                            })
+                            .collect()
+                    },
+                )
                 .collect()
         });
         let layer = &mut terms[2 * n * lt..2 * (n + 1) * lt];
@@ -537,10 +518,9 @@ pub fn run(
             let lo = -((mm / 2) as i64);
             !tiled || (k >= lo && k < lo + mm as i64)
         };
-        for (range, res) in col_ranges.iter().zip(results) {
-            for (i, k) in range.clone().enumerate() {
-                for j in 0..chh {
-                    let v = res[i * chh + j];
+        for (k, res) in results.iter().enumerate() {
+            {
+                for (j, &v) in res.iter().enumerate().take(chh) {
                     let kys = j as i64 - ky;
                     let (tx, ty) = (kx as usize + k, j);
                     let (txn, tyn) = (kx as usize - k, chh - 1 - j);

@@ -211,33 +211,26 @@ pub fn render_prepared_linear(p: &Prepared, opts: &Options) -> Result<LinearImag
 }
 
 /// Run `f(row index, row)` over the rows of `buf` on `threads` workers (0: all
-/// cores). Rows are dealt round-robin; the result does not depend on the count.
+/// cores, on rayon). Each row is one task; the result does not depend on the count.
 fn for_rows<T: Send>(
     buf: &mut [T],
     width: usize,
     threads: usize,
-    f: impl Fn(usize, &mut [T]) + Sync,
+    f: impl Fn(usize, &mut [T]) + Sync + Send,
 ) {
-    let threads = if threads == 0 {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    } else {
-        threads
+    use rayon::prelude::*;
+    let mut run = || {
+        buf.par_chunks_mut(width.max(1))
+            .enumerate()
+            .for_each(|(j, row)| f(j, row))
     };
-    type Rows<'a, T> = Vec<(usize, &'a mut [T])>;
-    let mut per_thread: Vec<Rows<T>> = (0..threads).map(|_| Vec::new()).collect();
-    for (j, row) in buf.chunks_mut(width.max(1)).enumerate() {
-        per_thread[j % threads].push((j, row));
+    match threads {
+        0 => run(),
+        n => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
+            Ok(pool) => pool.install(run),
+            Err(_) => run(),
+        },
     }
-    std::thread::scope(|sc| {
-        for work in per_thread {
-            let f = &f;
-            sc.spawn(move || {
-                for (j, row) in work {
-                    f(j, row);
-                }
-            });
-        }
-    });
 }
 
 /// Render an already prepared scene (display values). With `opts.samples > 1`
@@ -251,30 +244,10 @@ pub fn render_prepared(p: &Prepared, opts: &Options) -> Image {
     let [w, h] = opts.size.unwrap_or(p.scene.size);
     let gbuf = raster::rasterise(p, w, h);
     let shader = shade::Shader::new(p, opts);
-    let threads = if opts.threads == 0 {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    } else {
-        opts.threads
-    };
     let mut rgb = vec![[0.0f32; 3]; (w as usize) * (h as usize)];
-    let rows: Vec<&mut [[f32; 3]]> = rgb.chunks_mut(w as usize).collect();
-    type Rows<'a> = Vec<(usize, &'a mut [[f32; 3]])>;
-    let mut per_thread: Vec<Rows> = (0..threads).map(|_| Vec::new()).collect();
-    for (j, row) in rows.into_iter().enumerate() {
-        per_thread[j % threads].push((j, row));
-    }
-    std::thread::scope(|s| {
-        for work in per_thread {
-            let gbuf = &gbuf;
-            let shader = &shader;
-            s.spawn(move || {
-                for (j, row) in work {
-                    for (i, px) in row.iter_mut().enumerate() {
-                        let frag = &gbuf[j * w as usize + i];
-                        *px = shader.display(frag).map(|v| v as f32);
-                    }
-                }
-            });
+    for_rows(&mut rgb, w as usize, opts.threads, |j, row| {
+        for (i, px) in row.iter_mut().enumerate() {
+            *px = shader.display(&gbuf[j * w as usize + i]).map(|v| v as f32);
         }
     });
     Image {

@@ -395,9 +395,7 @@ impl Renderer {
                             let i = ((at / dt).floor() as usize).min(tt.len() - 1);
                             tt[i] as usize
                         };
-                        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-                        let rt =
-                            crate::table::build(pack, &samples, settings.table, &terms_at, threads);
+                        let rt = crate::table::build(pack, &samples, settings.table, &terms_at);
                         let bytes = (rt.data.len() * 16) as u64;
                         if bytes > max_binding {
                             return Err(Error::input(format!(

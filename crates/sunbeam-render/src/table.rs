@@ -11,6 +11,8 @@
 //! interpolation: `A = sum_n c_n D_n` on the crop, then the x taps for every
 //! table column, then the y taps for every table row.
 
+use rayon::prelude::*;
+
 use sunbeam_pack::{kernel, series, Model, Pack};
 use sunbeam_raster::spectral::Samples;
 
@@ -86,7 +88,6 @@ pub fn build(
     samples: &Samples,
     dims: Dims,
     terms_at: &(dyn Fn(f64) -> usize + Sync),
-    threads: usize,
 ) -> ResponseTable {
     let m = &pack.manifest;
     let (nu, nv, nw) = (dims.nu.max(2), dims.nv.max(2), dims.nw.max(2));
@@ -97,129 +98,121 @@ pub fn build(
     let layer = cw * ch;
     let ntaps = m.kernel.taps;
     let mut data = vec![[0.0f32; 4]; nu * nv * nw];
-    let threads = threads.max(1);
-    let slices: Vec<(usize, &mut [[f32; 4]])> = data.chunks_mut(nu * nv).enumerate().collect();
-    // One list of (w slice index, slice) per worker thread.
-    type Slice<'a> = (usize, &'a mut [[f32; 4]]);
-    let mut work: Vec<Vec<Slice>> = (0..threads).map(|_| Vec::new()).collect();
-    for (k, s) in slices {
-        work[k % threads].push((k, s));
-    }
-    std::thread::scope(|sc| {
-        for job in work {
-            sc.spawn(move || {
-                let mut a = vec![C::default(); layer];
-                let mut b = vec![C::default(); ch * nu]; // x-interpolated rows
-                let mut acc = vec![[0.0f64; 3]; nu * nv];
-                let mut wx = vec![0.0; nu * ntaps];
-                let mut kx0 = vec![0i64; nu];
-                let mut xok = vec![false; nu];
-                let mut wy = vec![0.0; ntaps];
-                for (iw, out) in job {
-                    let w = W_MIN + iw as f64 * dw;
-                    acc.iter_mut().for_each(|v| *v = [0.0; 3]);
-                    for s in &samples.0 {
-                        let lam = s.lambda_m;
-                        let t = pack.t(w, lam);
-                        let n = terms_at(t.abs()).clamp(1, m.terms);
-                        let c = series::coefficients_f64(m.basis, t, n);
-                        // A = sum_n c_n D_n over the crop (|A|^2 for the tiled model, in re).
-                        for (i, ai) in a.iter_mut().enumerate() {
-                            let mut re = 0.0;
-                            let mut im = 0.0;
-                            for (q, cn) in c.iter().enumerate() {
-                                let j = 2 * (q * layer + i);
-                                let (dr, di) = (pack.terms[j] as f64, pack.terms[j + 1] as f64);
-                                re += cn[0] * dr - cn[1] * di;
-                                im += cn[0] * di + cn[1] * dr;
-                            }
-                            *ai = match m.model {
-                                Model::Window => C { re, im },
-                                Model::Tiled => C {
-                                    re: re * re + im * im,
-                                    im: 0.0,
-                                },
-                            };
-                        }
-                        // x pass
-                        for iu in 0..nu {
-                            let u = U_MIN + iu as f64 * du;
-                            let kappa = -u / lam * m.bin_scale_m[0];
-                            if kappa.abs() > m.crop.kx as f64 + ntaps as f64 {
-                                xok[iu] = false;
-                                continue;
-                            }
-                            let (k0, any) = taps(
-                                m,
-                                kappa,
-                                m.crop.kx,
-                                0,
-                                &mut wx[iu * ntaps..(iu + 1) * ntaps],
-                            );
-                            kx0[iu] = k0;
-                            xok[iu] = any;
-                        }
-                        for ty in 0..ch {
-                            let row = &a[ty * cw..(ty + 1) * cw];
-                            for iu in 0..nu {
-                                if !xok[iu] {
-                                    continue;
-                                }
-                                let mut sre = 0.0;
-                                let mut sim = 0.0;
-                                for j in 0..ntaps {
-                                    let wt = wx[iu * ntaps + j];
-                                    if wt != 0.0 {
-                                        let v = row[(kx0[iu] + j as i64) as usize];
-                                        sre += wt * v.re;
-                                        sim += wt * v.im;
-                                    }
-                                }
-                                b[ty * nu + iu] = C { re: sre, im: sim };
-                            }
-                        }
-                        // y pass
-                        for iv in 0..nv {
-                            let v = U_MIN + iv as f64 * dv;
-                            let kappa = -v / lam * m.bin_scale_m[1];
-                            if kappa.abs() > m.crop.ky as f64 + ntaps as f64 {
-                                continue;
-                            }
-                            let (k0, any) = taps(m, kappa, m.crop.ky, 1, &mut wy);
-                            if !any {
-                                continue;
-                            }
-                            for iu in 0..nu {
-                                if !xok[iu] {
-                                    continue;
-                                }
-                                let mut sre = 0.0;
-                                let mut sim = 0.0;
-                                for (j, &wt) in wy.iter().enumerate().take(ntaps) {
-                                    if wt != 0.0 {
-                                        let q = b[(k0 + j as i64) as usize * nu + iu];
-                                        sre += wt * q.re;
-                                        sim += wt * q.im;
-                                    }
-                                }
-                                let r = match m.model {
-                                    Model::Window => sre * sre + sim * sim,
-                                    Model::Tiled => sre,
-                                };
-                                let cell = &mut acc[iv * nu + iu];
-                                for (c, w) in cell.iter_mut().zip(&s.weight) {
-                                    *c += r * w;
-                                }
-                            }
-                        }
+    data.par_chunks_mut(nu * nv).enumerate().for_each_init(
+        || {
+            (
+                vec![C::default(); layer],
+                vec![C::default(); ch * nu], // x-interpolated rows
+                vec![[0.0f64; 3]; nu * nv],
+                vec![0.0; nu * ntaps],
+                vec![0i64; nu],
+                vec![false; nu],
+                vec![0.0; ntaps],
+            )
+        },
+        |(a, b, acc, wx, kx0, xok, wy), (iw, out)| {
+            let w = W_MIN + iw as f64 * dw;
+            acc.iter_mut().for_each(|v| *v = [0.0; 3]);
+            for s in &samples.0 {
+                let lam = s.lambda_m;
+                let t = pack.t(w, lam);
+                let n = terms_at(t.abs()).clamp(1, m.terms);
+                let c = series::coefficients_f64(m.basis, t, n);
+                // A = sum_n c_n D_n over the crop (|A|^2 for the tiled model, in re).
+                for (i, ai) in a.iter_mut().enumerate() {
+                    let mut re = 0.0;
+                    let mut im = 0.0;
+                    for (q, cn) in c.iter().enumerate() {
+                        let j = 2 * (q * layer + i);
+                        let (dr, di) = (pack.terms[j] as f64, pack.terms[j + 1] as f64);
+                        re += cn[0] * dr - cn[1] * di;
+                        im += cn[0] * di + cn[1] * dr;
                     }
-                    for (o, v) in out.iter_mut().zip(&acc) {
-                        *o = [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
+                    *ai = match m.model {
+                        Model::Window => C { re, im },
+                        Model::Tiled => C {
+                            re: re * re + im * im,
+                            im: 0.0,
+                        },
+                    };
+                }
+                // x pass
+                for iu in 0..nu {
+                    let u = U_MIN + iu as f64 * du;
+                    let kappa = -u / lam * m.bin_scale_m[0];
+                    if kappa.abs() > m.crop.kx as f64 + ntaps as f64 {
+                        xok[iu] = false;
+                        continue;
+                    }
+                    let (k0, any) = taps(
+                        m,
+                        kappa,
+                        m.crop.kx,
+                        0,
+                        &mut wx[iu * ntaps..(iu + 1) * ntaps],
+                    );
+                    kx0[iu] = k0;
+                    xok[iu] = any;
+                }
+                for ty in 0..ch {
+                    let row = &a[ty * cw..(ty + 1) * cw];
+                    for iu in 0..nu {
+                        if !xok[iu] {
+                            continue;
+                        }
+                        let mut sre = 0.0;
+                        let mut sim = 0.0;
+                        for j in 0..ntaps {
+                            let wt = wx[iu * ntaps + j];
+                            if wt != 0.0 {
+                                let v = row[(kx0[iu] + j as i64) as usize];
+                                sre += wt * v.re;
+                                sim += wt * v.im;
+                            }
+                        }
+                        b[ty * nu + iu] = C { re: sre, im: sim };
                     }
                 }
-            });
-        }
-    });
+                // y pass
+                for iv in 0..nv {
+                    let v = U_MIN + iv as f64 * dv;
+                    let kappa = -v / lam * m.bin_scale_m[1];
+                    if kappa.abs() > m.crop.ky as f64 + ntaps as f64 {
+                        continue;
+                    }
+                    let (k0, any) = taps(m, kappa, m.crop.ky, 1, wy);
+                    if !any {
+                        continue;
+                    }
+                    for iu in 0..nu {
+                        if !xok[iu] {
+                            continue;
+                        }
+                        let mut sre = 0.0;
+                        let mut sim = 0.0;
+                        for (j, &wt) in wy.iter().enumerate().take(ntaps) {
+                            if wt != 0.0 {
+                                let q = b[(k0 + j as i64) as usize * nu + iu];
+                                sre += wt * q.re;
+                                sim += wt * q.im;
+                            }
+                        }
+                        let r = match m.model {
+                            Model::Window => sre * sre + sim * sim,
+                            Model::Tiled => sre,
+                        };
+                        let cell = &mut acc[iv * nu + iu];
+                        for (c, w) in cell.iter_mut().zip(&s.weight) {
+                            *c += r * w;
+                        }
+                    }
+                }
+            }
+            for (o, v) in out.iter_mut().zip(acc.iter()) {
+                *o = [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
+            }
+        },
+    );
     ResponseTable {
         dims: Dims { nu, nv, nw },
         du,
