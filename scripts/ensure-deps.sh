@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Install what `make test` / `make demo` need when it is missing: Debian packages
-# (software Vulkan/GL drivers, Xvfb, OpenEXR tools, Ninja) and the npm validators
+# (software Vulkan/GL drivers, Xvfb, OpenEXR tools, Ninja, glslang and SPIRV-Tools) and the npm validators
 # (glTF-Validator, three.js) under tests/node. Idempotent; quiet when all is there.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PKGS="mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth openimageio-tools ninja-build"
+PKGS="mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth openimageio-tools ninja-build glslang-tools spirv-tools"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

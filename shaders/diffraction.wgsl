@@ -19,7 +19,7 @@
 
 const MAX_TERMS: u32 = 64u;
 const MAX_TAPS: u32 = 16u;
-const TAU: f32 = 6.283185307179586;
+const TAU: f32 = SB_TAU;
 
 struct Globals {
     view_proj: mat4x4<f32>,
@@ -384,82 +384,23 @@ fn response_xyz(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
 }
 
 // ---------------------------------------------------------------- response map
-// Continuous texel coordinates (angle, radius, s) of (u, v, w), texel centres at
-// integers (crates/sunbeam-response/src/grid.rs).
-fn resp_coords(uvw: vec3<f32>) -> vec3<f32> {
-    let r = length(uvw.xy);
-    var th = atan2(uvw.y, uvw.x);
-    if (th < 0.0) {
-        th = th + TAU;
-    }
-    let rho = clamp(asinh(r / mat.resp_r0) / mat.resp_rho_scale, 0.0, 1.0);
-    let s = clamp(-uvw.z / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
-    return vec3<f32>(th / TAU * mat.resp_n_theta, rho * (mat.resp_n_rho - 1.0), s * (mat.resp_n_s - 1.0));
+// The material functions are in shaders/response_map.wgsl (prepended to this file).
+fn resp_grid() -> SbGrid {
+    return SbGrid(vec3<f32>(mat.resp_n_theta, mat.resp_n_rho, mat.resp_n_s), mat.resp_r0, mat.resp_rho_scale, g.f0);
 }
 
-// Derivative of the angle coordinate (texels) along a screen direction, from
-// those of u and v (no jump where the angle wraps).
-fn resp_dtheta(uv: vec2<f32>, duv: vec2<f32>) -> f32 {
-    let r2 = max(dot(uv, uv), 1e-12);
-    return (uv.x * duv.y - uv.y * duv.x) / r2 * mat.resp_n_theta / TAU;
-}
-
-fn resp_sample(c: vec3<f32>) -> vec3<f32> {
-    let n = vec3<f32>(mat.resp_n_theta, mat.resp_n_rho, mat.resp_n_s);
-    let cc = vec3<f32>(c.x, clamp(c.y, 0.0, n.y - 1.0), clamp(c.z, 0.0, n.z - 1.0));
-    return textureSampleLevel(resp_tex, resp_smp, (cc + 0.5) / n, 0.0).xyz;
-}
-
-// G T over the pixel (XYZ): the footprint is the parallelogram spanned by the
-// screen derivatives of (u, v, w); up to 4 x 4 stratified samples cover it (a box
-// filter, as a camera pixel integrates), as many per axis as texels it spans,
-// one when it is within a texel. Each sample has its own (u, v, w), so its own
-// texel coordinates and gain G(wi, wr') with wr' = -(u, v, w)' - wi.
 fn response_map_xyz(wi: vec3<f32>, uvw: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, jx: vec3<f32>, jy: vec3<f32>) -> vec3<f32> {
-    var nx = 1u;
-    var ny = 1u;
+    let gr = resp_grid();
     if (mat.resp_footprint == 1u) {
-        nx = u32(clamp(ceil(length(jx)), 1.0, 4.0));
-        ny = u32(clamp(ceil(length(jy)), 1.0, 4.0));
+        return sb_diffraction_xyz_filtered(wi, uvw, dx, dy, jx, jy, gr);
     }
-    if (nx * ny == 1u) {
-        return resp_sample(resp_coords(uvw)) * gain(wi, -uvw - wi);
-    }
-    var acc = vec3<f32>(0.0);
-    for (var a = 0u; a < nx; a = a + 1u) {
-        for (var b = 0u; b < ny; b = b + 1u) {
-            let ox = (f32(a) + 0.5) / f32(nx) - 0.5;
-            let oy = (f32(b) + 0.5) / f32(ny) - 0.5;
-            let q = uvw + ox * dx + oy * dy;
-            let wr = normalize(-q - wi);
-            acc = acc + resp_sample(resp_coords(-wi - wr)) * gain(wi, wr);
-        }
-    }
-    return acc / f32(nx * ny);
+    return sb_diffraction_xyz(wi, -uvw - wi, gr);
 }
 
 // ---------------------------------------------------------------- colour
-fn schlick(c: f32) -> f32 {
-    let m = 1.0 - clamp(c, 0.0, 1.0);
-    return g.f0 + (1.0 - g.f0) * m * m * m * m * m;
-}
-
-// sunbeam_optics::gain::g
+// sunbeam_optics::gain::g (shaders/response_map.wgsl)
 fn gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    let ci = wi.z;
-    let cr = wr.z;
-    if (!(ci > 0.0 && cr > 0.0)) {
-        return 0.0;
-    }
-    let s = wi + wr;
-    let len = length(s);
-    var ch = 0.0;
-    if (len > 0.0) {
-        ch = dot(wi, s) / len;
-    }
-    let f = schlick(ch);
-    let d = 1.0 + dot(wi, wr);
-    return (f * f * d * d) / (g.f0 * g.f0 * (ci + cr) * (ci + cr) * cr);
+    return sb_gain(wi, wr, g.f0);
 }
 
 fn srgb_oetf(y: f32) -> f32 {
@@ -539,13 +480,14 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         // Response-map coordinates and their screen derivatives, here in uniform
         // control flow (derivatives are undefined inside the branch below).
         let uvw = -wi_l - wr_l;
-        let rc = resp_coords(uvw);
+        let gr = resp_grid();
+        let rc = sb_resp_coords(uvw, gr);
         let duv_x = dpdx(uvw.xy);
         let duv_y = dpdy(uvw.xy);
         let dw_x = dpdx(uvw.z);
         let dw_y = dpdy(uvw.z);
-        let jx = vec3<f32>(resp_dtheta(uvw.xy, duv_x), dpdx(rc.y), dpdx(rc.z));
-        let jy = vec3<f32>(resp_dtheta(uvw.xy, duv_y), dpdy(rc.y), dpdy(rc.z));
+        let jx = vec3<f32>(sb_resp_dtheta(uvw.xy, duv_x, gr), dpdx(rc.y), dpdx(rc.z));
+        let jy = vec3<f32>(sb_resp_dtheta(uvw.xy, duv_y, gr), dpdy(rc.y), dpdy(rc.z));
         var diff = vec3<f32>(0.0);
         if (diffract && dw < 1.0 && wi_l.z > 0.0 && wr_l.z > 0.0) {
             var xyz: vec3<f32>;

@@ -13,6 +13,7 @@
 //! # let _ = image;
 //! ```
 
+pub mod export;
 pub mod gpu;
 pub mod renderer;
 pub mod response;

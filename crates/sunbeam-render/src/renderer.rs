@@ -12,8 +12,13 @@ use sunbeam_raster::{Image, LinearImage, Prepared};
 use sunbeam_scene::{camera, Camera, Light};
 use wgpu::util::DeviceExt;
 
-/// The WGSL source (shaders/diffraction.wgsl).
-pub const SHADER: &str = include_str!("../../../shaders/diffraction.wgsl");
+/// The WGSL source: the response-map material (shaders/response_map.wgsl, also
+/// what `--export-shader` translates) and the player's shading
+/// (shaders/diffraction.wgsl).
+pub const SHADER: &str = concat!(
+    include_str!("../../../shaders/response_map.wgsl"),
+    include_str!("../../../shaders/diffraction.wgsl")
+);
 
 /// Most lights a frame shades with.
 pub const MAX_LIGHTS: usize = 4;

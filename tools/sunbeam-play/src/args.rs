@@ -84,6 +84,10 @@ pub(crate) struct Cli {
     /// Write a Make depfile for -o.
     #[arg(long)]
     pub(crate) depfile: Option<PathBuf>,
+    /// Write the diffraction material's shader for another engine to -o and exit:
+    /// glsl (4.50), glsl-es (3.00, WebGL2), hlsl, msl, spv (SPIR-V), wgsl (docs/ENGINES.md).
+    #[arg(long, value_name = "LANG", value_parser = sunbeam_common::cli::one_of::<sunbeam_render::export::Lang>(&sunbeam_render::export::Lang::NAMES))]
+    pub(crate) export_shader: Option<sunbeam_render::export::Lang>,
     /// Less output.
     #[arg(short, long)]
     pub(crate) quiet: bool,

@@ -104,6 +104,9 @@ fn inputs(p: &Prepared, cli: &Cli) -> Vec<PathBuf> {
 }
 
 pub(crate) fn run(cli: Cli) -> Result<()> {
+    if let Some(lang) = cli.export_shader {
+        return export_shader(lang, &cli);
+    }
     let scene = load_scene(&cli)?;
     let st = settings(&cli)?;
     let backend: Backend = cli.backend.parse()?;
@@ -228,6 +231,24 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     }
     if cli.json {
         println!("{report}");
+    }
+    Ok(())
+}
+
+/// `--export-shader LANG -o FILE`: the material for another engine (docs/ENGINES.md).
+fn export_shader(lang: sunbeam_render::export::Lang, cli: &Cli) -> Result<()> {
+    let out = cli
+        .output
+        .as_ref()
+        .ok_or_else(|| Error::usage("--export-shader needs -o FILE"))?;
+    let bytes = sunbeam_render::export::export(lang)?;
+    sunbeam_common::output::write_atomic(out, &bytes)?;
+    if !cli.quiet {
+        eprintln!(
+            "sunbeam-play: wrote {} ({} bytes)",
+            out.display(),
+            bytes.len()
+        );
     }
     Ok(())
 }
