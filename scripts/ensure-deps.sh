@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Install what `make test` / `make demo` need when it is missing: Debian packages
-# (software Vulkan/GL drivers, Xvfb, OpenEXR tools, Ninja, glslang and SPIRV-Tools) and the npm validators
-# (glTF-Validator, three.js) under tests/node. Idempotent; quiet when all is there.
+# (software Vulkan/GL drivers, Xvfb, OpenEXR tools, Ninja, glslang and SPIRV-Tools, Chromium) and the
+# npm packages (glTF-Validator, three.js, playwright-core) under tests/node. Idempotent; quiet when all is there.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PKGS="mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth openimageio-tools ninja-build glslang-tools spirv-tools"
+PKGS="mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth openimageio-tools ninja-build glslang-tools spirv-tools chromium"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
@@ -18,7 +18,7 @@ if [ -n "$missing" ]; then
   for i in 1 2 3 4 5 6; do $SUDO apt-get install -y -qq --no-install-recommends $missing >/dev/null && break; sleep 10; done
 fi
 
-if [ -f tests/node/package.json ] && [ ! -d tests/node/node_modules ]; then
+if [ -f tests/node/package.json ] && { [ ! -d tests/node/node_modules ] || [ ! -d tests/node/node_modules/playwright-core ]; }; then
   command -v npm >/dev/null || { echo "ensure-deps: npm not found (apt-get install nodejs npm)" >&2; exit 1; }
   echo "ensure-deps: installing npm validators in tests/node" >&2
   (cd tests/node && for i in 1 2 3; do npm ci --no-audit --no-fund --loglevel=error && break; sleep 5; done)

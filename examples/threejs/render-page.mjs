@@ -1,0 +1,84 @@
+// The page render.mjs drives in headless Chromium: window.sunbeamRender(job)
+// draws the scene with three.js into a float target at K x K times the frame
+// size, box-filters it in linear light and returns the linear RGB pixels
+// (rows top first, exposure applied), as sunbeam-eval render --samples K*K does.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import {
+  adaptExportedGlsl, addOrientation, builtinGeometry, parseResponseMap, sceneCamera,
+  sunbeamMaterial, updateSunbeamUniforms,
+} from './sunbeam-three.mjs';
+
+// Colours are linear values as given (no sRGB conversion of inputs or outputs).
+THREE.ColorManagement.enabled = false;
+
+window.sunbeamRender = async (job) => {
+  try {
+    const { scene: desc, meshes, size, supersample: k, glsl } = job;
+    const [w, h] = size;
+    const W = w * k, H = h * k;
+    const canvas = document.createElement('canvas');
+    canvas.width = W;
+    canvas.height = H;
+    document.body.appendChild(canvas);
+    const renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
+    renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
+    const gl = renderer.getContext();
+    const exported = adaptExportedGlsl(glsl);
+    const scale = Math.pow(2, desc.exposure);
+    const root = new THREE.Scene();
+    for (const m of meshes) {
+      const map = m.map ? parseResponseMap(await (await fetch(m.map)).arrayBuffer()) : null;
+      const material = sunbeamMaterial({
+        exportedGlsl: exported, map, baseColor: m.baseColor, diffuseWeight: m.diffuseWeight,
+        lights: desc.lights, exposure: desc.exposure,
+      });
+      if (m.builtin) {
+        root.add(new THREE.Mesh(builtinGeometry(m.builtin), material));
+      } else {
+        const gltf = await new GLTFLoader().loadAsync(m.url);
+        gltf.scene.traverse((o) => {
+          if (o.isMesh) {
+            addOrientation(o.geometry);
+            o.material = material;
+          }
+        });
+        root.add(gltf.scene);
+      }
+    }
+    const camera = sceneCamera(desc, w / h);
+    root.updateMatrixWorld(true);
+    updateSunbeamUniforms(root, camera);
+    const rt = new THREE.WebGLRenderTarget(W, H, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true });
+    renderer.setRenderTarget(rt);
+    const bg = desc.background;
+    renderer.setClearColor(new THREE.Color(bg[0] * scale, bg[1] * scale, bg[2] * scale), 1);
+    renderer.render(root, camera);
+    const buf = new Float32Array(W * H * 4);
+    renderer.readRenderTargetPixels(rt, 0, 0, W, H, buf);
+    // Box filter K x K in linear light; WebGL rows run bottom-up.
+    const rgb = new Array(w * h * 3).fill(0);
+    for (let y = 0; y < h; y++) {
+      for (let x = 0; x < w; x++) {
+        let r = 0, g = 0, b = 0;
+        for (let j = 0; j < k; j++) {
+          const row = H - 1 - (y * k + j);
+          for (let i = 0; i < k; i++) {
+            const p = 4 * (row * W + x * k + i);
+            r += buf[p]; g += buf[p + 1]; b += buf[p + 2];
+          }
+        }
+        const o = 3 * (y * w + x);
+        rgb[o] = r / (k * k); rgb[o + 1] = g / (k * k); rgb[o + 2] = b / (k * k);
+      }
+    }
+    const dbg = gl.getExtension('WEBGL_debug_renderer_info');
+    const name = dbg ? gl.getParameter(dbg.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);
+    const glError = gl.getError();
+    if (glError !== gl.NO_ERROR) return { error: `WebGL error 0x${glError.toString(16)}` };
+    renderer.dispose();
+    return { rgb, renderer: name };
+  } catch (e) {
+    return { error: `three.js: ${e.message}` };
+  }
+};

@@ -1,0 +1,261 @@
+// Render a Sunbeam scene file (docs/SCENE.md) with three.js in headless
+// Chromium, as a browser would draw it:
+//
+//   node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K]
+//
+// - the material is sunbeam-three.mjs: the GLSL ES that
+//   `sunbeam-play --export-shader glsl-es` writes from the player's WGSL
+//   (SUNBEAM_PLAY or ../../target/release/sunbeam-play, or --glsl FILE);
+// - each mesh's pack is read through its response map, NAME.response.ktx2
+//   beside the pack (`sunbeam-pack --response`);
+// - the frame is rendered into a float target at K x K times the size (default
+//   K = 4) and box-filtered in linear light (a pixel is the average over its
+//   area), then written as PNG (exposure, clip at 1, sRGB curve: what
+//   sunbeam-eval render and sunbeam-play write) and, with --exr, as a linear
+//   OpenEXR (exposure applied, no tone curve) for comparisons.
+//
+// Needs three and playwright-core next to it (node_modules) and Debian's
+// chromium (CHROMIUM or /usr/bin/chromium; playwright gives it a fresh
+// temporary profile). WebGL2 runs on SwiftShader.
+import { readFileSync, writeFileSync, existsSync, mkdtempSync, rmSync, renameSync } from 'node:fs';
+import { createServer } from 'node:http';
+import { tmpdir } from 'node:os';
+import { dirname, join, resolve, extname, basename } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { execFileSync } from 'node:child_process';
+import zlib from 'node:zlib';
+
+const here = dirname(fileURLToPath(import.meta.url));
+
+function usage(msg) {
+  if (msg) console.error(`render.mjs: error: ${msg}`);
+  console.error('usage: node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--glsl FILE]');
+  process.exit(1);
+}
+
+function fail(code, msg) {
+  console.error(`render.mjs: error: ${msg}`);
+  process.exit(code);
+}
+
+// ---- arguments -----------------------------------------------------------------
+const args = process.argv.slice(2);
+const opt = { supersample: 4 };
+for (let i = 0; i < args.length; i++) {
+  const a = args[i];
+  const next = () => (i + 1 < args.length ? args[++i] : usage(`${a} needs a value`));
+  if (a === '-o' || a === '--output') opt.output = next();
+  else if (a === '--exr') opt.exr = next();
+  else if (a === '--size') {
+    const m = /^(\d+)x(\d+)$/.exec(next());
+    if (!m || +m[1] < 1 || +m[2] < 1 || +m[1] > 8192 || +m[2] > 8192) usage('--size: expected WxH');
+    opt.size = [+m[1], +m[2]];
+  } else if (a === '--supersample') {
+    opt.supersample = Number(next());
+    if (!Number.isInteger(opt.supersample) || opt.supersample < 1 || opt.supersample > 8) usage('--supersample: 1..8');
+  } else if (a === '--glsl') opt.glsl = next();
+  else if (a === '-h' || a === '--help') usage();
+  else if (a.startsWith('-')) usage(`unknown option ${a}`);
+  else if (!opt.scene) opt.scene = a;
+  else usage(`unexpected argument ${a}`);
+}
+if (!opt.scene || !opt.output) usage('SCENE.json and -o FRAME.png are required');
+
+// ---- the scene (the same defaults as crates/sunbeam-scene) -------------------------
+let scene;
+try {
+  scene = JSON.parse(readFileSync(opt.scene, 'utf8'));
+} catch (e) {
+  fail(2, `${opt.scene}: ${e.message}`);
+}
+const sceneDir = dirname(resolve(opt.scene));
+if (!scene.camera || !Array.isArray(scene.camera.eye) || !Array.isArray(scene.camera.target)) fail(2, `${opt.scene}: camera.eye and camera.target are required`);
+if (!Array.isArray(scene.meshes) || scene.meshes.length === 0) fail(2, `${opt.scene}: meshes: at least one mesh is required`);
+scene.lights = scene.lights ?? [{ direction: [0.3, 1.0, 0.6], intensity: 1 }];
+scene.exposure = scene.exposure ?? 0;
+scene.background = scene.background ?? [0, 0, 0];
+const size = opt.size ?? scene.size ?? [512, 512];
+
+const problems = []; // what the page or the server reported
+const files = new Map(); // url path -> absolute file
+function serve(abs) {
+  const key = `/fs/${files.size}${extname(abs)}`;
+  files.set(key, abs);
+  return key;
+}
+const meshes = scene.meshes.map((m, i) => {
+  if (typeof m.mesh !== 'string') fail(2, `${opt.scene}: meshes[${i}].mesh is required`);
+  const out = {
+    baseColor: m.base_color ?? [0.05, 0.05, 0.05],
+    diffuseWeight: m.diffuse_weight ?? 0.2,
+  };
+  if (m.mesh.startsWith('builtin:')) out.builtin = m.mesh.slice(8);
+  else {
+    const p = resolve(sceneDir, m.mesh);
+    if (!existsSync(p)) fail(2, `${opt.scene}: meshes[${i}].mesh: ${p} not found`);
+    if (!/\.(glb|gltf)$/i.test(p)) fail(2, `${opt.scene}: meshes[${i}].mesh: three.js path reads glTF/GLB only (${p})`);
+    out.url = serve(p);
+  }
+  if (m.pack) {
+    const p = resolve(sceneDir, m.pack);
+    const side = join(dirname(p), `${basename(p, extname(p))}.response.ktx2`);
+    if (!existsSync(side)) fail(2, `${opt.scene}: meshes[${i}].pack: no response map ${side} (write it with sunbeam-pack --response)`);
+    out.map = serve(side);
+  }
+  return out;
+});
+
+// ---- the exported material -------------------------------------------------------
+let glsl;
+if (opt.glsl) glsl = readFileSync(opt.glsl, 'utf8');
+else {
+  const play = process.env.SUNBEAM_PLAY ?? resolve(here, '../../target/release/sunbeam-play');
+  const tmp = mkdtempSync(join(tmpdir(), 'sunbeam-glsl-'));
+  try {
+    execFileSync(play, ['--export-shader', 'glsl-es', '-o', join(tmp, 'm.frag'), '-q']);
+    glsl = readFileSync(join(tmp, 'm.frag'), 'utf8');
+  } catch (e) {
+    fail(2, `cannot export the material with ${play} (set SUNBEAM_PLAY or --glsl FILE): ${e.message}`);
+  } finally {
+    rmSync(tmp, { recursive: true, force: true });
+  }
+}
+
+// ---- a local server for the page, three and the scene's files ----------------------
+const page = `<!doctype html><html><head><meta charset="utf-8">
+<script type="importmap">{"imports":{"three":"/node_modules/three/build/three.module.js","three/addons/":"/node_modules/three/examples/jsm/"}}</script>
+<script type="module" src="/render-page.mjs"></script></head><body></body></html>`;
+const types = { '.mjs': 'text/javascript', '.js': 'text/javascript', '.html': 'text/html', '.glb': 'model/gltf-binary', '.ktx2': 'image/ktx2', '.json': 'application/json' };
+const server = createServer((req, res) => {
+  const path = decodeURIComponent(new URL(req.url, 'http://x').pathname);
+  let file;
+  if (path === '/favicon.ico') {
+    res.writeHead(204);
+    res.end();
+    return;
+  }
+  if (path === '/render.html') {
+    res.writeHead(200, { 'content-type': 'text/html' });
+    res.end(page);
+    return;
+  } else if (files.has(path)) file = files.get(path);
+  else if (path === '/render-page.mjs' || path === '/sunbeam-three.mjs') file = join(here, path);
+  else if (path.startsWith('/node_modules/three/') && !path.includes('..')) file = join(here, path);
+  if (!file || !existsSync(file)) {
+    problems.push(`404: ${path}`);
+    res.writeHead(404);
+    res.end();
+    return;
+  }
+  res.writeHead(200, { 'content-type': types[extname(file)] ?? 'application/octet-stream' });
+  res.end(readFileSync(file));
+});
+await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
+const base = `http://127.0.0.1:${server.address().port}`;
+
+// ---- headless Chromium -----------------------------------------------------------
+const { chromium } = await import('playwright-core');
+let browser;
+let pixels;
+try {
+  browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+    args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+      '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update',
+      '--disable-sync'],
+  });
+  const p = await browser.newPage();
+  p.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warning') problems.push(`console ${m.type()}: ${m.text()}`); });
+  p.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  await p.goto(`${base}/render.html`);
+  await p.waitForFunction(() => window.sunbeamRender !== undefined, null, { timeout: 60000 });
+  const job = { scene, meshes, size, supersample: opt.supersample, glsl };
+  pixels = await p.evaluate((j) => window.sunbeamRender(j), job);
+} catch (e) {
+  fail(4, `rendering in Chromium failed: ${e.message}${problems.length ? `\n${problems.join('\n')}` : ''}`);
+} finally {
+  if (browser) await browser.close();
+  server.close();
+}
+if (pixels.error) fail(2, pixels.error);
+const errors = problems.filter((s) => !/GPU stall due to ReadPixels|Automatic fallback to software WebGL/.test(s));
+if (errors.length) fail(4, `the page reported problems:\n${errors.join('\n')}`);
+
+// ---- outputs: linear EXR and display PNG ---------------------------------------------
+const [w, h] = size;
+const lin = Float32Array.from(pixels.rgb); // rows top first, RGB, exposure applied
+
+function atomicWrite(path, bytes) {
+  const tmp = join(dirname(resolve(path)), `.${basename(path)}.tmp.${process.pid}`);
+  writeFileSync(tmp, bytes);
+  renameSync(tmp, path);
+}
+
+function pngBytes(rgb8) {
+  const crcTable = [];
+  for (let n = 0; n < 256; n++) {
+    let c = n;
+    for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+    crcTable[n] = c >>> 0;
+  }
+  const crc = (buf) => { let c = 0xffffffff; for (const b of buf) c = crcTable[(c ^ b) & 0xff] ^ (c >>> 8); return (c ^ 0xffffffff) >>> 0; };
+  const chunk = (type, data) => {
+    const len = Buffer.alloc(4); len.writeUInt32BE(data.length);
+    const td = Buffer.concat([Buffer.from(type, 'ascii'), data]);
+    const c = Buffer.alloc(4); c.writeUInt32BE(crc(td));
+    return Buffer.concat([len, td, c]);
+  };
+  const ihdr = Buffer.alloc(13);
+  ihdr.writeUInt32BE(w, 0); ihdr.writeUInt32BE(h, 4); ihdr[8] = 8; ihdr[9] = 2; ihdr[10] = 0; ihdr[11] = 0; ihdr[12] = 0;
+  const raw = Buffer.alloc((w * 3 + 1) * h);
+  for (let y = 0; y < h; y++) {
+    raw[y * (w * 3 + 1)] = 0;
+    rgb8.copy(raw, y * (w * 3 + 1) + 1, y * w * 3, (y + 1) * w * 3);
+  }
+  return Buffer.concat([Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]), chunk('IHDR', ihdr), chunk('IDAT', zlib.deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]);
+}
+
+// sunbeam_optics::colour: clip at 1, sRGB OETF, round to 8 bits.
+const oetf = (x) => (x <= 0.0031308 ? 12.92 * x : 1.055 * Math.pow(x, 1 / 2.4) - 0.055);
+const rgb8 = Buffer.alloc(w * h * 3);
+for (let i = 0; i < w * h * 3; i++) {
+  let x = lin[i];
+  if (!(x > 0)) x = 0;
+  rgb8[i] = Math.round(oetf(Math.min(x, 1)) * 255);
+}
+atomicWrite(opt.output, pngBytes(rgb8));
+
+// Uncompressed scanline OpenEXR, channels B, G, R as FLOAT (alphabetical, as the format wants).
+function exrBytes() {
+  const attrs = [];
+  const attr = (name, type, data) => attrs.push(Buffer.concat([Buffer.from(`${name}\0${type}\0`, 'latin1'), (() => { const b = Buffer.alloc(4); b.writeInt32LE(data.length); return b; })(), data]));
+  const chl = Buffer.concat(['B', 'G', 'R'].map((c) => { const b = Buffer.alloc(c.length + 1 + 16); b.write(c, 0, 'latin1'); b.writeInt32LE(2, c.length + 1); b.writeInt32LE(1, c.length + 9); b.writeInt32LE(1, c.length + 13); return b; }).concat([Buffer.from([0])]));
+  attr('channels', 'chlist', chl);
+  attr('compression', 'compression', Buffer.from([0]));
+  const box = Buffer.alloc(16); box.writeInt32LE(0, 0); box.writeInt32LE(0, 4); box.writeInt32LE(w - 1, 8); box.writeInt32LE(h - 1, 12);
+  attr('dataWindow', 'box2i', box);
+  attr('displayWindow', 'box2i', box);
+  attr('lineOrder', 'lineOrder', Buffer.from([0]));
+  const f = Buffer.alloc(4); f.writeFloatLE(1); attr('pixelAspectRatio', 'float', f);
+  attr('screenWindowCenter', 'v2f', Buffer.alloc(8));
+  attr('screenWindowWidth', 'float', f);
+  const header = Buffer.concat([Buffer.from([0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0]), ...attrs, Buffer.from([0])]);
+  const lineBytes = 8 + w * 12;
+  const table = Buffer.alloc(8 * h);
+  const start = header.length + table.length;
+  const lines = Buffer.alloc(lineBytes * h);
+  for (let y = 0; y < h; y++) {
+    table.writeBigUInt64LE(BigInt(start + y * lineBytes), 8 * y);
+    const o = y * lineBytes;
+    lines.writeInt32LE(y, o); lines.writeInt32LE(w * 12, o + 4);
+    for (let x = 0; x < w; x++) {
+      const p = 3 * (y * w + x);
+      lines.writeFloatLE(lin[p + 2], o + 8 + 4 * x);
+      lines.writeFloatLE(lin[p + 1], o + 8 + 4 * (w + x));
+      lines.writeFloatLE(lin[p], o + 8 + 4 * (2 * w + x));
+    }
+  }
+  return Buffer.concat([header, table, lines]);
+}
+if (opt.exr) atomicWrite(opt.exr, exrBytes());
+console.error(`render.mjs: wrote ${opt.output}${opt.exr ? ` and ${opt.exr}` : ''} (${w}x${h}, ${opt.supersample}x${opt.supersample} samples per pixel, ${pixels.renderer})`);

@@ -1,0 +1,157 @@
+//! examples/threejs/render.mjs (three.js in headless Chromium, WebGL2 on
+//! SwiftShader) against the CPU reference: the same scene file rendered by
+//! `sunbeam-eval render --samples 16` (a different code path: per-pixel spectral
+//! evaluation of the pack, no response map, no GPU), both anti-aliased and
+//! compared in linear light, CIEDE2000 over lit pixels p99 < 2 (issue 12). The
+//! page must load with no WebGL or console errors (render.mjs fails on any).
+//! Scenes: a front-lit sphere and the baked snake, each with a ridge pack.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use sunbeam::{scratch, tool, workspace_root};
+use sunbeam_common::testdata;
+use sunbeam_raster::{compare_linear, LinearImage};
+
+fn run_ok(cmd: &mut Command) -> std::process::Output {
+    let o = cmd.output().expect("run");
+    assert!(
+        o.status.success(),
+        "{cmd:?}: {}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+/// The example next to a node_modules with three and playwright-core, as a user runs it.
+fn example(d: &Path) -> Option<PathBuf> {
+    if !testdata::have_command("node", &[]) || !testdata::have_command("chromium", &["--version"]) {
+        return None;
+    }
+    let modules = workspace_root().join("tests/node/node_modules");
+    if !modules.join("playwright-core/package.json").exists() {
+        if testdata::require_all() {
+            panic!("tests/node/node_modules/playwright-core missing and SUNBEAM_REQUIRE_ALL=1 (run scripts/ensure-deps.sh)");
+        }
+        eprintln!("SKIP: playwright-core not installed in tests/node/node_modules");
+        return None;
+    }
+    let js = d.join("js");
+    std::fs::create_dir_all(&js).unwrap();
+    for f in ["render.mjs", "render-page.mjs", "sunbeam-three.mjs"] {
+        std::fs::copy(
+            workspace_root().join("examples/threejs").join(f),
+            js.join(f),
+        )
+        .unwrap();
+    }
+    std::os::unix::fs::symlink(&modules, js.join("node_modules")).unwrap();
+    Some(js.join("render.mjs"))
+}
+
+fn ridge_pack(d: &Path, name: &str, size: &str, pixel: &str) -> PathBuf {
+    let h = d.join(format!("{name}.exr"));
+    let p = d.join(format!("{name}.ktx2"));
+    run_ok(
+        Command::new(tool("sunbeam-import"))
+            .args([
+                "synthetic:xenopeltis",
+                "--synthetic-size",
+                size,
+                "--synthetic-pixel",
+                pixel,
+                "-q",
+                "-o",
+            ])
+            .arg(&h),
+    );
+    run_ok(
+        Command::new(tool("sunbeam-pack"))
+            .arg(&h)
+            .arg("-o")
+            .arg(&p)
+            .args(["--response", "-q"]),
+    );
+    p
+}
+
+fn compare(render: &Path, d: &Path, scene: &str, name: &str) {
+    let s = d.join(format!("{name}.json"));
+    std::fs::write(&s, scene).unwrap();
+    let (png, exr, reference) = (
+        d.join(format!("{name}.png")),
+        d.join(format!("{name}.exr")),
+        d.join(format!("{name}-ref.exr")),
+    );
+    run_ok(
+        Command::new("node")
+            .arg(render)
+            .arg(&s)
+            .arg("-o")
+            .arg(&png)
+            .arg("--exr")
+            .arg(&exr)
+            .env("SUNBEAM_PLAY", tool("sunbeam-play")),
+    );
+    assert!(png.is_file());
+    run_ok(
+        Command::new(tool("sunbeam-eval"))
+            .arg("render")
+            .arg(&s)
+            .args(["--samples", "16", "-q", "-o"])
+            .arg(&reference),
+    );
+    let a = LinearImage::read_exr(&exr).unwrap();
+    let r = LinearImage::read_exr(&reference).unwrap();
+    let c = compare_linear(&a, &r).unwrap();
+    eprintln!("three.js {name}: {c}");
+    assert!(c.pixels > 200, "{name}: only {} lit pixels", c.pixels);
+    assert!(c.p99 < 2.0, "{name}: three.js vs reference {c}");
+}
+
+#[test]
+fn threejs_renders_the_sphere_and_the_snake_like_the_reference() {
+    let d = scratch("threejs-render");
+    let Some(render) = example(&d) else { return };
+    ridge_pack(&d, "ridges", "256", "20nm");
+    let sphere = r#"{ "camera": { "eye": [0, 0, 1.6], "target": [0, 0, 0], "fov_y_deg": 35 },
+  "lights": [ { "direction": [0.15, 0.1, 1], "intensity": 1 } ],
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1 } ],
+  "exposure": 0, "size": [48, 48] }"#;
+    compare(&render, &d, sphere, "sphere");
+
+    let glb = d.join("snake.glb");
+    run_ok(
+        Command::new(tool("sunbeam-bake"))
+            .arg("--generate-snake")
+            .arg("-o")
+            .arg(&glb)
+            .arg("-q"),
+    );
+    let snake = r#"{ "camera": { "eye": [0, 0.3, 1.0], "target": [0, 0, 0], "fov_y_deg": 35 },
+  "lights": [ { "direction": [0.2, 0.5, 1], "intensity": 1 }, { "direction": [-0.5, 0.3, 0.6], "intensity": 0.5 } ],
+  "meshes": [ { "mesh": "snake.glb", "pack": "ridges.ktx2", "base_color": [0.05, 0.05, 0.05], "diffuse_weight": 0.2 } ],
+  "exposure": 1, "size": [96, 48] }"#;
+    compare(&render, &d, snake, "snake");
+}
+
+#[test]
+fn bad_scenes_exit_non_zero_with_the_field_named() {
+    let d = scratch("threejs-render-bad");
+    let Some(render) = example(&d) else { return };
+    let s = d.join("bad.json");
+    std::fs::write(&s, r#"{ "camera": { "eye": [0, 0, 2], "target": [0, 0, 0] }, "meshes": [ { "mesh": "builtin:sphere", "pack": "missing.ktx2" } ] }"#).unwrap();
+    let o = Command::new("node")
+        .arg(&render)
+        .arg(&s)
+        .arg("-o")
+        .arg(d.join("x.png"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("meshes[0].pack"), "{err}");
+    assert!(!d.join("x.png").exists());
+    let o = Command::new("node").arg(&render).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+}
