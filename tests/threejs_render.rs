@@ -75,9 +75,17 @@ fn ridge_pack(d: &Path, name: &str, size: &str, pixel: &str) -> PathBuf {
     p
 }
 
+/// render.mjs on `scene` against the reference of `ref_scene` (the same
+/// scene unless the material comes from the GLB's extension instead of `pack`).
 fn compare(render: &Path, d: &Path, scene: &str, name: &str) {
+    compare_with(render, d, scene, scene, name)
+}
+
+fn compare_with(render: &Path, d: &Path, scene: &str, ref_scene: &str, name: &str) {
     let s = d.join(format!("{name}.json"));
     std::fs::write(&s, scene).unwrap();
+    let rs = d.join(format!("{name}-ref.json"));
+    std::fs::write(&rs, ref_scene).unwrap();
     let (png, exr, reference) = (
         d.join(format!("{name}.png")),
         d.join(format!("{name}.exr")),
@@ -97,7 +105,7 @@ fn compare(render: &Path, d: &Path, scene: &str, name: &str) {
     run_ok(
         Command::new(tool("sunbeam-eval"))
             .arg("render")
-            .arg(&s)
+            .arg(&rs)
             .args(["--samples", "16", "-q", "-o"])
             .arg(&reference),
     );
@@ -133,6 +141,23 @@ fn threejs_renders_the_sphere_and_the_snake_like_the_reference() {
   "meshes": [ { "mesh": "snake.glb", "pack": "ridges.ktx2", "base_color": [0.05, 0.05, 0.05], "diffuse_weight": 0.2 } ],
   "exposure": 1, "size": [96, 48] }"#;
     compare(&render, &d, snake, "snake");
+
+    // The material from the GLB alone (sunbeam-bake --pack writes
+    // SUNBEAM_materials_diffraction): the same frame as with the scene's pack.
+    run_ok(
+        Command::new(tool("sunbeam-bake"))
+            .args(["--generate-snake", "--pack"])
+            .arg(d.join("ridges.ktx2"))
+            .arg("-o")
+            .arg(d.join("snake-ext.glb"))
+            .arg("-q"),
+    );
+    let alone = snake.replace(
+        "\"mesh\": \"snake.glb\", \"pack\": \"ridges.ktx2\", ",
+        "\"mesh\": \"snake-ext.glb\", ",
+    );
+    assert!(!alone.contains("pack"));
+    compare_with(&render, &d, &alone, snake, "snake-ext");
 }
 
 #[test]

@@ -6,7 +6,7 @@ import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import {
   adaptExportedGlsl, addOrientation, builtinGeometry, parseResponseMap, sceneCamera,
-  sunbeamMaterial, updateSunbeamUniforms,
+  SunbeamDiffractionPlugin, sunbeamMaterial, updateSunbeamUniforms,
 } from './sunbeam-three.mjs';
 
 // Colours are linear values as given (no sRGB conversion of inputs or outputs).
@@ -27,24 +27,38 @@ window.sunbeamRender = async (job) => {
     const exported = adaptExportedGlsl(glsl);
     const scale = Math.pow(2, desc.exposure);
     const root = new THREE.Scene();
+    const maps = new Map();
+    const loadMap = async (url) => {
+      if (!maps.has(url)) maps.set(url, parseResponseMap(await (await fetch(url)).arrayBuffer()));
+      return maps.get(url);
+    };
+    const make = (map, baseColor, diffuseWeight) => sunbeamMaterial({
+      exportedGlsl: exported, map, baseColor, diffuseWeight, lights: desc.lights, exposure: desc.exposure,
+    });
     for (const m of meshes) {
-      const map = m.map ? parseResponseMap(await (await fetch(m.map)).arrayBuffer()) : null;
-      const material = sunbeamMaterial({
-        exportedGlsl: exported, map, baseColor: m.baseColor, diffuseWeight: m.diffuseWeight,
-        lights: desc.lights, exposure: desc.exposure,
-      });
+      // The scene's pack wins; else the GLB's own SUNBEAM_materials_diffraction.
+      const sceneMap = m.map ? await loadMap(m.map) : null;
       if (m.builtin) {
-        root.add(new THREE.Mesh(builtinGeometry(m.builtin), material));
-      } else {
-        const gltf = await new GLTFLoader().loadAsync(m.url);
-        gltf.scene.traverse((o) => {
-          if (o.isMesh) {
-            addOrientation(o.geometry);
-            o.material = material;
-          }
-        });
-        root.add(gltf.scene);
+        root.add(new THREE.Mesh(builtinGeometry(m.builtin), make(sceneMap, m.baseColor, m.diffuseWeight)));
+        continue;
       }
+      const loader = new GLTFLoader();
+      loader.register((p) => new SunbeamDiffractionPlugin(p));
+      const gltf = await loader.loadAsync(m.url);
+      const meshObjs = [];
+      gltf.scene.traverse((o) => { if (o.isMesh) meshObjs.push(o); });
+      for (const o of meshObjs) {
+        addOrientation(o.geometry);
+        const ext = o.userData.sunbeam;
+        if (sceneMap || !ext || m.packGiven) {
+          o.material = make(sceneMap, m.baseColor, m.diffuseWeight);
+        } else {
+          const url = m.extMaps?.[ext.responseMap.uri];
+          if (!url) return { error: `${m.url}: SUNBEAM_materials_diffraction map ${ext.responseMap.uri} not served` };
+          o.material = make(await loadMap(url), ext.baseColor ?? m.baseColor, ext.diffuseWeight ?? m.diffuseWeight);
+        }
+      }
+      root.add(gltf.scene);
     }
     const camera = sceneCamera(desc, w / h);
     root.updateMatrixWorld(true);

@@ -83,6 +83,24 @@ function serve(abs) {
   files.set(key, abs);
   return key;
 }
+// The response maps a GLB names in SUNBEAM_materials_diffraction (sunbeam-bake --pack), served.
+function extensionMaps(glb, what) {
+  const b = readFileSync(glb);
+  if (b.length < 20 || b.readUInt32LE(0) !== 0x46546c67) fail(2, `${what}: ${glb} is not a GLB`);
+  const json = JSON.parse(b.subarray(20, 20 + b.readUInt32LE(12)).toString('utf8'));
+  const maps = {};
+  for (const mat of json.materials ?? []) {
+    const e = mat.extensions?.SUNBEAM_materials_diffraction;
+    if (!e) continue;
+    const uri = e.responseMap?.uri;
+    if (typeof uri !== 'string') fail(2, `${what}: SUNBEAM_materials_diffraction.responseMap.uri missing`);
+    const abs = resolve(dirname(glb), decodeURIComponent(uri));
+    if (!existsSync(abs)) fail(2, `${what}: SUNBEAM_materials_diffraction.responseMap.uri: ${abs} not found`);
+    maps[uri] = serve(abs);
+  }
+  return maps;
+}
+
 const meshes = scene.meshes.map((m, i) => {
   if (typeof m.mesh !== 'string') fail(2, `${opt.scene}: meshes[${i}].mesh is required`);
   const out = {
@@ -95,8 +113,10 @@ const meshes = scene.meshes.map((m, i) => {
     if (!existsSync(p)) fail(2, `${opt.scene}: meshes[${i}].mesh: ${p} not found`);
     if (!/\.(glb|gltf)$/i.test(p)) fail(2, `${opt.scene}: meshes[${i}].mesh: three.js path reads glTF/GLB only (${p})`);
     out.url = serve(p);
+    if (/\.glb$/i.test(p) && !m.pack) out.extMaps = extensionMaps(p, `${opt.scene}: meshes[${i}].mesh`);
   }
   if (m.pack) {
+    out.packGiven = true;
     const p = resolve(sceneDir, m.pack);
     const side = join(dirname(p), `${basename(p, extname(p))}.response.ktx2`);
     if (!existsSync(side)) fail(2, `${opt.scene}: meshes[${i}].pack: no response map ${side} (write it with sunbeam-pack --response)`);

@@ -191,6 +191,31 @@ export function addOrientation(geometry) {
   return geometry;
 }
 
+/**
+ * GLTFLoader plugin for the vendor extension SUNBEAM_materials_diffraction
+ * (written by `sunbeam-bake --pack`, docs/ENGINES.md): every mesh whose glTF
+ * material carries it gets `userData.sunbeam` = the extension's object
+ * (`responseMap.uri` relative to the GLB, `grid`, `f0`, `diffuseWeight`,
+ * `baseColor`). Register with `loader.register((p) => new SunbeamDiffractionPlugin(p))`.
+ */
+export class SunbeamDiffractionPlugin {
+  constructor(parser) {
+    this.parser = parser;
+    this.name = 'SUNBEAM_materials_diffraction';
+  }
+
+  afterRoot(gltf) {
+    const mats = this.parser.json.materials ?? [];
+    gltf.scene.traverse((o) => {
+      if (!o.isMesh) return;
+      const a = this.parser.associations.get(o.material);
+      const ext = a && a.materials !== undefined ? mats[a.materials]?.extensions?.[this.name] : undefined;
+      if (ext) o.userData.sunbeam = ext;
+    });
+    return null;
+  }
+}
+
 /** sunbeam-scene's built-in meshes (crates/sunbeam-scene/src/geometry.rs), same vertices and tangents. */
 export function builtinGeometry(name) {
   const g = new THREE.BufferGeometry();

@@ -40,6 +40,7 @@
 
 pub mod bake;
 pub mod bvh;
+pub mod diffraction_ext;
 pub mod geom;
 pub mod gltf;
 pub mod nodes;

@@ -29,6 +29,16 @@ pub(crate) struct Cli {
     #[arg(short, long)]
     pub(crate) output: PathBuf,
 
+    /// Term pack whose diffraction the GLB's materials render: writes the
+    /// SUNBEAM_materials_diffraction extension naming the pack and its response
+    /// map (NAME.response.ktx2 beside it, from sunbeam-pack --response), by paths
+    /// relative to the output (docs/ENGINES.md).
+    #[arg(long, value_name = "PACK")]
+    pub(crate) pack: Option<PathBuf>,
+    /// Diffuse weight written with --pack (the scene's diffuse_weight, docs/SCENE.md).
+    #[arg(long, default_value_t = 0.2, requires = "pack")]
+    pub(crate) diffuse_weight: f64,
+
     /// A world direction projected onto each tangent plane.
     #[arg(
         long,

@@ -103,6 +103,9 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         baked.report.texture = Some(rep);
         tex_bytes = Some(bytes);
     }
+    if let Some(pack) = &cli.pack {
+        inputs.extend(attach_diffraction(&mut baked.doc, pack, &cli)?);
+    }
     let glb = baked.doc.to_glb();
     if to_stdout {
         std::io::stdout()
@@ -171,4 +174,78 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `--pack`: the SUNBEAM_materials_diffraction extension on the GLB's materials
+/// (docs/ENGINES.md). Returns the files it read (for the depfile).
+fn attach_diffraction(
+    doc: &mut sunbeam_mesh::gltf::Document,
+    pack: &Path,
+    cli: &Cli,
+) -> Result<Vec<PathBuf>> {
+    if cli.output.as_os_str() == "-" {
+        return Err(Error::usage(
+            "--pack needs a file output (the URIs are relative to it)",
+        ));
+    }
+    if !(0.0..=1.0).contains(&cli.diffuse_weight) {
+        return Err(Error::usage("--diffuse-weight must be in [0, 1]"));
+    }
+    if !pack.is_file() {
+        return Err(Error::input_file(pack, "--pack: no such file"));
+    }
+    let map_path = sunbeam_response::sidecar_path(pack);
+    if !map_path.is_file() {
+        return Err(Error::input_file(
+            pack,
+            format!(
+                "--pack: no response map {} beside it (write it with sunbeam-pack --response)",
+                map_path.display()
+            ),
+        ));
+    }
+    let map = sunbeam_response::ktx2::read(&map_path)?;
+    let g = map.info.grid;
+    let out_dir = cli
+        .output
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let uri = |p: &Path| -> Result<String> {
+        let rel = relative_path(p, out_dir)?;
+        Ok(rel
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .join("/"))
+    };
+    let base = [0.05, 0.05, 0.05];
+    let ext = serde_json::json!({
+        "responseMap": { "uri": uri(&map_path)?, "mimeType": "image/ktx2" },
+        "pack": { "uri": uri(pack)? },
+        "grid": { "nTheta": g.n_theta, "nRho": g.n_rho, "nS": g.n_s, "r0": g.r0 },
+        "f0": 0.04,
+        "diffuseWeight": cli.diffuse_weight,
+        "baseColor": base,
+    });
+    sunbeam_mesh::diffraction_ext::attach(doc, &ext, base);
+    Ok(vec![pack.to_path_buf(), map_path])
+}
+
+/// `target` relative to the folder `from` (both made absolute first).
+fn relative_path(target: &Path, from: &Path) -> Result<PathBuf> {
+    let abs = |p: &Path| {
+        std::path::absolute(p).map_err(|e| Error::input_file(p, format!("cannot resolve: {e}")))
+    };
+    let (t, f) = (abs(target)?, abs(from)?);
+    let (tc, fc): (Vec<_>, Vec<_>) = (t.components().collect(), f.components().collect());
+    let common = tc.iter().zip(&fc).take_while(|(a, b)| a == b).count();
+    let mut rel = PathBuf::new();
+    for _ in common..fc.len() {
+        rel.push("..");
+    }
+    for c in &tc[common..] {
+        rel.push(c);
+    }
+    Ok(rel)
 }

@@ -563,3 +563,106 @@ fn rich_gltf_keeps_everything() {
     );
     let _ = std::fs::remove_dir_all(d);
 }
+
+/// `--pack`: the SUNBEAM_materials_diffraction extension names the pack and its
+/// response map relative to the GLB, carries the map's grid as the map's own
+/// header says, is used but not required, lands on every material (one is made
+/// for primitives without), passes glTF-Validator; a pack without a map is refused.
+#[test]
+fn pack_writes_the_diffraction_extension() {
+    let d = tmpdir("ext");
+    let tool = |name: &str| PathBuf::from(env!("CARGO_BIN_EXE_sunbeam-bake")).with_file_name(name);
+    let h = d.join("h.exr");
+    let packs = d.join("packs");
+    std::fs::create_dir_all(&packs).unwrap();
+    let pack = packs.join("x.ktx2");
+    ok(&Command::new(tool("sunbeam-import"))
+        .args(["synthetic:xenopeltis", "--synthetic-size", "64", "-q", "-o"])
+        .arg(&h)
+        .output()
+        .unwrap());
+    ok(&Command::new(tool("sunbeam-pack"))
+        .arg(&h)
+        .arg("-o")
+        .arg(&pack)
+        .arg("-q")
+        .output()
+        .unwrap());
+    let glb = d.join("out").join("snake.glb");
+    std::fs::create_dir_all(glb.parent().unwrap()).unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    // No map yet: refused, nothing written.
+    let o = bake(&[
+        "--generate-snake",
+        "--snake-detail",
+        "0.3",
+        "--pack",
+        &s(&pack),
+        "-o",
+        &s(&glb),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("response map"));
+    assert!(!glb.exists());
+    ok(&Command::new(tool("sunbeam-pack"))
+        .arg(&h)
+        .arg("-o")
+        .arg(&pack)
+        .args(["--response", "-q"])
+        .output()
+        .unwrap());
+    let dep = d.join("snake.d");
+    ok(&bake(&[
+        "--generate-snake",
+        "--snake-detail",
+        "0.3",
+        "--pack",
+        &s(&pack),
+        "--diffuse-weight",
+        "0.3",
+        "-o",
+        &s(&glb),
+        "--depfile",
+        &s(&dep),
+    ]));
+    let b = std::fs::read(&glb).unwrap();
+    let len = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
+    let j: serde_json::Value = serde_json::from_slice(&b[20..20 + len]).unwrap();
+    assert!(j["extensionsUsed"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|v| v == "SUNBEAM_materials_diffraction"));
+    assert!(j.get("extensionsRequired").is_none_or(|r| !r
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|v| v == "SUNBEAM_materials_diffraction")));
+    let mats = j["materials"].as_array().unwrap();
+    assert!(!mats.is_empty());
+    let header = std::fs::read(packs.join("x.response.ktx2")).unwrap();
+    let text = String::from_utf8_lossy(&header);
+    for m in mats {
+        let e = &m["extensions"]["SUNBEAM_materials_diffraction"];
+        assert_eq!(e["responseMap"]["uri"], "../packs/x.response.ktx2");
+        assert_eq!(e["pack"]["uri"], "../packs/x.ktx2");
+        assert_eq!(e["diffuseWeight"], 0.3);
+        // The grid as the map's own header records it.
+        let n_theta = e["grid"]["nTheta"].as_u64().unwrap();
+        assert!(
+            text.contains(&format!("\"n_theta\":{n_theta}")),
+            "nTheta {n_theta} not in the map's header"
+        );
+    }
+    for p in j["meshes"][0]["primitives"].as_array().unwrap() {
+        assert!(p.get("material").is_some());
+    }
+    let deps = std::fs::read_to_string(&dep).unwrap();
+    assert!(deps.contains("x.response.ktx2") && deps.contains("x.ktx2"));
+    validate(&[&glb]);
+}
