@@ -81,6 +81,14 @@ rule bake
   depfile = \${target}.d
   deps = gcc
   description = bake \${target}
+rule bake_pack
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-bake --generate-snake --snake-detail $(esc "$SNAKE_DETAIL") --pack \$in -o \${target} --depfile \${target}.d \$q
+  depfile = \${target}.d
+  deps = gcc
+  description = bake \${target}
+rule export_shader
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-play --export-shader glsl-es -o \${target} \$q
+  description = export \${target}
 rule scene
   command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake.glb|' \$in > \${outdir}/.\${name}-scene.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-scene.json.tmp.\$\$\$\$ \${target}
   description = scene \${target}
@@ -143,8 +151,14 @@ EOF
     echo "build $o/$m-frame.png: play $o/$m-scene.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/snake.glb $(path "$BIN/sunbeam-play")"
     echo "  target = $(esc "$OUT/$m-frame.png")"
     echo "  tidy = $(esc "$OUT/.$m-frame.png").tmp.*"
+    echo "build $o/snake-$m.glb: bake_pack $o/$m.ktx2 | $o/$m.response.ktx2 $(path "$BIN/sunbeam-bake")"
+    echo "  target = $(esc "$OUT/snake-$m.glb")"
+    echo "  tidy = $(esc "$OUT/.snake-$m.glb").tmp.*"
     sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png"
   done
+  echo "build $o/sunbeam-es.frag: export_shader | $(path "$BIN/sunbeam-play")"
+  echo "  target = $(esc "$OUT/sunbeam-es.frag")"
+  echo "  tidy = $(esc "$OUT/.sunbeam-es.frag").tmp.*"
   echo "build $o/snake.glb: bake | $(path "$BIN/sunbeam-bake")"
   echo "  target = $(esc "$OUT/snake.glb")"
   echo "  tidy = $(esc "$OUT/.snake.glb").tmp.*"
@@ -159,7 +173,9 @@ EOF
   echo "build pictures: phony$(list -brdf.png -grating.png)"
   echo "build frames: phony$(list -frame.png)"
   echo "build sheet: phony $o/contact-sheet.png"
-  echo "build all: phony $o/contact-sheet.png"
+  web_in=""; for m in $MATERIALS; do web_in="$web_in $o/snake-$m.glb"; done
+  echo "build web: phony $o/sunbeam-es.frag$web_in"
+  echo "build all: phony $o/contact-sheet.png web"
   echo "default all"
 } > "$tmp"
 mv "$tmp" "$OUT/build.ninja"

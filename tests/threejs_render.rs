@@ -180,3 +180,65 @@ fn bad_scenes_exit_non_zero_with_the_field_named() {
     let o = Command::new("node").arg(&render).output().unwrap();
     assert_eq!(o.status.code(), Some(1));
 }
+
+/// examples/threejs/index.html (the viewer a user opens after `make demo`) loads
+/// the snake with its material from the GLB's extension and draws a frame with
+/// no WebGL, console or page error (page-check.mjs fails on any).
+#[test]
+fn the_viewer_page_loads_without_errors() {
+    let d = scratch("threejs-page");
+    let Some(render) = example(&d) else { return };
+    let js = render.parent().unwrap().to_path_buf();
+    let root = d.join("site");
+    let (web, out) = (root.join("threejs"), root.join("out"));
+    std::fs::create_dir_all(&web).unwrap();
+    std::fs::create_dir_all(&out).unwrap();
+    for f in [
+        "index.html",
+        "sunbeam-three.mjs",
+        "serve.mjs",
+        "page-check.mjs",
+    ] {
+        std::fs::copy(
+            workspace_root().join("examples/threejs").join(f),
+            web.join(f),
+        )
+        .unwrap();
+    }
+    std::os::unix::fs::symlink(
+        std::fs::read_link(js.join("node_modules")).unwrap(),
+        web.join("node_modules"),
+    )
+    .unwrap();
+    let pack = ridge_pack(&out, "xeno", "128", "25nm");
+    run_ok(
+        Command::new(tool("sunbeam-bake"))
+            .args(["--generate-snake", "--snake-detail", "0.5", "--pack"])
+            .arg(&pack)
+            .arg("-o")
+            .arg(out.join("snake-xeno.glb"))
+            .arg("-q"),
+    );
+    run_ok(
+        Command::new(tool("sunbeam-play"))
+            .args(["--export-shader", "glsl-es", "-q", "-o"])
+            .arg(out.join("sunbeam-es.frag")),
+    );
+    let o = Command::new("node")
+        .arg(web.join("page-check.mjs"))
+        .arg(&root)
+        .arg("threejs/index.html")
+        .output()
+        .unwrap();
+    let report = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{report}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_str(report.trim()).unwrap();
+    let run = &v["runs"][0];
+    assert!(run["loadMs"].as_f64().unwrap() > 0.0, "{report}");
+    assert!(run["mapBytes"].as_u64().unwrap() > 1000, "{report}");
+    assert_eq!(run["material"], "xeno");
+}

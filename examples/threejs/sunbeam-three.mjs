@@ -90,6 +90,7 @@ uniform int sbLightCount;
 uniform vec4 sbLights[${MAX_LIGHTS}]; // xyz towards the light (unit), w intensity
 uniform float sbExposure;              // 2^exposure
 uniform int sbHasMap;
+uniform int sbDisplay;                 // 1: clip at 1 and sRGB-encode (drawing to a canvas)
 in vec3 vWorld;
 in vec3 vNormal;
 in vec3 vOrient;
@@ -117,7 +118,13 @@ void main() {
     }
     rgb += sbLights[i].w * c;
   }
-  fragColor = vec4(rgb * sbExposure, 1.0);
+  vec3 c = rgb * sbExposure;
+  if (sbDisplay == 1) {
+    // sunbeam_optics::colour: clip, then the sRGB curve (what sunbeam-play writes).
+    c = clamp(c, 0.0, 1.0);
+    c = mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+  }
+  fragColor = vec4(c, 1.0);
 }`;
 }
 
@@ -125,9 +132,10 @@ void main() {
  * The material: `exportedGlsl` (adapted, see adaptExportedGlsl), `map` from
  * parseResponseMap or null (base colour only), `baseColor` linear [r, g, b],
  * `diffuseWeight`, `lights` [{direction: [x, y, z] towards the light, intensity}],
- * `exposure` in stops. Uniforms can be changed later (material.uniforms).
+ * `exposure` in stops, `display`: clip and sRGB-encode (for a canvas; off for
+ * linear float targets). Uniforms can be changed later (material.uniforms).
  */
-export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, lights = [], exposure = 0, f0 = 0.04 }) {
+export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, lights = [], exposure = 0, f0 = 0.04, display = false }) {
   const g = map ? map.grid : { n_theta: 1, n_rho: 2, n_s: 2, r0: 1 };
   const lightVecs = [];
   for (let i = 0; i < MAX_LIGHTS; i++) {
@@ -150,6 +158,7 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
       sbLights: { value: lightVecs },
       sbExposure: { value: Math.pow(2, exposure) },
       sbHasMap: { value: map ? 1 : 0 },
+      sbDisplay: { value: display ? 1 : 0 },
       _group_0_binding_1_fs: { value: map ? map.texture : placeholder },
       _group_0_binding_0_fs: {
         value: {
