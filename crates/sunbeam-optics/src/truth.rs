@@ -267,6 +267,22 @@ impl Truth {
         self.sigma_f
     }
 
+    /// The effective coherent area `A` (square metres) that turns `R` into a
+    /// BRDF for extended light: `f_r cos(theta_i) = G R A / lambda^2`, so that
+    /// `L_o = integral L(wi) G R (A / lambda^2) cos(theta_i) dw_i`
+    /// (docs/LIGHTING.md). By Parseval, `integral R d^2f = 1 / A` for every
+    /// surface: window model `A = (sum g)^2 / sum g^2 * dx dy`; tiled model
+    /// `A = 1 / (2 pi sigma_f^2) = 2 pi (coherence / 4)^2`.
+    pub fn coherent_area_m2(&self) -> f64 {
+        match self.params.model {
+            Model::Window => {
+                let s2 = |g: &[f64]| g.iter().map(|v| v * v).sum::<f64>();
+                self.gsum * self.gsum / (s2(&self.gx) * s2(&self.gy)) * self.dx * self.dy
+            }
+            Model::Tiled => 1.0 / (2.0 * PI * self.sigma_f * self.sigma_f),
+        }
+    }
+
     /// Centre and half range of the heights, metres.
     pub fn height_centre_and_half_range(&self) -> (f64, f64) {
         (self.height_centre_m, self.height_half_range_m)
