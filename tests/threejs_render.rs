@@ -179,6 +179,24 @@ fn bad_scenes_exit_non_zero_with_the_field_named() {
     assert!(!d.join("x.png").exists());
     let o = Command::new("node").arg(&render).output().unwrap();
     assert_eq!(o.status.code(), Some(1));
+    // An output that cannot be written: exit 3.
+    ridge_pack(&d, "ok", "64", "25nm");
+    let s = d.join("ok.json");
+    std::fs::write(&s, r#"{ "camera": { "eye": [0, 0, 2], "target": [0, 0, 0] }, "meshes": [ { "mesh": "builtin:quad", "pack": "ok.ktx2" } ], "size": [8, 8] }"#).unwrap();
+    let o = Command::new("node")
+        .arg(&render)
+        .arg(&s)
+        .arg("-o")
+        .arg(d.join("no/such/dir/x.png"))
+        .env("SUNBEAM_PLAY", tool("sunbeam-play"))
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 /// examples/threejs/index.html (the viewer a user opens after `make demo`) loads

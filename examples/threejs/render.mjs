@@ -207,8 +207,13 @@ const lin = Float32Array.from(pixels.rgb); // rows top first, RGB, exposure appl
 
 function atomicWrite(path, bytes) {
   const tmp = join(dirname(resolve(path)), `.${basename(path)}.tmp.${process.pid}`);
-  writeFileSync(tmp, bytes);
-  renameSync(tmp, path);
+  try {
+    writeFileSync(tmp, bytes);
+    renameSync(tmp, path);
+  } catch (e) {
+    rmSync(tmp, { force: true });
+    fail(3, `${path}: cannot write: ${e.message}`);
+  }
 }
 
 function pngBytes(rgb8) {
