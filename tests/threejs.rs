@@ -4,19 +4,8 @@
 //! with what the tools themselves report (sunbeam-bake --json, sunbeam-pack --manifest).
 
 use std::process::Command;
-use sunbeam::{scratch, tool, workspace_root};
+use sunbeam::{run_ok, scratch, tool, workspace_root};
 use sunbeam_common::testdata;
-
-fn run_ok(cmd: &mut Command) -> std::process::Output {
-    let o = cmd.output().expect("run");
-    assert!(
-        o.status.success(),
-        "{cmd:?}: {}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
 
 #[test]
 fn threejs_loads_the_baked_glb_and_the_ktx2_pack() {

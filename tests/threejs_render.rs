@@ -8,20 +8,9 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use sunbeam::{scratch, tool, workspace_root};
+use sunbeam::{run_ok, scratch, tool, workspace_root};
 use sunbeam_common::testdata;
 use sunbeam_raster::{compare_linear, LinearImage};
-
-fn run_ok(cmd: &mut Command) -> std::process::Output {
-    let o = cmd.output().expect("run");
-    assert!(
-        o.status.success(),
-        "{cmd:?}: {}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
 
 /// The example next to a node_modules with three and playwright-core, as a user runs it.
 fn example(d: &Path) -> Option<PathBuf> {
