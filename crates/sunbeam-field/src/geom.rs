@@ -1,4 +1,4 @@
-//! Rotations by quarter turns, flips and crops. Pixel sizes follow the axes.
+//! Rotations by quarter turns, flips, crops and tiling. Pixel sizes follow the axes.
 
 use crate::HeightField;
 use sunbeam_common::{Error, Result};
@@ -141,6 +141,25 @@ impl CropSpec {
     }
 }
 
+/// Replicate a height field `nx` x `ny` times (a periodic patch seen by a
+/// window larger than one period); `nx = ny = 1` is a copy.
+pub fn tile(f: &HeightField, nx: usize, ny: usize) -> Result<HeightField> {
+    if nx == 1 && ny == 1 {
+        return Ok(f.clone());
+    }
+    let (w, h) = (f.width * nx, f.height * ny);
+    let mut data = Vec::with_capacity(w * h);
+    for r in 0..h {
+        for c in 0..w {
+            data.push(f.at(r % f.height, c % f.width));
+        }
+    }
+    let mut t = HeightField::new(w, h, f.dx, f.dy, data)?;
+    t.provenance = f.provenance.clone();
+    t.provenance.processing.push(format!("tiled {nx}x{ny}"));
+    Ok(t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -191,5 +210,24 @@ mod tests {
             (1, 1, 3, 2)
         );
         assert!(CropSpec::parse("1,2nm,3,4").is_err());
+    }
+
+    #[test]
+    fn tiling() {
+        let t = tile(&f32x2(), 2, 2).unwrap();
+        assert_eq!((t.width, t.height, t.dx, t.dy), (6, 4, 1.0, 2.0));
+        #[rustfmt::skip]
+        let want = vec![
+            0.0, 1.0, 2.0, 0.0, 1.0, 2.0,
+            3.0, 4.0, 5.0, 3.0, 4.0, 5.0,
+            0.0, 1.0, 2.0, 0.0, 1.0, 2.0,
+            3.0, 4.0, 5.0, 3.0, 4.0, 5.0,
+        ];
+        assert_eq!(t.data, want);
+        assert_eq!(t.provenance.processing.last().unwrap(), "tiled 2x2");
+        assert_eq!(tile(&f32x2(), 1, 1).unwrap(), f32x2());
+        let row = tile(&f32x2(), 1, 3).unwrap();
+        assert_eq!((row.width, row.height), (3, 6));
+        assert_eq!(&row.data[12..], &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
     }
 }

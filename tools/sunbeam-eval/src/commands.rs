@@ -51,7 +51,7 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
         let mut f = input::read_height(&a.input, &a.heights)?;
         if let Some(t) = &a.tile {
             let (nx, ny) = input::parse_tile(t)?;
-            f = input::tile(&f, nx, ny)?;
+            f = sunbeam_field::geom::tile(&f, nx, ny)?;
         }
         Source::from_field(f, &params).map_err(|e| e.context(a.input.display()))?
     };
