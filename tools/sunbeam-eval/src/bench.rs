@@ -12,7 +12,8 @@ use sunbeam_analysis::compare::{colour_vs, spectral_at, truth_colours, SpectralE
 use sunbeam_analysis::sample::Rng;
 use sunbeam_common::{output, Error, Result};
 use sunbeam_field::HeightField;
-use sunbeam_optics::truth::{Model as TModel, Params, Truth};
+use sunbeam_optics::truth::{Params, Truth};
+use sunbeam_optics::Model;
 use sunbeam_pack::{Basis, BuildOptions, FieldRef, Pack, Precision};
 
 pub struct Options {
@@ -164,7 +165,7 @@ pub fn run(o: &Options) -> Result<()> {
         let truth = Truth::new(
             f,
             &Params {
-                model: TModel::Window,
+                model: Model::Window,
                 coherence_m: 65e-6,
             },
         )?;
@@ -256,7 +257,7 @@ pub fn run(o: &Options) -> Result<()> {
         let truth = Truth::new(
             &f,
             &Params {
-                model: TModel::Window,
+                model: Model::Window,
                 coherence_m: 65e-6,
             },
         )?;

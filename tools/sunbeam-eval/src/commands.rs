@@ -139,7 +139,7 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
 }
 
 fn compare_cmd(a: CompareArgs) -> Result<()> {
-    use sunbeam_optics::truth::{Model, Params, Truth};
+    use sunbeam_optics::truth::{Params, Truth};
     if a.points == 0 || a.views == 0 || a.lambda_samples == 0 {
         return Err(Error::usage(
             "--points, --views and --lambda-samples must be positive",
@@ -172,10 +172,7 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
             ),
         ));
     }
-    let model = match m.model {
-        sunbeam_pack::Model::Window => Model::Window,
-        sunbeam_pack::Model::Tiled => Model::Tiled,
-    };
+    let model = m.model;
     let truth = Truth::new(
         &field,
         &Params {
