@@ -2,7 +2,7 @@
 //! or from the float64 ground truth of a height field behind one interface
 //! ([`source::Source`]), deterministic sampling ([`sample`]), a pack against
 //! its truth ([`compare`]: spectral and colour error), what the BRDF pictures
-//! show ([`brdf`]), the grating period a
+//! show ([`brdf`]), `R` at the points of a points file ([`probe`]), the grating period a
 //! surface's diffraction peaks imply ([`grating`]), and the pack facts those
 //! need ([`packinfo`]). The tool keeps argument parsing, plots, progress and
 //! exit codes (docs/EVAL.md).
@@ -11,6 +11,7 @@ pub mod brdf;
 pub mod compare;
 pub mod grating;
 pub mod packinfo;
+pub mod probe;
 pub mod sample;
 pub mod source;
 
