@@ -12,9 +12,9 @@
 //! ```
 //!
 //! Length arguments are parsed by clap value parsers built on [`crate::units`]
-//! ([`length`], [`positive_length`], [`length_range`], [`pixel_size`]), and
-//! sizes in bytes by [`byte_size`], so a bad value is a usage error (exit 1)
-//! that names the flag, before the tool runs.
+//! ([`length`], [`positive_length`], [`length_range`], [`pixel_size`]), angles
+//! by [`angle`] and sizes in bytes by [`byte_size`], so a bad value is a usage
+//! error (exit 1) that names the flag, before the tool runs.
 
 use crate::error::{run_main, Error, Result};
 use crate::units;
@@ -120,6 +120,11 @@ pub fn pixel_size(s: &str) -> Result<PixelSize> {
     }
 }
 
+/// clap value parser: an angle (`75deg`, `1.3rad`; a bare number is degrees), in radians.
+pub fn angle(s: &str) -> Result<f64> {
+    units::parse_angle(s)
+}
+
 /// clap value parser: a size in bytes, at least 1, with an optional suffix
 /// `B`, `KiB`, `MiB` or `GiB` (`64MiB`, `1.5GiB`, `4096`).
 pub fn byte_size(s: &str) -> Result<usize> {
@@ -164,6 +169,21 @@ mod tests {
         pixel_size: Option<PixelSize>,
         #[arg(long, value_parser = positive_length, default_value = "65um")]
         coherence: f64,
+        #[arg(long, value_parser = angle, default_value = "75deg", allow_hyphen_values = true)]
+        theta: f64,
+    }
+
+    #[test]
+    fn angles_parse_in_clap() {
+        let c = parse_from::<Cli, _, _>(["t"]).unwrap().unwrap();
+        assert!((c.theta - 75f64.to_radians()).abs() < 1e-15);
+        let c = parse_from::<Cli, _, _>(["t", "--theta", "-0.5rad"])
+            .unwrap()
+            .unwrap();
+        assert_eq!(c.theta, -0.5);
+        let e = parse_from::<Cli, _, _>(["t", "--theta", "75furlongs"]).unwrap_err();
+        assert_eq!(e.exit_code(), 1);
+        assert!(e.to_string().contains("--theta"), "{e}");
     }
 
     #[test]

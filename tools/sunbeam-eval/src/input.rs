@@ -54,7 +54,7 @@ pub fn parse_tile(s: &str) -> Result<(usize, usize)> {
             .parse::<usize>()
             .ok()
             .filter(|&n| (1..=64).contains(&n))
-            .ok_or_else(|| Error::usage(format!("--tile '{s}': expected NxM with 1 <= N, M <= 64")))
+            .ok_or_else(|| Error::usage("expected NxM with 1 <= N, M <= 64"))
     };
     Ok((p(a)?, p(b)?))
 }
