@@ -99,7 +99,7 @@ impl CropSpec {
     pub fn parse(s: &str) -> Result<CropSpec> {
         let parts: Vec<&str> = s.split(',').map(str::trim).collect();
         if parts.len() != 4 {
-            return Err(Error::usage(format!("--crop '{s}': expected X,Y,W,H")));
+            return Err(Error::usage("expected X,Y,W,H"));
         }
         if parts.iter().all(|p| p.parse::<usize>().is_ok()) {
             let v: Vec<usize> = parts.iter().map(|p| p.parse().unwrap_or(0)).collect();
@@ -113,12 +113,10 @@ impl CropSpec {
         let mut v = [0.0; 4];
         for (k, p) in parts.iter().enumerate() {
             v[k] = sunbeam_common::units::parse_length(p).map_err(|e| {
-                Error::usage(format!(
-                    "--crop '{s}': {e} (give all four in pixels or all with units)"
-                ))
+                Error::usage(format!("{e} (give all four in pixels or all with units)"))
             })?;
             if v[k] < 0.0 {
-                return Err(Error::usage(format!("--crop '{s}': negative value")));
+                return Err(Error::usage("negative value"));
             }
         }
         Ok(CropSpec::Metres {
