@@ -106,7 +106,7 @@ pub(crate) struct BrdfArgs {
     pub(crate) exposure: Option<f64>,
     /// Tone curve: clamp or reinhard.
     #[arg(long, default_value = "clamp")]
-    pub(crate) tone: String,
+    pub(crate) tone: sunbeam_optics::colour::ToneCurve,
     #[arg(long)]
     pub(crate) json: bool,
 }

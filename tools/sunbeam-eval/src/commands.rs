@@ -239,14 +239,14 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
 }
 
 fn brdf_cmd(a: BrdfArgs) -> Result<()> {
-    use sunbeam_optics::colour::{ToneCurve, ToneMap};
+    use sunbeam_optics::colour::ToneMap;
     let light = a.light;
     if !(16..=2048).contains(&a.size) || a.lambda_samples == 0 {
         return Err(Error::usage(
             "--size must be 16..2048 and --lambda-samples positive",
         ));
     }
-    let curve: ToneCurve = a.tone.parse()?;
+    let curve = a.tone;
     let pack = sunbeam_pack::Pack::read(&a.pack)?;
     let title = a
         .pack
