@@ -4,7 +4,9 @@
 //!   (never on the instrument readers, the glTF loader or the render scene);
 //! - no crate depends on a tool (a package under `tools/`);
 //! - inside a crate, no cycle of `crate::` references between its top modules;
-//! - every tool's `main.rs` stays under 150 lines.
+//! - every tool's `main.rs` stays under 150 lines;
+//! - no hand-made thread pools (`std::thread::spawn`/`scope`/`Builder`) in the
+//!   crates' and tools' sources: parallel work goes through rayon.
 //!
 //! The crate graph comes from `cargo metadata`. `SUNBEAM_ARCH_ROOT=DIR` checks
 //! another checkout instead of this one (that is how the check was shown to fail
@@ -309,4 +311,69 @@ fn tool_mains_are_short() {
         long.is_empty(),
         "tool main.rs files over {LIMIT} lines: {long:?}"
     );
+}
+
+/// Does `text` (Rust source, unit tests and `//` comments left out) start
+/// threads by hand?
+fn spawns_threads(text: &str) -> bool {
+    let text = text.split("#[cfg(test)]").next().unwrap_or("");
+    text.lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .any(|l| {
+            ["thread::spawn", "thread::scope", "thread::Builder"]
+                .iter()
+                .any(|p| l.contains(p))
+        })
+}
+
+/// Every `.rs` file under `dir`, sorted.
+fn rs_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = vec![];
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        if let Ok(rd) = std::fs::read_dir(&d) {
+            for p in rd.flatten().map(|e| e.path()) {
+                if p.is_dir() {
+                    stack.push(p);
+                } else if p.extension().is_some_and(|e| e == "rs") {
+                    out.push(p);
+                }
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Parallel work goes through rayon, whose indexed collect keeps outputs in
+/// order whatever the thread count (docs/dev/ARCHITECTURE.md): no crate or
+/// tool starts threads of its own. Tests (`tests/`, `#[cfg(test)]`) may.
+#[test]
+fn no_hand_made_thread_pools() {
+    let mut found = vec![];
+    for p in workspace().values() {
+        for f in rs_files(&p.dir.join("src")) {
+            if spawns_threads(&std::fs::read_to_string(&f).unwrap_or_default()) {
+                found.push(f.display().to_string());
+            }
+        }
+    }
+    assert!(found.is_empty(), "hand-made threads (use rayon): {found:?}");
+}
+
+#[test]
+fn the_thread_finder_finds_threads() {
+    assert!(spawns_threads(
+        "fn f() {\n    std::thread::scope(|s| {\n        s.spawn(|| 1);\n    });\n}"
+    ));
+    assert!(spawns_threads("let h = thread::spawn(move || work());"));
+    assert!(!spawns_threads(
+        "// std::thread::spawn is not used here\nfn f() {}"
+    ));
+    assert!(!spawns_threads(
+        "fn f() {}\n#[cfg(test)]\nmod tests { fn t() { std::thread::spawn(|| ()); } }"
+    ));
+    assert!(!spawns_threads(
+        "let n = std::thread::available_parallelism();"
+    ));
 }

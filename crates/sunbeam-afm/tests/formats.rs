@@ -152,13 +152,8 @@ fn xyz_regular_grid_is_a_grid() {
 #[test]
 fn xyz_scattered_points_are_triangulated() {
     let mut s = String::new();
-    let mut seed = 12345u64;
-    let mut rnd = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = sunbeam_common::rng::SplitMix64::new(12345);
+    let mut rnd = || rng.unit();
     // corners so the hull is the square, then random points
     let mut pts = vec![(0.0, 0.0), (1e-6, 0.0), (0.0, 1e-6), (1e-6, 1e-6)];
     for _ in 0..400 {

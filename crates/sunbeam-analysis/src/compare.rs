@@ -2,7 +2,7 @@
 //! against the ground truth of the height field it was built from
 //! (PHYSICS.md 4).
 
-use crate::sample::{fibonacci_hemisphere, percentile, Rng};
+use crate::sample::{fibonacci_hemisphere, percentile, scatter_points};
 use crate::source::par_map;
 use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
 use sunbeam_optics::truth::Truth;
@@ -23,18 +23,7 @@ pub struct SpectralError {
 /// (|w| <= max_w, lambda in its range).
 pub fn spectral(pack: &Pack, truth: &Truth, n: usize, seed: u64) -> SpectralError {
     let m = &pack.manifest;
-    let mut rng = Rng::new(seed);
-    let mut pts = Vec::with_capacity(n);
-    while pts.len() < n {
-        let wi = rng.hemisphere(0.05);
-        let wr = rng.hemisphere(0.05);
-        let w = -wi[2] - wr[2];
-        if w.abs() > m.max_w {
-            continue;
-        }
-        let l = m.lambda_min_m + (m.lambda_max_m - m.lambda_min_m) * rng.next_f64();
-        pts.push([-wi[0] - wr[0], -wi[1] - wr[1], w, l]);
-    }
+    let pts = scatter_points(n, seed, 0.05, m.max_w, (m.lambda_min_m, m.lambda_max_m));
     spectral_at(pack, truth, &pts)
 }
 

@@ -7,10 +7,7 @@ pub fn patch_size(p: &Pack) -> (f64, f64) {
 }
 
 pub fn model_name(p: &Pack) -> String {
-    match p.manifest.model {
-        Model::Window => "window".into(),
-        Model::Tiled => "tiled".into(),
-    }
+    p.manifest.model.name().into()
 }
 
 /// Half width of the specular lobe in cycles per metre (see `Source::specular_halfwidth`).

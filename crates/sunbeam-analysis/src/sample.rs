@@ -23,6 +23,33 @@ impl Rng {
     }
 }
 
+/// `n` random points `(u, v, w, lambda)` of `R`: `wi` and `wr` uniform in
+/// solid angle with `d.n >= min_cos` (`u, v, w = -(wi + wr)`), kept when
+/// `|w| <= max_w`, then `lambda` uniform in `lambda_range` (metres). The same
+/// seed gives the same points.
+pub fn scatter_points(
+    n: usize,
+    seed: u64,
+    min_cos: f64,
+    max_w: f64,
+    lambda_range: (f64, f64),
+) -> Vec<[f64; 4]> {
+    let mut rng = Rng::new(seed);
+    let mut pts = Vec::with_capacity(n);
+    while pts.len() < n {
+        let wi = rng.hemisphere(min_cos);
+        let wr = rng.hemisphere(min_cos);
+        let w = -wi[2] - wr[2];
+        if w.abs() > max_w {
+            continue;
+        }
+        let (l0, l1) = lambda_range;
+        let l = l0 + (l1 - l0) * rng.next_f64();
+        pts.push([-wi[0] - wr[0], -wi[1] - wr[1], w, l]);
+    }
+    pts
+}
+
 /// `n` directions on the upper hemisphere (Fibonacci lattice, uniform in solid
 /// angle), with d.n in [min_cos, 1].
 pub fn fibonacci_hemisphere(n: usize, min_cos: f64) -> Vec<[f64; 3]> {

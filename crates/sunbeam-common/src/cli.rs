@@ -12,8 +12,9 @@
 //! ```
 //!
 //! Length arguments are parsed by clap value parsers built on [`crate::units`]
-//! ([`length`], [`positive_length`], [`length_range`], [`pixel_size`]), so a bad
-//! value is a usage error (exit 1) that names the flag, before the tool runs.
+//! ([`length`], [`positive_length`], [`length_range`], [`pixel_size`]), angles
+//! by [`angle`] and sizes in bytes by [`byte_size`], so a bad value is a usage
+//! error (exit 1) that names the flag, before the tool runs.
 
 use crate::error::{run_main, Error, Result};
 use crate::units;
@@ -119,6 +120,32 @@ pub fn pixel_size(s: &str) -> Result<PixelSize> {
     }
 }
 
+/// clap value parser: an angle (`75deg`, `1.3rad`; a bare number is degrees), in radians.
+pub fn angle(s: &str) -> Result<f64> {
+    units::parse_angle(s)
+}
+
+/// clap value parser: a size in bytes, at least 1, with an optional suffix
+/// `B`, `KiB`, `MiB` or `GiB` (`64MiB`, `1.5GiB`, `4096`).
+pub fn byte_size(s: &str) -> Result<usize> {
+    let t = s.trim();
+    let (num, mult) = [
+        ("GiB", 1usize << 30),
+        ("MiB", 1 << 20),
+        ("KiB", 1 << 10),
+        ("B", 1),
+    ]
+    .iter()
+    .find_map(|(suf, m)| t.strip_suffix(suf).map(|n| (n.trim(), *m)))
+    .unwrap_or((t, 1));
+    match num.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 1.0 => Ok((v * mult as f64) as usize),
+        _ => Err(Error::usage(
+            "not a size: give one such as 64MiB (suffixes B, KiB, MiB, GiB)",
+        )),
+    }
+}
+
 /// clap value parser for an enum of named values (`--model window|tiled`):
 /// `names` are shown in `--help` and checked by clap, then parsed with `T::from_str`.
 pub fn one_of<T>(names: &'static [&'static str]) -> impl clap::builder::TypedValueParser<Value = T>
@@ -142,6 +169,34 @@ mod tests {
         pixel_size: Option<PixelSize>,
         #[arg(long, value_parser = positive_length, default_value = "65um")]
         coherence: f64,
+        #[arg(long, value_parser = angle, default_value = "75deg", allow_hyphen_values = true)]
+        theta: f64,
+    }
+
+    #[test]
+    fn angles_parse_in_clap() {
+        let c = parse_from::<Cli, _, _>(["t"]).unwrap().unwrap();
+        assert!((c.theta - 75f64.to_radians()).abs() < 1e-15);
+        let c = parse_from::<Cli, _, _>(["t", "--theta", "-0.5rad"])
+            .unwrap()
+            .unwrap();
+        assert_eq!(c.theta, -0.5);
+        let e = parse_from::<Cli, _, _>(["t", "--theta", "75furlongs"]).unwrap_err();
+        assert_eq!(e.exit_code(), 1);
+        assert!(e.to_string().contains("--theta"), "{e}");
+    }
+
+    #[test]
+    fn byte_sizes() {
+        assert_eq!(byte_size("64MiB").unwrap(), 64 << 20);
+        assert_eq!(byte_size(" 1.5 GiB ").unwrap(), 3 << 29);
+        assert_eq!(byte_size("2KiB").unwrap(), 2048);
+        assert_eq!(byte_size("100B").unwrap(), 100);
+        assert_eq!(byte_size("4096").unwrap(), 4096);
+        for bad in ["", "lots", "0", "0.5MiB", "-1MiB", "inf", "NaN", "64MB"] {
+            let e = byte_size(bad).unwrap_err();
+            assert_eq!(e.exit_code(), 1, "{bad}");
+        }
     }
 
     #[test]

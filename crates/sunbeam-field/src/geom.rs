@@ -1,4 +1,4 @@
-//! Rotations by quarter turns, flips and crops. Pixel sizes follow the axes.
+//! Rotations by quarter turns, flips, crops and tiling. Pixel sizes follow the axes.
 
 use crate::HeightField;
 use sunbeam_common::{Error, Result};
@@ -99,7 +99,7 @@ impl CropSpec {
     pub fn parse(s: &str) -> Result<CropSpec> {
         let parts: Vec<&str> = s.split(',').map(str::trim).collect();
         if parts.len() != 4 {
-            return Err(Error::usage(format!("--crop '{s}': expected X,Y,W,H")));
+            return Err(Error::usage("expected X,Y,W,H"));
         }
         if parts.iter().all(|p| p.parse::<usize>().is_ok()) {
             let v: Vec<usize> = parts.iter().map(|p| p.parse().unwrap_or(0)).collect();
@@ -113,12 +113,10 @@ impl CropSpec {
         let mut v = [0.0; 4];
         for (k, p) in parts.iter().enumerate() {
             v[k] = sunbeam_common::units::parse_length(p).map_err(|e| {
-                Error::usage(format!(
-                    "--crop '{s}': {e} (give all four in pixels or all with units)"
-                ))
+                Error::usage(format!("{e} (give all four in pixels or all with units)"))
             })?;
             if v[k] < 0.0 {
-                return Err(Error::usage(format!("--crop '{s}': negative value")));
+                return Err(Error::usage("negative value"));
             }
         }
         Ok(CropSpec::Metres {
@@ -139,6 +137,25 @@ impl CropSpec {
             }
         }
     }
+}
+
+/// Replicate a height field `nx` x `ny` times (a periodic patch seen by a
+/// window larger than one period); `nx = ny = 1` is a copy.
+pub fn tile(f: &HeightField, nx: usize, ny: usize) -> Result<HeightField> {
+    if nx == 1 && ny == 1 {
+        return Ok(f.clone());
+    }
+    let (w, h) = (f.width * nx, f.height * ny);
+    let mut data = Vec::with_capacity(w * h);
+    for r in 0..h {
+        for c in 0..w {
+            data.push(f.at(r % f.height, c % f.width));
+        }
+    }
+    let mut t = HeightField::new(w, h, f.dx, f.dy, data)?;
+    t.provenance = f.provenance.clone();
+    t.provenance.processing.push(format!("tiled {nx}x{ny}"));
+    Ok(t)
 }
 
 #[cfg(test)]
@@ -191,5 +208,24 @@ mod tests {
             (1, 1, 3, 2)
         );
         assert!(CropSpec::parse("1,2nm,3,4").is_err());
+    }
+
+    #[test]
+    fn tiling() {
+        let t = tile(&f32x2(), 2, 2).unwrap();
+        assert_eq!((t.width, t.height, t.dx, t.dy), (6, 4, 1.0, 2.0));
+        #[rustfmt::skip]
+        let want = vec![
+            0.0, 1.0, 2.0, 0.0, 1.0, 2.0,
+            3.0, 4.0, 5.0, 3.0, 4.0, 5.0,
+            0.0, 1.0, 2.0, 0.0, 1.0, 2.0,
+            3.0, 4.0, 5.0, 3.0, 4.0, 5.0,
+        ];
+        assert_eq!(t.data, want);
+        assert_eq!(t.provenance.processing.last().unwrap(), "tiled 2x2");
+        assert_eq!(tile(&f32x2(), 1, 1).unwrap(), f32x2());
+        let row = tile(&f32x2(), 1, 3).unwrap();
+        assert_eq!((row.width, row.height), (3, 6));
+        assert_eq!(&row.data[12..], &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
     }
 }

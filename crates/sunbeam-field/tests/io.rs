@@ -215,13 +215,8 @@ fn mutated_files_never_panic() {
         (0..63).map(|v| v as f64 * 1e-10).collect(),
     )
     .unwrap();
-    let mut seed = 0x1234_5678_9abc_def0u64;
-    let mut next = move || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 33) as usize
-    };
+    let mut rng = sunbeam_common::rng::SplitMix64::new(0x1234_5678_9abc_def0);
+    let mut next = move || (rng.next_u64() >> 33) as usize;
     for kind in [Kind::Exr, Kind::Gsf] {
         let good = io::encode(kind, &f).unwrap();
         for _ in 0..3000 {

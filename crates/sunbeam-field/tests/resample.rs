@@ -7,15 +7,15 @@
 use sunbeam_field::resample::{resample, resample_grid, Target};
 use sunbeam_field::HeightField;
 
-/// A deterministic pseudo-random generator (no dependencies).
+/// Deterministic pseudo-random numbers in [-1, 1): the project's seeded
+/// `SplitMix64` (`sunbeam_common::rng`), state in `.0`.
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        let mut g = sunbeam_common::rng::SplitMix64(self.0);
+        let v = g.unit();
+        self.0 = g.0;
+        v * 2.0 - 1.0
     }
 }
 

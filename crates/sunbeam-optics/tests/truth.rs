@@ -13,16 +13,11 @@ fn field(w: usize, h: usize, dx: f64, dy: f64, f: impl Fn(usize, usize) -> f64) 
     HeightField::new(w, h, dx, dy, data).unwrap()
 }
 
-/// A deterministic pseudo-random rough surface (xorshift), heights in [0, amp].
+/// A deterministic pseudo-random rough surface (the project's seeded
+/// `SplitMix64`), heights in [0, amp].
 fn rough(w: usize, h: usize, dx: f64, dy: f64, amp: f64, seed: u64) -> HeightField {
-    let mut s = seed;
-    let mut next = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let data: Vec<f64> = (0..w * h).map(|_| amp * next()).collect();
+    let mut rng = sunbeam_common::rng::SplitMix64::new(seed);
+    let data: Vec<f64> = (0..w * h).map(|_| amp * rng.unit()).collect();
     HeightField::new(w, h, dx, dy, data).unwrap()
 }
 

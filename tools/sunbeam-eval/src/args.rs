@@ -67,8 +67,8 @@ pub(crate) struct CompareArgs {
     #[arg(long, default_value_t = 64)]
     pub(crate) views: usize,
     /// Light directions `THETA[,PHI]` (repeatable); default 0, 30, 60, 75 deg at phi 0 and 60 deg at phi 90.
-    #[arg(long, allow_hyphen_values = true)]
-    pub(crate) light: Vec<String>,
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_light)]
+    pub(crate) light: Vec<[f64; 3]>,
     /// Wavelength samples of the pack's colour integral (the truth uses 1 nm).
     #[arg(long, default_value_t = 64)]
     pub(crate) lambda_samples: usize,
@@ -90,8 +90,8 @@ pub(crate) struct BrdfArgs {
     /// The pack (KTX2/EXR).
     pub(crate) pack: PathBuf,
     /// Light direction `THETA[,PHI]`.
-    #[arg(long, default_value = "60deg,0deg", allow_hyphen_values = true)]
-    pub(crate) light: String,
+    #[arg(long, default_value = "60deg,0deg", allow_hyphen_values = true, value_parser = parse_light)]
+    pub(crate) light: [f64; 3],
     /// Output PNG.
     #[arg(short, long)]
     pub(crate) output: PathBuf,
@@ -106,7 +106,7 @@ pub(crate) struct BrdfArgs {
     pub(crate) exposure: Option<f64>,
     /// Tone curve: clamp or reinhard.
     #[arg(long, default_value = "clamp")]
-    pub(crate) tone: String,
+    pub(crate) tone: sunbeam_optics::colour::ToneCurve,
     #[arg(long)]
     pub(crate) json: bool,
 }
@@ -148,11 +148,11 @@ pub(crate) struct GratingArgs {
     /// A height field or a pack.
     pub(crate) input: PathBuf,
     /// Incidence angle in the plane of incidence.
-    #[arg(long, default_value = "75deg", allow_hyphen_values = true)]
-    pub(crate) theta_i: String,
+    #[arg(long, default_value = "75deg", allow_hyphen_values = true, value_parser = cli::angle)]
+    pub(crate) theta_i: f64,
     /// Azimuth of the plane of incidence from the patch's +x axis.
-    #[arg(long, default_value = "0deg", allow_hyphen_values = true)]
-    pub(crate) azimuth: String,
+    #[arg(long, default_value = "0deg", allow_hyphen_values = true, value_parser = cli::angle)]
+    pub(crate) azimuth: f64,
     /// Wavelength range.
     #[arg(long, default_value = "380nm..780nm", value_parser = cli::length_range)]
     pub(crate) lambda: (f64, f64),
@@ -160,8 +160,8 @@ pub(crate) struct GratingArgs {
     #[arg(long, default_value = "10nm", value_parser = cli::positive_length)]
     pub(crate) lambda_step: f64,
     /// Viewing-angle step of the scan (peaks are then refined on the continuous R).
-    #[arg(long, default_value = "0.1deg")]
-    pub(crate) angle_step: String,
+    #[arg(long, default_value = "0.1deg", value_parser = cli::angle)]
+    pub(crate) angle_step: f64,
     /// Order of the brightest peaks when the orders cannot be told apart (one order visible).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     pub(crate) order: i32,
@@ -169,8 +169,8 @@ pub(crate) struct GratingArgs {
     #[arg(long, value_name = "LEN", value_parser = cli::positive_length)]
     pub(crate) max_period: Option<f64>,
     /// Replicate the height field NxM times first (a periodic patch seen by a wider window).
-    #[arg(long, value_name = "NxM")]
-    pub(crate) tile: Option<String>,
+    #[arg(long, value_name = "NxM", value_parser = input::parse_tile)]
+    pub(crate) tile: Option<(usize, usize)>,
     /// The true period, if known: drawn in the plot and compared in the report.
     #[arg(long, value_name = "LEN", value_parser = cli::positive_length)]
     pub(crate) true_period: Option<f64>,
@@ -240,9 +240,7 @@ pub(crate) fn parse_light(s: &str) -> sunbeam_common::Result<[f64; 3]> {
     let th = units::parse_angle(a)?;
     let ph = units::parse_angle(b)?;
     if !(0.0..89.9f64.to_radians()).contains(&th.abs()) {
-        return Err(Error::usage(format!(
-            "--light '{s}': polar angle must be in [0, 89.9) degrees"
-        )));
+        return Err(Error::usage("the polar angle must be in [0, 89.9) degrees"));
     }
     Ok(sunbeam_analysis::sample::dir(th.abs(), ph))
 }

@@ -9,10 +9,10 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use sunbeam_analysis::compare::{colour_vs, spectral_at, truth_colours, SpectralError};
-use sunbeam_analysis::sample::Rng;
 use sunbeam_common::{output, Error, Result};
 use sunbeam_field::HeightField;
-use sunbeam_optics::truth::{Model as TModel, Params, Truth};
+use sunbeam_optics::truth::{Params, Truth};
+use sunbeam_optics::Model;
 use sunbeam_pack::{Basis, BuildOptions, FieldRef, Pack, Precision};
 
 pub struct Options {
@@ -87,15 +87,7 @@ fn fref(f: &HeightField) -> FieldRef<'_> {
 }
 
 fn points(n: usize, seed: u64, min_cos: f64, lambda: (f64, f64)) -> Vec<[f64; 4]> {
-    let mut rng = Rng::new(seed);
-    (0..n)
-        .map(|_| {
-            let wi = rng.hemisphere(min_cos);
-            let wr = rng.hemisphere(min_cos);
-            let l = lambda.0 + (lambda.1 - lambda.0) * rng.next_f64();
-            [-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], l]
-        })
-        .collect()
+    sunbeam_analysis::sample::scatter_points(n, seed, min_cos, f64::INFINITY, lambda)
 }
 
 fn build(
@@ -164,7 +156,7 @@ pub fn run(o: &Options) -> Result<()> {
         let truth = Truth::new(
             f,
             &Params {
-                model: TModel::Window,
+                model: Model::Window,
                 coherence_m: 65e-6,
             },
         )?;
@@ -256,7 +248,7 @@ pub fn run(o: &Options) -> Result<()> {
         let truth = Truth::new(
             &f,
             &Params {
-                model: TModel::Window,
+                model: Model::Window,
                 coherence_m: 65e-6,
             },
         )?;

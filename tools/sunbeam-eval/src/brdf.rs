@@ -6,8 +6,7 @@
 use crate::plot::{perr, png, viridis};
 use plotters::prelude::*;
 use std::path::Path;
-use sunbeam_analysis::par_map;
-use sunbeam_analysis::sample::percentile;
+use sunbeam_analysis::brdf;
 use sunbeam_common::Result;
 use sunbeam_optics::colour::{self, ToneMap};
 use sunbeam_pack::Pack;
@@ -29,50 +28,25 @@ pub struct Outcome {
 
 pub fn run(pack: &Pack, o: &Options, out: &Path) -> Result<Outcome> {
     let n = o.size;
-    let px = par_map(n * n, |k| {
-        let (i, j) = (k % n, k / n);
-        let x = (i as f64 + 0.5) / n as f64 * 2.0 - 1.0;
-        let y = 1.0 - (j as f64 + 0.5) / n as f64 * 2.0;
-        let r2 = x * x + y * y;
-        if r2 >= 0.999 {
-            return None;
-        }
-        let wr = [x, y, (1.0 - r2).sqrt()];
-        Some(pack.colour_xyz(o.light, wr, o.lambda_samples))
-    });
-    let ys: Vec<f64> = px.iter().flatten().map(|c| c[1]).collect();
-    let max_y = ys.iter().copied().fold(0.0, f64::max);
-    let ev = o.exposure_ev.unwrap_or_else(|| {
-        let p = percentile(&ys, 95.0);
-        if p > 0.0 && p.is_finite() {
-            -p.log2()
-        } else {
-            0.0
-        }
-    });
+    let hemi = brdf::hemisphere(pack, o.light, n, o.lambda_samples);
+    let max_y = hemi.max_y;
+    let ev = o.exposure_ev.unwrap_or_else(|| hemi.auto_exposure_ev());
     let tm = ToneMap {
         exposure_ev: ev,
         curve: o.tone.curve,
     };
-    let img: Vec<Option<[u8; 3]>> = px
+    let img: Vec<Option<[u8; 3]>> = hemi
+        .xyz
         .iter()
         .map(|c| c.map(|xyz| colour::xyz_to_srgb8(xyz, &tm)))
         .collect();
 
     // Right panel: R over (theta_r, lambda) in the plane of incidence.
-    let (lt, lp) = (o.light[2].acos(), o.light[1].atan2(o.light[0]));
-    let (ca, sa) = (lp.cos(), lp.sin());
+    let lt = o.light[2].acos();
     let m = &pack.manifest;
-    let nl = 80usize;
-    let na = 360usize;
-    let grid = par_map(nl * na, |k| {
-        let (li, ai) = (k / na, k % na);
-        let l = m.lambda_min_m + (m.lambda_max_m - m.lambda_min_m) * (li as f64 + 0.5) / nl as f64;
-        let th = (-89.5 + 179.0 * (ai as f64 + 0.5) / na as f64).to_radians();
-        let wi = [lt.sin() * ca, lt.sin() * sa, lt.cos()];
-        let wr = [th.sin() * ca, th.sin() * sa, th.cos()];
-        pack.reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], l)
-    });
+    let plane = brdf::plane_of_incidence(pack, o.light, 80, 360);
+    let (nl, na, grid) = (plane.lambdas, plane.angles, &plane.r);
+    let (a0, a1) = brdf::PlaneGrid::ANGLE_RANGE_DEG;
     let lo_nm = m.lambda_min_m * 1e9;
     let hi_nm = m.lambda_max_m * 1e9;
     png(out, 1300, 640, |root| {
@@ -131,7 +105,7 @@ pub fn run(pack: &Pack, o: &Options, out: &Path) -> Result<Outcome> {
             .margin(12)
             .x_label_area_size(44)
             .y_label_area_size(60)
-            .build_cartesian_2d(-89.5f64..89.5, lo_nm..hi_nm)
+            .build_cartesian_2d(a0..a1, lo_nm..hi_nm)
             .map_err(perr)?;
         c2.configure_mesh()
             .disable_mesh()
@@ -141,10 +115,10 @@ pub fn run(pack: &Pack, o: &Options, out: &Path) -> Result<Outcome> {
             .draw()
             .map_err(perr)?;
         let dl = (hi_nm - lo_nm) / nl as f64;
-        let da = 179.0 / na as f64;
+        let da = (a1 - a0) / na as f64;
         c2.draw_series(grid.iter().enumerate().map(|(k, r)| {
             let (li, ai) = (k / na, k % na);
-            let a = -89.5 + ai as f64 * da;
+            let a = a0 + ai as f64 * da;
             let l = lo_nm + li as f64 * dl;
             // log10 R from -6 to 0 mapped to the colour map.
             let t = ((r.max(1e-12)).log10() + 6.0) / 6.0;

@@ -5,7 +5,7 @@ use crate::{bench, brdf, grating_plot, input, probe, render, sheet};
 use serde_json::json;
 
 use sunbeam_analysis::{compare, grating, sample, Source};
-use sunbeam_common::{units, Error, Result};
+use sunbeam_common::{Error, Result};
 
 pub(crate) fn run(cli: Cli) -> Result<()> {
     match cli.cmd {
@@ -35,11 +35,10 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
 }
 
 fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
-    let theta_i = units::parse_angle(&a.theta_i)?;
-    let azimuth = units::parse_angle(&a.azimuth)?;
+    let (theta_i, azimuth) = (a.theta_i, a.azimuth);
     let (lmin, lmax) = a.lambda;
     let lstep = a.lambda_step;
-    let astep = units::parse_angle(&a.angle_step)?;
+    let astep = a.angle_step;
     let (max_period, true_period) = (a.max_period, a.true_period);
     let params = a.model.params()?;
     let src = if input::is_pack(&a.input)? {
@@ -49,9 +48,8 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
         Source::open(&a.input, &a.heights.options(), &a.model.params()?, false)?
     } else {
         let mut f = input::read_height(&a.input, &a.heights)?;
-        if let Some(t) = &a.tile {
-            let (nx, ny) = input::parse_tile(t)?;
-            f = input::tile(&f, nx, ny)?;
+        if let Some((nx, ny)) = a.tile {
+            f = sunbeam_field::geom::tile(&f, nx, ny)?;
         }
         Source::from_field(f, &params).map_err(|e| e.context(a.input.display()))?
     };
@@ -139,16 +137,13 @@ fn grating_cmd(a: GratingArgs, quiet: bool) -> Result<()> {
 }
 
 fn compare_cmd(a: CompareArgs) -> Result<()> {
-    use sunbeam_optics::truth::{Model, Params, Truth};
+    use sunbeam_optics::truth::{Params, Truth};
     if a.points == 0 || a.views == 0 || a.lambda_samples == 0 {
         return Err(Error::usage(
             "--points, --views and --lambda-samples must be positive",
         ));
     }
-    let mut lights = Vec::new();
-    for l in &a.light {
-        lights.push(parse_light(l)?);
-    }
+    let mut lights = a.light.clone();
     if lights.is_empty() {
         for (t, p) in [
             (0.0, 0.0),
@@ -172,10 +167,7 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
             ),
         ));
     }
-    let model = match m.model {
-        sunbeam_pack::Model::Window => Model::Window,
-        sunbeam_pack::Model::Tiled => Model::Tiled,
-    };
+    let model = m.model;
     let truth = Truth::new(
         &field,
         &Params {
@@ -247,14 +239,14 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
 }
 
 fn brdf_cmd(a: BrdfArgs) -> Result<()> {
-    use sunbeam_optics::colour::{ToneCurve, ToneMap};
-    let light = parse_light(&a.light)?;
+    use sunbeam_optics::colour::ToneMap;
+    let light = a.light;
     if !(16..=2048).contains(&a.size) || a.lambda_samples == 0 {
         return Err(Error::usage(
             "--size must be 16..2048 and --lambda-samples positive",
         ));
     }
-    let curve: ToneCurve = a.tone.parse()?;
+    let curve = a.tone;
     let pack = sunbeam_pack::Pack::read(&a.pack)?;
     let title = a
         .pack

@@ -46,25 +46,6 @@ pub fn read_height(path: &Path, args: &HeightArgs) -> Result<HeightField> {
     Ok(height::read_height_field(path, &args.options())?.field)
 }
 
-/// Replicate a height field `nx` x `ny` times (a periodic patch seen by a
-/// window larger than one period).
-pub fn tile(f: &HeightField, nx: usize, ny: usize) -> Result<HeightField> {
-    if nx == 1 && ny == 1 {
-        return Ok(f.clone());
-    }
-    let (w, h) = (f.width * nx, f.height * ny);
-    let mut data = Vec::with_capacity(w * h);
-    for r in 0..h {
-        for c in 0..w {
-            data.push(f.at(r % f.height, c % f.width));
-        }
-    }
-    let mut t = HeightField::new(w, h, f.dx, f.dy, data)?;
-    t.provenance = f.provenance.clone();
-    t.provenance.processing.push(format!("tiled {nx}x{ny}"));
-    Ok(t)
-}
-
 /// `NxM` (or `N`, meaning `Nx1`).
 pub fn parse_tile(s: &str) -> Result<(usize, usize)> {
     let (a, b) = s.split_once(['x', 'X']).unwrap_or((s, "1"));
@@ -73,7 +54,7 @@ pub fn parse_tile(s: &str) -> Result<(usize, usize)> {
             .parse::<usize>()
             .ok()
             .filter(|&n| (1..=64).contains(&n))
-            .ok_or_else(|| Error::usage(format!("--tile '{s}': expected NxM with 1 <= N, M <= 64")))
+            .ok_or_else(|| Error::usage("expected NxM with 1 <= N, M <= 64"))
     };
     Ok((p(a)?, p(b)?))
 }

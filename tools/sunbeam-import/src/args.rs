@@ -2,7 +2,13 @@
 
 use clap::Parser;
 use std::path::PathBuf;
+use sunbeam_afm::Format;
 use sunbeam_common::cli::{pixel_size, positive_length, PixelSize};
+use sunbeam_common::units::parse_size;
+use sunbeam_common::{Error, Result};
+use sunbeam_field::align::AlignRows;
+use sunbeam_field::geom::CropSpec;
+use sunbeam_field::pipeline::{FlipAxis, Level};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -21,8 +27,8 @@ pub(crate) struct Cli {
     #[arg(short, long, required_unless_present = "list")]
     pub(crate) output: Option<PathBuf>,
     /// Force the input format (nanoscope, gwy, gsf, ibw, sxm, park, jpk, png, tiff, bmp, ascii, xyz, exr).
-    #[arg(long, value_name = "NAME")]
-    pub(crate) format: Option<String>,
+    #[arg(long, value_name = "NAME", value_parser = format_name)]
+    pub(crate) format: Option<Format>,
     /// List the channels (name, size, physical size, units) and exit.
     #[arg(long)]
     pub(crate) list: bool,
@@ -31,10 +37,10 @@ pub(crate) struct Cli {
     pub(crate) channel: Option<String>,
     /// Background levelling: plane (Gwyddion's Plane Level) or poly:N.
     #[arg(long, value_name = "plane|poly:N")]
-    pub(crate) level: Option<String>,
+    pub(crate) level: Option<Level>,
     /// Row alignment: median, median-diff or none (Gwyddion's Align Rows).
     #[arg(long, value_name = "METHOD")]
-    pub(crate) align_rows: Option<String>,
+    pub(crate) align_rows: Option<AlignRows>,
     /// Replace NaN/Inf values by Laplace interpolation.
     #[arg(long)]
     pub(crate) fill_nonfinite: bool,
@@ -53,10 +59,10 @@ pub(crate) struct Cli {
     pub(crate) rotate: Option<i32>,
     /// Mirror along x (left-right) or y (top-bottom).
     #[arg(long, value_name = "x|y")]
-    pub(crate) flip: Option<String>,
+    pub(crate) flip: Option<FlipAxis>,
     /// Crop X,Y,W,H from the top-left corner: pixels (10,10,256,256) or lengths (0um,0um,1um,1um).
-    #[arg(long, value_name = "X,Y,W,H")]
-    pub(crate) crop: Option<String>,
+    #[arg(long, value_name = "X,Y,W,H", value_parser = CropSpec::parse)]
+    pub(crate) crop: Option<CropSpec>,
     /// Pixel size. For files without lateral calibration (plain images, bare
     /// ASCII matrices, EXRs from other tools) it IS the calibration; for
     /// calibrated files it resamples to square pixels of this size.
@@ -67,8 +73,8 @@ pub(crate) struct Cli {
     #[arg(long, value_name = "LEN", conflicts_with = "size", value_parser = positive_length)]
     pub(crate) resample_to: Option<f64>,
     /// Resample to WxH pixels (square pixels; the longer side is cropped if the aspect differs).
-    #[arg(long, value_name = "WxH")]
-    pub(crate) size: Option<String>,
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub(crate) size: Option<(usize, usize)>,
     /// Calibration for uncalibrated images: height of the full grey range.
     #[arg(long, value_name = "LEN", value_parser = positive_length)]
     pub(crate) z_range: Option<f64>,
@@ -96,4 +102,12 @@ pub(crate) struct Cli {
     /// Print the steps.
     #[arg(short, long)]
     pub(crate) verbose: bool,
+}
+
+/// clap value parser of `--format`: a format's name or alias.
+fn format_name(s: &str) -> Result<Format> {
+    Format::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
+        Error::usage(format!("unknown format (one of {})", names.join(", ")))
+    })
 }

@@ -5,12 +5,10 @@ use std::path::Path;
 use sunbeam_afm::height::{self, HeightOptions};
 use sunbeam_afm::{Channel, ChannelInfo, Format};
 use sunbeam_common::cli::PixelSize;
-use sunbeam_common::units::{format_length, parse_size};
+use sunbeam_common::units::format_length;
 use sunbeam_common::{Error, Result};
-use sunbeam_field::align::AlignRows;
-use sunbeam_field::geom::CropSpec;
 use sunbeam_field::io::{self, Kind};
-use sunbeam_field::pipeline::{self, FlipAxis, Level, Step};
+use sunbeam_field::pipeline::{self, Step};
 use sunbeam_field::resample::Target;
 use sunbeam_field::stats::Stats;
 
@@ -23,21 +21,18 @@ struct Plan {
 }
 
 fn plan(cli: &Cli) -> Result<Plan> {
-    let ctx = |flag: &'static str| move |e: Error| e.context(flag);
     let mut steps = Vec::new();
-    if let Some(c) = &cli.crop {
-        steps.push(Step::Crop(CropSpec::parse(c)?));
+    if let Some(c) = cli.crop {
+        steps.push(Step::Crop(c));
     }
     if cli.fill_nonfinite {
         steps.push(Step::FillNonFinite);
     }
-    if let Some(l) = &cli.level {
-        steps.push(Step::Level(l.parse::<Level>().map_err(ctx("--level"))?));
+    if let Some(l) = cli.level {
+        steps.push(Step::Level(l));
     }
-    if let Some(a) = &cli.align_rows {
-        steps.push(Step::AlignRows(
-            a.parse::<AlignRows>().map_err(ctx("--align-rows"))?,
-        ));
+    if let Some(a) = cli.align_rows {
+        steps.push(Step::AlignRows(a));
     }
     if cli.remove_scars {
         steps.push(Step::RemoveScars);
@@ -51,25 +46,17 @@ fn plan(cli: &Cli) -> Result<Plan> {
         }
         steps.push(Step::Rotate(r));
     }
-    if let Some(f) = &cli.flip {
-        steps.push(Step::Flip(f.parse::<FlipAxis>().map_err(ctx("--flip"))?));
+    if let Some(f) = cli.flip {
+        steps.push(Step::Flip(f));
     }
     if let Some(r) = cli.resample_to {
         steps.push(Step::Resample(Target::PixelSize(r)));
     }
-    if let Some(s) = &cli.size {
-        let (w, h) = parse_size(s).map_err(ctx("--size"))?;
+    if let Some((w, h)) = cli.size {
         steps.push(Step::Resample(Target::Size(w, h)));
     }
     steps.sort_by_key(Step::canonical_order);
-    let format = cli
-        .format
-        .as_deref()
-        .map(|f| {
-            Format::from_name(f)
-                .ok_or_else(|| Error::usage(format!("--format {f}: unknown format")))
-        })
-        .transpose()?;
+    let format = cli.format;
     if let Some(o) = &cli.output {
         Kind::from_path(o)?;
         if same_file(o, &cli.input) {

@@ -95,8 +95,8 @@ pub(crate) struct Cli {
     #[arg(long, default_value_t = sunbeam_response::build::DEFAULT_LAMBDA_SAMPLES)]
     pub(crate) response_lambda: usize,
     /// Size bound of the response map (e.g. 64MiB; RGBA16F texels).
-    #[arg(long, default_value = "64MiB")]
-    pub(crate) response_budget: String,
+    #[arg(long, default_value = "64MiB", value_name = "SIZE", value_parser = sunbeam_common::cli::byte_size)]
+    pub(crate) response_budget: usize,
     /// Print a JSON report on stdout.
     #[arg(long)]
     pub(crate) json: bool,

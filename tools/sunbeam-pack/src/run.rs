@@ -12,26 +12,6 @@ use sunbeam_pack::formats::{write_pack, OutputKind};
 use sunbeam_pack::manifest::Source;
 use sunbeam_pack::{Basis, Precision};
 
-/// A byte count with an optional KiB/MiB/GiB suffix.
-fn parse_bytes(s: &str) -> Result<usize> {
-    let t = s.trim();
-    let (num, mult) = [
-        ("GiB", 1usize << 30),
-        ("MiB", 1 << 20),
-        ("KiB", 1 << 10),
-        ("B", 1),
-    ]
-    .iter()
-    .find_map(|(suf, m)| t.strip_suffix(suf).map(|n| (n.trim(), *m)))
-    .unwrap_or((t, 1));
-    match num.parse::<f64>() {
-        Ok(v) if v.is_finite() && v >= 1.0 => Ok((v * mult as f64) as usize),
-        _ => Err(sunbeam_common::Error::usage(format!(
-            "--response-budget '{s}': give a size such as 64MiB"
-        ))),
-    }
-}
-
 /// The triangles of a scene's mesh file (for `--scene`).
 fn mesh_triangles(path: &Path) -> Result<sunbeam_scene::reach::Triangles> {
     let m = sunbeam_mesh::load_scene_mesh(path)?;
@@ -177,7 +157,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             let t = Instant::now();
             let ro = sunbeam_response::Options {
                 lambda_samples: cli.response_lambda.clamp(1, 4096),
-                budget_bytes: parse_bytes(&cli.response_budget)?,
+                budget_bytes: cli.response_budget,
                 grid: None,
             };
             let r = sunbeam_response::build(&pack, &ro);

@@ -75,15 +75,15 @@ pub fn grid(
     (pos, uv, idx)
 }
 
-/// Deterministic pseudo-random numbers in [0,1).
+/// Deterministic pseudo-random numbers in [0,1): the project's seeded
+/// `SplitMix64` (`sunbeam_common::rng`), state in `.0`.
 pub struct Lcg(pub u64);
 impl Lcg {
     pub fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        let mut g = sunbeam_common::rng::SplitMix64(self.0);
+        let v = g.unit();
+        self.0 = g.0;
+        v
     }
 }
 

@@ -5,14 +5,15 @@ use sunbeam_field::HeightField;
 use sunbeam_pack::build::{BuildOptions, FieldRef};
 use sunbeam_pack::Pack;
 
-/// Deterministic xorshift RNG in [0, 1).
+/// Deterministic random numbers in [0, 1): the project's seeded
+/// `SplitMix64` (`sunbeam_common::rng`), state in `.0`.
 pub struct Rng(pub u64);
 impl Rng {
     pub fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        let mut g = sunbeam_common::rng::SplitMix64(self.0);
+        let v = g.unit();
+        self.0 = g.0;
+        v
     }
     pub fn range(&mut self, a: f64, b: f64) -> f64 {
         a + (b - a) * self.next()
