@@ -22,6 +22,21 @@ struct Taps {
 
 impl Pack {
     /// Checks shared by the readers: sizes and finiteness.
+    /// A pack known by its manifest only (`Pack::read_manifest`), for a reader
+    /// that needs no term data (the player's default mode reads a response map
+    /// built from it). Its evaluators must not be called: [`Pack::has_terms`].
+    pub fn manifest_only(manifest: Manifest) -> Pack {
+        Pack {
+            manifest,
+            terms: Vec::new(),
+        }
+    }
+
+    /// False for [`Pack::manifest_only`].
+    pub fn has_terms(&self) -> bool {
+        !self.terms.is_empty()
+    }
+
     pub fn new(manifest: Manifest, terms: Vec<f32>) -> Result<Pack> {
         manifest.validate()?;
         let want = manifest

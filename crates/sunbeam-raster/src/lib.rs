@@ -122,6 +122,12 @@ pub fn default_scene(mesh: &Path, pack: Option<&Path>) -> Result<Scene> {
 
 /// Load every mesh and pack of a scene (each file once).
 pub fn prepare(scene: &Scene) -> Result<Prepared> {
+    prepare_with(scene, &Pack::read)
+}
+
+/// [`prepare`] with the packs read by `load_pack` (the player reads only a
+/// pack's manifest when a current response map stands beside it).
+pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) -> Result<Prepared> {
     let mut meshes = Vec::new();
     let mut mesh_cache: Vec<(std::path::PathBuf, Arc<Mesh>)> = Vec::new();
     let mut pack_cache: Vec<(std::path::PathBuf, Arc<Pack>)> = Vec::new();
@@ -142,7 +148,7 @@ pub fn prepare(scene: &Scene) -> Result<Prepared> {
                 Some((_, k)) => k.clone(),
                 None => {
                     let k = Arc::new(
-                        Pack::read(pp).map_err(|e| e.context(format!("meshes[{i}].pack")))?,
+                        load_pack(pp).map_err(|e| e.context(format!("meshes[{i}].pack")))?,
                     );
                     pack_cache.push((pp.clone(), k.clone()));
                     k

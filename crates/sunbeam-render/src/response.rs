@@ -14,6 +14,21 @@ use sunbeam_response::{ktx2, Response};
 /// `dir/NAME.response.ktx2` for a pack `dir/NAME.ext`.
 pub use sunbeam_response::sidecar_path as sidecar;
 
+/// Read a pack for the default mode: only its manifest when a response map
+/// built from it stands beside it (the map is all the default mode draws
+/// with; a 4096^2 scan's pack is 430 MB), else the whole pack.
+pub fn load_pack(path: &Path) -> Result<Pack> {
+    let side = sidecar(path);
+    if side.is_file() {
+        if let (Ok(m), Ok(info)) = (Pack::read_manifest(path), ktx2::read_info(&side)) {
+            if info.pack == m {
+                return Ok(Pack::manifest_only(m));
+            }
+        }
+    }
+    Pack::read(path)
+}
+
 /// The map of `pack` (read from `path`'s sidecar, or built), and a note for the
 /// user when it had to be built.
 pub fn load_or_build(
@@ -21,6 +36,21 @@ pub fn load_or_build(
     path: Option<&Path>,
     opts: &sunbeam_response::Options,
 ) -> Result<(Arc<Response>, Option<String>)> {
+    // A manifest-only pack (load_pack) has no terms to build from: read it whole
+    // if its map turns out not to be current after all.
+    let full;
+    let pack = match path {
+        Some(p) if !pack.has_terms() => {
+            if let Ok(r) = ktx2::read(&sidecar(p)) {
+                if r.info.pack == pack.manifest {
+                    return Ok((Arc::new(r), None));
+                }
+            }
+            full = Arc::new(Pack::read(p)?);
+            &full
+        }
+        _ => pack,
+    };
     if let Some(p) = path {
         let side = sidecar(p);
         if side.is_file() {

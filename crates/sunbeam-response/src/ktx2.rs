@@ -143,6 +143,32 @@ pub fn decode(bytes: &[u8]) -> Result<Response> {
             bytes.len()
         )));
     }
+    let info = parse_info(bytes, kvd_off, kvd_len)?;
+    let g = &info.grid;
+    if (g.n_theta, g.n_rho, g.n_s) != (w, h, d) {
+        return Err(Error::input(format!(
+            "sunbeam.response grid {}x{}x{} differs from the texture {w}x{h}x{d}",
+            g.n_theta, g.n_rho, g.n_s
+        )));
+    }
+    let raw = &bytes[lv_off as usize..(lv_off + lv_len) as usize];
+    let data = raw
+        .chunks_exact(2)
+        .map(|c| u16::from_le_bytes([c[0], c[1]]))
+        .collect();
+    let r = Response { info, data };
+    r.validate()?;
+    Ok(r)
+}
+
+/// The `sunbeam.response` entry of the key/value data at `kvd_off..+kvd_len`.
+fn parse_info(bytes: &[u8], kvd_off: usize, kvd_len: usize) -> Result<Info> {
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
+    if kvd_off.checked_add(kvd_len).is_none_or(|e| e > bytes.len()) {
+        return Err(Error::input(
+            "KTX2 key/value data runs past the end of the file",
+        ));
+    }
     let mut info: Option<Info> = None;
     let mut p = kvd_off;
     while p + 4 <= kvd_off + kvd_len {
@@ -164,22 +190,27 @@ pub fn decode(bytes: &[u8]) -> Result<Response> {
         }
         p += 4 + len.div_ceil(4) * 4;
     }
-    let info = info.ok_or_else(|| Error::input("KTX2 file has no sunbeam.response key"))?;
-    let g = &info.grid;
-    if (g.n_theta, g.n_rho, g.n_s) != (w, h, d) {
-        return Err(Error::input(format!(
-            "sunbeam.response grid {}x{}x{} differs from the texture {w}x{h}x{d}",
-            g.n_theta, g.n_rho, g.n_s
-        )));
+    info.ok_or_else(|| Error::input("KTX2 file has no sunbeam.response key"))
+}
+
+/// Only a map's description (grid, wavelengths, the pack's manifest), from the
+/// file's head: the texels are not read (the player checks a map against its
+/// pack this way before it reads either in full).
+pub fn read_info(path: &std::path::Path) -> Result<Info> {
+    let head = sunbeam_common::magic::read_ktx2_head(path)?
+        .ok_or_else(|| Error::input_file(path, "not a KTX2 file (wrong identifier)"))?;
+    let ctx = |e: Error| e.context(path.display().to_string());
+    if head.len() < HEADER_LEN + LEVEL_INDEX_LEN {
+        return Err(ctx(Error::input("KTX2 file truncated in its header")));
     }
-    let raw = &bytes[lv_off as usize..(lv_off + lv_len) as usize];
-    let data = raw
-        .chunks_exact(2)
-        .map(|c| u16::from_le_bytes([c[0], c[1]]))
-        .collect();
-    let r = Response { info, data };
-    r.validate()?;
-    Ok(r)
+    let u32_at = |o: usize| u32::from_le_bytes(head[o..o + 4].try_into().unwrap());
+    if u32_at(12) != VK_R16G16B16A16_SFLOAT {
+        return Err(ctx(Error::input(format!(
+            "KTX2 vkFormat {} is not a response map (R16G16B16A16_SFLOAT, 97)",
+            u32_at(12)
+        ))));
+    }
+    parse_info(&head, u32_at(56) as usize, u32_at(60) as usize).map_err(ctx)
 }
 
 /// Read a map from a file (errors name the file).

@@ -110,7 +110,13 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     let scene = load_scene(&cli)?;
     let st = settings(&cli)?;
     let backend: Backend = cli.backend.parse()?;
-    let prepared = sunbeam_raster::prepare(&scene)?;
+    // The default mode draws with the response maps: a pack with a current map
+    // beside it is read as its manifest only (the CPU renderer needs the terms).
+    let prepared = if st.mode == Mode::Default && !cli.cpu {
+        sunbeam_raster::prepare_with(&scene, &sunbeam_render::response::load_pack)?
+    } else {
+        sunbeam_raster::prepare(&scene)?
+    };
     let headless = cli.headless || cli.bench || cli.cpu;
     if !headless {
         if cli.compare.is_some() || cli.depfile.is_some() {

@@ -228,8 +228,10 @@ pub fn key_values(bytes: &[u8]) -> Result<Vec<(String, Vec<u8>)>> {
     Ok(out)
 }
 
-/// Decode a KTX2 pack.
-pub fn decode(bytes: &[u8]) -> Result<Pack> {
+/// The manifest and texture shape of a KTX2 pack from its head (header through
+/// the key/value data; the level data need not be there), checked against
+/// each other.
+pub fn decode_head(bytes: &[u8]) -> Result<(Manifest, Precision, usize, usize, usize)> {
     if bytes.len() < HEADER_LEN + LEVEL_INDEX_LEN || !bytes.starts_with(&IDENTIFIER) {
         return Err(Error::input(
             "not a KTX2 file (bad identifier or too short)",
@@ -277,6 +279,12 @@ pub fn decode(bytes: &[u8]) -> Result<Pack> {
             "KTX2: vkFormat does not match the manifest's precision",
         ));
     }
+    Ok((manifest, precision, width, height, layers))
+}
+
+/// Decode a KTX2 pack.
+pub fn decode(bytes: &[u8]) -> Result<Pack> {
+    let (manifest, precision, width, height, layers) = decode_head(bytes)?;
     let texel = if precision == Precision::F32 { 8 } else { 4 };
     let off = u64_at(bytes, 80)?;
     let len = u64_at(bytes, 88)?;

@@ -23,6 +23,17 @@ impl Pack {
         Self::from_bytes(&bytes).map_err(|e| e.context(path.display()))
     }
 
+    /// Only a pack's manifest: from a KTX2 file's head (the term data is not
+    /// read), from an EXR by reading it whole.
+    pub fn read_manifest(path: &Path) -> Result<crate::manifest::Manifest> {
+        match magic::read_ktx2_head(path)? {
+            Some(head) => Ok(ktx2::decode_head(&head)
+                .map_err(|e| e.context(path.display()))?
+                .0),
+            None => Ok(Self::read(path)?.manifest),
+        }
+    }
+
     /// Parse a pack from bytes (KTX2 or single-file EXR).
     pub fn from_bytes(bytes: &[u8]) -> Result<Pack> {
         if magic::is_ktx2(bytes) {
