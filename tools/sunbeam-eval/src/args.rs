@@ -206,8 +206,8 @@ pub(crate) struct RenderArgs {
     #[arg(long)]
     pub(crate) pack: Option<PathBuf>,
     /// Frame size WxH (default: the scene's).
-    #[arg(long)]
-    pub(crate) size: Option<String>,
+    #[arg(long, value_name = "WxH", value_parser = sunbeam_common::units::parse_size)]
+    pub(crate) size: Option<(usize, usize)>,
     /// Exposure in stops (default: the scene's).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) exposure: Option<f64>,

@@ -5,7 +5,7 @@
 //! samples in linear light (the anti-aliased reference); `-o F.exr` writes the
 //! linear frame (exposure applied, no tone curve) instead of display values.
 
-use sunbeam_common::{units, Error, Result};
+use sunbeam_common::{Error, Result};
 use sunbeam_scene::Scene;
 
 pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
@@ -36,8 +36,7 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
         }
         scene.exposure = ev;
     }
-    if let Some(s) = &a.size {
-        let (w, h) = units::parse_size(s)?;
+    if let Some((w, h)) = a.size {
         scene.size = [w as u32, h as u32];
         scene.validate()?;
     }

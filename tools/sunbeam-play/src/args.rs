@@ -35,8 +35,8 @@ pub(crate) struct Cli {
     #[arg(long)]
     pub(crate) no_footprint: bool,
     /// Frame size WxH (headless: default the scene's size; window: initial size).
-    #[arg(long)]
-    pub(crate) size: Option<String>,
+    #[arg(long, value_name = "WxH", value_parser = sunbeam_common::units::parse_size)]
+    pub(crate) size: Option<(usize, usize)>,
     /// Headless: frames rendered (the last one is written). Window: exit after N frames.
     #[arg(long)]
     pub(crate) frames: Option<u32>,
@@ -44,12 +44,12 @@ pub(crate) struct Cli {
     #[arg(long, default_value_t = 0.0)]
     pub(crate) hold_secs: f64,
     /// GPU backend.
-    #[arg(long, default_value = "auto")]
-    pub(crate) backend: String,
+    #[arg(long, default_value = "auto", value_parser = |s: &str| s.parse::<sunbeam_render::Backend>())]
+    pub(crate) backend: sunbeam_render::Backend,
     /// Shading: default (response map), table (the former Cartesian table, built at load),
     /// direct (per-fragment sum), thesis (39 terms, 5 nm, nearest bin), lambert (base colour only).
-    #[arg(long, default_value = "default")]
-    pub(crate) mode: String,
+    #[arg(long, default_value = "default", value_parser = |s: &str| s.parse::<sunbeam_render::Mode>())]
+    pub(crate) mode: sunbeam_render::Mode,
     /// Same as --mode thesis.
     #[arg(long)]
     pub(crate) thesis: bool,
@@ -63,8 +63,8 @@ pub(crate) struct Cli {
     #[arg(long)]
     pub(crate) term_tolerance: Option<f64>,
     /// Tone curve after exposure: clamp or reinhard.
-    #[arg(long, default_value = "clamp")]
-    pub(crate) tone: String,
+    #[arg(long, default_value = "clamp", value_parser = |s: &str| s.parse::<sunbeam_optics::colour::ToneCurve>())]
+    pub(crate) tone: sunbeam_optics::colour::ToneCurve,
     /// Exposure in stops (overrides the scene's).
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) exposure: Option<f64>,

@@ -4,7 +4,7 @@ use crate::args::*;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Duration;
-use sunbeam_common::{units, Error, Result};
+use sunbeam_common::{Error, Result};
 use sunbeam_optics::colour::ToneCurve;
 use sunbeam_raster::{Image, LinearImage, Prepared};
 use sunbeam_render::window::{self, WindowOptions};
@@ -39,8 +39,7 @@ fn load_scene(cli: &Cli) -> Result<Scene> {
         }
         scene.exposure = ev;
     }
-    if let Some(s) = &cli.size {
-        let (w, h) = units::parse_size(s)?;
+    if let Some((w, h)) = cli.size {
         scene.size = [w as u32, h as u32];
         scene.validate()?;
     }
@@ -48,7 +47,7 @@ fn load_scene(cli: &Cli) -> Result<Scene> {
 }
 
 fn settings(cli: &Cli) -> Result<Settings> {
-    let mut mode: Mode = cli.mode.parse()?;
+    let mut mode: Mode = cli.mode;
     if cli.thesis && cli.lambert {
         return Err(Error::usage("--thesis and --lambert exclude each other"));
     }
@@ -66,7 +65,7 @@ fn settings(cli: &Cli) -> Result<Settings> {
             return Err(Error::usage("--term-tolerance must be positive"));
         }
     }
-    let curve: ToneCurve = cli.tone.parse()?;
+    let curve: ToneCurve = cli.tone;
     if cli.msaa != 1 && cli.msaa != 4 {
         return Err(Error::usage("--msaa must be 1 or 4"));
     }
@@ -109,7 +108,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     }
     let scene = load_scene(&cli)?;
     let st = settings(&cli)?;
-    let backend: Backend = cli.backend.parse()?;
+    let backend: Backend = cli.backend;
     // The default mode draws with the response maps: a pack with a current map
     // beside it is read as its manifest only (the CPU renderer needs the terms).
     let prepared = if st.mode == Mode::Default && !cli.cpu {
