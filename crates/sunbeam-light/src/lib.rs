@@ -17,6 +17,8 @@
 //! Lookup is nearest texel (the map is treated as piecewise constant, which
 //! is also the density the sampler draws from, so `pdf` and `lookup` agree).
 
+pub mod io;
+
 use std::f64::consts::PI;
 
 /// Why an environment map was refused.
