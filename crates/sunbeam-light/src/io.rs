@@ -171,6 +171,31 @@ mod tests {
         b
     }
 
+    /// New-style RLE scanlines (hand-encoded: one run per channel for the
+    /// first 6 texels, a literal for the last 10) decode to the same values as
+    /// the flat encoding.
+    #[test]
+    fn reads_rle_scanlines() {
+        let (w, h) = (16usize, 8usize);
+        let mut b = format!("#?RADIANCE\n\n-Y {h} +X {w}\n").into_bytes();
+        for _ in 0..h {
+            b.extend_from_slice(&[2, 2, 0, w as u8]);
+            for c in [128u8, 64, 32, 129] {
+                b.extend_from_slice(&[128 + 6, c]);
+                b.push(10);
+                b.extend(std::iter::repeat_n(c, 10));
+            }
+        }
+        let (rw, rh, px) = read_rgbe(&b).unwrap();
+        assert_eq!((rw, rh), (w, h));
+        assert!(px.iter().all(|p| *p == [1.0, 0.5, 0.25]));
+        // A run past the end of the scanline is refused, not a panic.
+        let mut bad = b.clone();
+        let at = bad.len() - (4 + 4 * 13) * h + 4;
+        bad[at] = 128 + 60;
+        assert!(read_rgbe(&bad).is_err());
+    }
+
     #[test]
     fn reads_rgbe_and_refuses_bad_maps() {
         let dir = std::env::temp_dir().join(format!("sunbeam-light-io-{}", std::process::id()));
