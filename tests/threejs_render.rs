@@ -168,6 +168,17 @@ fn bad_scenes_exit_non_zero_with_the_field_named() {
     assert!(!d.join("x.png").exists());
     let o = Command::new("node").arg(&render).output().unwrap();
     assert_eq!(o.status.code(), Some(1));
+    // An environment is refused until it is shaded (docs/SCENE.md).
+    std::fs::write(&s, r#"{ "camera": { "eye": [0, 0, 2], "target": [0, 0, 0] }, "meshes": [ { "mesh": "builtin:sphere" } ], "environment": { "map": "sky.exr" } }"#).unwrap();
+    let o = Command::new("node")
+        .arg(&render)
+        .arg(&s)
+        .arg("-o")
+        .arg(d.join("x.png"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("environment"));
     // An output that cannot be written: exit 3.
     ridge_pack(&d, "ok", "64", "25nm");
     let s = d.join("ok.json");

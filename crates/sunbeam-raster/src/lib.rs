@@ -128,6 +128,14 @@ pub fn prepare(scene: &Scene) -> Result<Prepared> {
 /// [`prepare`] with the packs read by `load_pack` (the player reads only a
 /// pack's manifest when a current response map stands beside it).
 pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) -> Result<Prepared> {
+    // Refused rather than ignored: a frame lit without the scene's environment
+    // would look plausible and be wrong (docs/SCENE.md, docs/LIGHTING.md).
+    if scene.environment.is_some() {
+        return Err(Error::input(
+            "environment: sky and map lighting are read and checked but not rendered yet; \
+             light the scene with lights[] (docs/SCENE.md)",
+        ));
+    }
     let mut meshes = Vec::new();
     let mut mesh_cache: Vec<(std::path::PathBuf, Arc<Mesh>)> = Vec::new();
     let mut pack_cache: Vec<(std::path::PathBuf, Arc<Pack>)> = Vec::new();

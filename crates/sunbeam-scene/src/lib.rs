@@ -29,6 +29,98 @@ pub struct Scene {
     /// Output size in pixels (width, height) for headless renders.
     #[serde(default = "default_size")]
     pub size: [u32; 2],
+    /// Extended light around the scene: a built-in sky or an equirectangular map.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub environment: Option<Environment>,
+}
+
+/// `"environment"`: exactly one of `sky` or `map`, scaled by `intensity`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Environment {
+    /// Built-in analytic sky and sun.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sky: Option<Sky>,
+    /// Equirectangular HDR image (`.hdr` or `.exr`), width = 2 * height,
+    /// relative to the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub map: Option<PathBuf>,
+    /// Rotation of the map about +y, degrees (towards +z from +x); maps only.
+    #[serde(default)]
+    pub rotation_deg: f64,
+    /// Scale on the environment's radiance, finite and >= 0.
+    #[serde(default = "one")]
+    pub intensity: f64,
+}
+
+/// `"environment.sky"`: sun position and atmospheric turbidity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sky {
+    /// Sun elevation above the horizon, degrees, in [-90, 90].
+    pub sun_elevation_deg: f64,
+    /// Sun azimuth, degrees, from +x towards +z (the map's convention).
+    #[serde(default)]
+    pub sun_azimuth_deg: f64,
+    /// Atmospheric turbidity, in [1.7, 10] (Preetham's model's range).
+    #[serde(default = "default_turbidity")]
+    pub turbidity: f64,
+}
+
+fn default_turbidity() -> f64 {
+    3.0
+}
+
+impl Environment {
+    /// Check the fields (not the map's pixels: the loader does that).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.intensity.is_finite() && self.intensity >= 0.0) {
+            return Err(Error::input(format!(
+                "environment.intensity {} must be finite and >= 0",
+                self.intensity
+            )));
+        }
+        if !self.rotation_deg.is_finite() {
+            return Err(Error::input("environment.rotation_deg must be finite"));
+        }
+        match (&self.sky, &self.map) {
+            (Some(_), Some(_)) | (None, None) => {
+                return Err(Error::input(
+                    "environment needs exactly one of 'sky' and 'map'",
+                ))
+            }
+            (Some(sky), None) => {
+                if !(-90.0..=90.0).contains(&sky.sun_elevation_deg) {
+                    return Err(Error::input(
+                        "environment.sky.sun_elevation_deg must be in [-90, 90]",
+                    ));
+                }
+                if !sky.sun_azimuth_deg.is_finite() {
+                    return Err(Error::input(
+                        "environment.sky.sun_azimuth_deg must be finite",
+                    ));
+                }
+                if !(1.7..=10.0).contains(&sky.turbidity) {
+                    return Err(Error::input(
+                        "environment.sky.turbidity must be in [1.7, 10]",
+                    ));
+                }
+            }
+            (None, Some(map)) => {
+                let ext = map
+                    .extension()
+                    .and_then(|e| e.to_str())
+                    .map(|e| e.to_ascii_lowercase());
+                if !matches!(ext.as_deref(), Some("hdr") | Some("exr")) {
+                    return Err(Error::input(format!(
+                        "environment.map {}: must be a .hdr or .exr file",
+                        map.display()
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -145,6 +237,7 @@ impl Scene {
             exposure: 0.0,
             background: default_background(),
             size: default_size(),
+            environment: None,
         }
     }
 
@@ -154,6 +247,11 @@ impl Scene {
         let mut s: Scene = serde_json::from_str(&text)
             .map_err(|e| Error::input_file(path, format!("invalid scene: {e}")))?;
         let base = path.parent().unwrap_or(Path::new(""));
+        if let Some(map) = s.environment.as_mut().and_then(|e| e.map.as_mut()) {
+            if map.is_relative() {
+                *map = base.join(&*map);
+            }
+        }
         for m in &mut s.meshes {
             if m.mesh.is_relative() && !geometry::is_builtin(&m.mesh) {
                 m.mesh = base.join(&m.mesh);
@@ -194,6 +292,9 @@ impl Scene {
         if self.size[0] == 0 || self.size[1] == 0 || self.size[0] > 16384 || self.size[1] > 16384 {
             return Err(Error::input("size must be 1..16384 pixels per side"));
         }
+        if let Some(env) = &self.environment {
+            env.validate()?;
+        }
         Ok(())
     }
 }
@@ -214,5 +315,53 @@ mod tests {
             r#"{"camera":{"eye":[0,0,3],"target":[0,0,0]},"meshes":[],"bogus":1}"#
         )
         .is_err());
+    }
+
+    fn env_scene(env: &str) -> Result<Scene> {
+        let text = format!(
+            r#"{{"camera":{{"eye":[0,0,3],"target":[0,0,0]}},"meshes":[{{"mesh":"a.glb"}}],"environment":{env}}}"#
+        );
+        let mut s: Scene = serde_json::from_str(&text).map_err(|e| Error::input(e.to_string()))?;
+        s.validate()?;
+        Ok(s)
+    }
+
+    #[test]
+    fn environment_sky_and_map() {
+        let s = env_scene(
+            r#"{"sky":{"sun_elevation_deg":30,"sun_azimuth_deg":120,"turbidity":2.5},"intensity":2}"#,
+        )
+        .unwrap();
+        let e = s.environment.unwrap();
+        assert_eq!(e.intensity, 2.0);
+        assert_eq!(e.sky.unwrap().turbidity, 2.5);
+        let s = env_scene(r#"{"map":"sky.EXR","rotation_deg":45}"#).unwrap();
+        assert_eq!(s.environment.unwrap().rotation_deg, 45.0);
+        for (bad, field) in [
+            (r#"{"map":"a.hdr","intensity":-1}"#, "intensity"),
+            (
+                r#"{"sky":{"sun_elevation_deg":10},"intensity":-0.5}"#,
+                "intensity",
+            ),
+            (r#"{"sky":{"sun_elevation_deg":100}}"#, "sun_elevation_deg"),
+            (
+                r#"{"sky":{"sun_elevation_deg":10,"turbidity":0.5}}"#,
+                "turbidity",
+            ),
+            (r#"{"map":"a.png"}"#, "environment.map"),
+            (r#"{"intensity":1}"#, "exactly one"),
+            (
+                r#"{"map":"a.hdr","sky":{"sun_elevation_deg":10}}"#,
+                "exactly one",
+            ),
+            (r#"{"map":"a.hdr","bogus":1}"#, "bogus"),
+        ] {
+            let msg = env_scene(bad).unwrap_err().to_string();
+            assert!(msg.contains(field), "{bad}: {msg}");
+        }
+        // JSON has no NaN: a NaN intensity can only come from code; refused too.
+        let mut s = env_scene(r#"{"map":"a.hdr"}"#).unwrap();
+        s.environment.as_mut().unwrap().intensity = f64::NAN;
+        assert!(s.validate().is_err());
     }
 }
