@@ -6,18 +6,28 @@
 //! - polar angle `theta = acos(y)` from +y, azimuth `phi = atan2(z, x)` in
 //!   `[0, 2 pi)`, measured from +x towards +z;
 //! - texel `(i, j)` (column `i` of `width`, row `j` of `height`, row 0 at the
-//!   top) covers `u = (i + 0.5) / width` with `phi = 2 pi u`, and
-//!   `v = (j + 0.5) / height` with `theta = pi v`;
+//!   top) covers `phi` in `2 pi [i, i + 1) / width` and `theta` in
+//!   `pi [j, j + 1) / height`;
 //! - `rotation_deg = R` turns the environment by `R` degrees about +y in the
 //!   sense of increasing `phi`: the radiance arriving from direction `d` is the
 //!   map's radiance at `rot_y(-R) d`. An environment rotated by `R` therefore
 //!   lights a scene exactly as the unrotated one lights the scene rotated by
 //!   `-R` (tested below).
 //!
-//! Lookup is nearest texel (the map is treated as piecewise constant, which
-//! is also the density the sampler draws from, so `pdf` and `lookup` agree).
+//! Lookup is nearest texel (the map is treated as piecewise constant). The
+//! sampler draws a texel with probability proportional to its luminance times
+//! its exact solid angle `(2 pi / W)(cos theta_j - cos theta_(j+1))`, then a
+//! direction uniformly over the texel's solid angle (uniform in `phi` and in
+//! `cos theta`), so `pdf` is the exact density of `sample` and `L / pdf` is
+//! constant inside a texel when `L` is proportional to luminance.
 
+pub mod daylight;
+pub mod environment;
 pub mod io;
+pub mod rgb_spectrum;
+pub mod sky;
+
+pub use environment::Environment;
 
 use std::f64::consts::PI;
 
@@ -75,7 +85,7 @@ pub struct EnvMap {
     marginal: Vec<f64>,
     /// Conditional CDF per row (height rows of width + 1).
     conditional: Vec<f64>,
-    /// Sum of all texel weights (luminance * sin(theta)).
+    /// Sum of all texel weights (luminance * the row's cos theta span).
     total: f64,
 }
 
@@ -116,10 +126,10 @@ impl EnvMap {
         let mut conditional = vec![0.0; height * (width + 1)];
         let mut marginal = vec![0.0; height + 1];
         for j in 0..height {
-            let sin_t = (PI * (j as f64 + 0.5) / height as f64).sin();
+            let span = cos_span(j, height);
             let row = &mut conditional[j * (width + 1)..(j + 1) * (width + 1)];
             for i in 0..width {
-                row[i + 1] = row[i] + luminance(rgb[j * width + i]) * sin_t;
+                row[i + 1] = row[i] + luminance(rgb[j * width + i]) * span;
             }
             marginal[j + 1] = marginal[j] + row[width];
         }
@@ -174,15 +184,11 @@ impl EnvMap {
             return 0.0;
         }
         let (i, j) = self.texel(d);
-        let sin_t = (PI * (j as f64 + 0.5) / self.height as f64).sin();
-        let w = luminance(self.rgb[j * self.width + i]) * sin_t;
-        // Probability of the texel over its solid angle; the texel's solid
-        // angle is taken as (2 pi / W)(pi / H) sin(theta_j), the same sin as
-        // the weight, so the density is constant inside a texel's area in
-        // (u, v) and normalised exactly.
-        let texel_prob = w / self.total;
-        let d_omega = (2.0 * PI / self.width as f64) * (PI / self.height as f64) * sin_t;
-        texel_prob / d_omega
+        let span = cos_span(j, self.height);
+        // The texel's probability over its exact solid angle (2 pi / W) span:
+        // the weight carries the same span, so only the luminance remains.
+        let texel_prob = luminance(self.rgb[j * self.width + i]) * span / self.total;
+        texel_prob / ((2.0 * PI / self.width as f64) * span)
     }
 
     /// Draw a direction with density `pdf` from two uniform numbers in [0, 1).
@@ -197,18 +203,22 @@ impl EnvMap {
         // Position inside the texel: remaining fractions, uniform in (u, v).
         let fu = frac_in(&self.marginal, j, u1 * self.total);
         let fi = frac_in(row, i, u2 * row[self.width]);
-        let v = (j as f64 + fu) / self.height as f64;
-        let u = (i as f64 + fi) / self.width as f64;
-        let theta = PI * v;
-        let phi = 2.0 * PI * u;
-        let local = [
-            theta.sin() * phi.cos(),
-            theta.cos(),
-            theta.sin() * phi.sin(),
-        ];
+        // Uniform in cos(theta) over the row: uniform over its solid angle.
+        let c0 = (PI * j as f64 / self.height as f64).cos();
+        let c1 = (PI * (j + 1) as f64 / self.height as f64).cos();
+        let cos_t = (c0 + fu * (c1 - c0)).clamp(-1.0, 1.0);
+        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+        let phi = 2.0 * PI * (i as f64 + fi) / self.width as f64;
+        let local = [sin_t * phi.cos(), cos_t, sin_t * phi.sin()];
         let d = rot_y(local, self.rotation_deg);
         Some((d, self.pdf(d)))
     }
+}
+
+/// `cos(theta_j) - cos(theta_(j+1))` of row `j` of `height` (its solid angle is
+/// this times `2 pi / width`).
+fn cos_span(j: usize, height: usize) -> f64 {
+    (PI * j as f64 / height as f64).cos() - (PI * (j + 1) as f64 / height as f64).cos()
 }
 
 /// Largest index k with cdf[k] <= x and cdf[k+1] > x (skipping empty bins).
@@ -293,8 +303,7 @@ mod tests {
         for _ in 0..1000 {
             let d = norm([lcg(&mut s) - 0.5, lcg(&mut s) - 0.5, lcg(&mut s) - 0.5]);
             let p = m.pdf(d);
-            // Exact up to the midpoint-sin vs exact-cap area of a texel row.
-            assert!((p * 4.0 * PI - 1.0).abs() < 2e-3, "pdf {p}");
+            assert!((p * 4.0 * PI - 1.0).abs() < 1e-12, "pdf {p}");
         }
     }
 
@@ -306,11 +315,9 @@ mod tests {
         let truth: f64 = (0..m.height)
             .flat_map(|j| (0..m.width).map(move |i| (i, j)))
             .map(|(i, j)| {
-                let sin_t = (PI * (j as f64 + 0.5) / m.height as f64).sin();
                 luminance(m.rgb[j * m.width + i])
-                    * sin_t
+                    * cos_span(j, m.height)
                     * (2.0 * PI / m.width as f64)
-                    * (PI / m.height as f64)
             })
             .sum();
         let mut s = 11;
@@ -322,9 +329,8 @@ mod tests {
             est += luminance(m.lookup(d)) / p;
         }
         est /= n as f64;
-        // Radiance proportional to pdf: every sample has the same weight up to
-        // the sin midpoint rule, so the estimate is nearly exact.
-        assert!((est / truth - 1.0).abs() < 0.01, "{est} vs {truth}");
+        // Luminance proportional to pdf: every sample has the same weight.
+        assert!((est / truth - 1.0).abs() < 1e-9, "{est} vs {truth}");
     }
 
     /// An environment rotated by R lights direction d as the unrotated one

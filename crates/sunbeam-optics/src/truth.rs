@@ -468,3 +468,26 @@ fn levels_of(h: &[f64]) -> Option<Heights> {
         index,
     })
 }
+
+/// The window model's coherent area `A = (sum g)^2 / sum g^2 dx dy` (docs/LIGHTING.md)
+/// of an `mx x my` patch of pixel `dx x dy` under the Gaussian window of `sigma_m`
+/// centred on the patch: what [`Truth::coherent_area_m2`] gives, from a pack's
+/// manifest alone.
+pub fn window_coherent_area_m2(mx: usize, my: usize, dx: f64, dy: f64, sigma_m: f64) -> f64 {
+    let axis = |m: usize, d: f64| {
+        let (mut s1, mut s2) = (0.0, 0.0);
+        for c in 0..m {
+            let x = (c as f64 - 0.5 * (m as f64 - 1.0)) * d;
+            let g = (-(x * x) / (2.0 * sigma_m * sigma_m)).exp();
+            s1 += g;
+            s2 += g * g;
+        }
+        s1 * s1 / s2
+    };
+    axis(mx, dx) * axis(my, dy) * dx * dy
+}
+
+/// The tiled model's coherent area `1 / (2 pi sigma_f^2)` (docs/LIGHTING.md).
+pub fn tiled_coherent_area_m2(sigma_f_per_m: f64) -> f64 {
+    1.0 / (2.0 * PI * sigma_f_per_m * sigma_f_per_m)
+}

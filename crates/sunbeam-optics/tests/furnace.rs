@@ -119,6 +119,13 @@ fn the_factor_follows_parseval() {
     let want = 4.0 * std::f64::consts::PI * s * s * k * k;
     assert!((a / want - 1.0).abs() < 2e-3, "A {a} vs {want}");
     assert!(a < 40e-6 * 40e-6);
+    // The manifest-only form (what renderers use) agrees with the truth's.
+    let (mx, my, dx, dy) = t.grid();
+    let from_manifest = sunbeam_optics::truth::window_coherent_area_m2(mx, my, dx, dy, s);
+    assert!(
+        (from_manifest / a - 1.0).abs() < 1e-12,
+        "{from_manifest} vs {a}"
+    );
     // Tiled: A = 2 pi (coherence / 4)^2.
     let t = Truth::new(
         &flat(32, 50e-9),
@@ -130,6 +137,12 @@ fn the_factor_follows_parseval() {
     .unwrap();
     let want = 2.0 * std::f64::consts::PI * 5e-6 * 5e-6;
     assert!((t.coherent_area_m2() / want - 1.0).abs() < 1e-9);
+    let sigma_f = 1.0 / (2.0 * std::f64::consts::PI * 5e-6);
+    let from_manifest = sunbeam_optics::truth::tiled_coherent_area_m2(sigma_f);
+    assert!(
+        (from_manifest / want - 1.0).abs() < 1e-9,
+        "{from_manifest} vs {want}"
+    );
 }
 
 /// Patch width in micrometres (for the log lines).

@@ -132,6 +132,7 @@ pub fn prepared(scene: Scene, mesh: Mesh, pack: Option<Arc<Pack>>) -> Prepared {
     Prepared {
         meshes: vec![(Arc::new(mesh), mat)],
         scene,
+        environment: None,
     }
 }
 

@@ -12,9 +12,14 @@
 //!   `G` (`sunbeam_optics::gain`), then linear sRGB, the diffuse blend, exposure,
 //!   tone curve and sRGB encoding (`sunbeam_optics::colour`).
 //!
+//! - Under a scene `environment` (sky or map), the lighting integral by Monte
+//!   Carlo with multiple importance sampling, spectral ([`environment`],
+//!   docs/LIGHTING.md).
+//!
 //! `render(&Scene)` is what `sunbeam-eval render` calls.
 
 pub mod diff;
+pub mod environment;
 pub mod fixtures;
 pub mod image;
 pub mod linear;
@@ -49,8 +54,13 @@ pub struct Options {
     pub size: Option<[u32; 2]>,
     /// Samples per pixel (0 or 1: the pixel centre; else a perfect square `s * s`:
     /// a stratified `s x s` grid of sub-pixel positions, averaged in linear light:
-    /// what a camera records, the anti-aliased reference).
+    /// what a camera records, the anti-aliased reference). Under an environment
+    /// each sub-pixel sample also draws one wavelength and two directions
+    /// (docs/LIGHTING.md).
     pub samples: u32,
+    /// Seed of the environment's Monte Carlo sampling (frames with different
+    /// seeds differ by the estimator's noise only).
+    pub seed: u64,
 }
 
 /// The grid side `s` of `samples = s * s` per pixel, or a usage error.
@@ -81,6 +91,8 @@ pub struct Material {
 pub struct Prepared {
     pub scene: Scene,
     pub meshes: Vec<(Arc<Mesh>, Material)>,
+    /// The scene's environment, loaded (None: point lights only).
+    pub environment: Option<Arc<sunbeam_light::Environment>>,
 }
 
 /// Load a mesh named by a scene: `builtin:quad`, `builtin:sphere`, or a glTF/GLB/OBJ
@@ -128,14 +140,11 @@ pub fn prepare(scene: &Scene) -> Result<Prepared> {
 /// [`prepare`] with the packs read by `load_pack` (the player reads only a
 /// pack's manifest when a current response map stands beside it).
 pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) -> Result<Prepared> {
-    // Refused rather than ignored: a frame lit without the scene's environment
-    // would look plausible and be wrong (docs/SCENE.md, docs/LIGHTING.md).
-    if scene.environment.is_some() {
-        return Err(Error::input(
-            "environment: sky and map lighting are read and checked but not rendered yet; \
-             light the scene with lights[] (docs/SCENE.md)",
-        ));
-    }
+    let environment = scene
+        .environment
+        .as_ref()
+        .map(load_environment)
+        .transpose()?;
     let mut meshes = Vec::new();
     let mut mesh_cache: Vec<(std::path::PathBuf, Arc<Mesh>)> = Vec::new();
     let mut pack_cache: Vec<(std::path::PathBuf, Arc<Pack>)> = Vec::new();
@@ -180,7 +189,31 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
     Ok(Prepared {
         scene: scene.clone(),
         meshes,
+        environment,
     })
+}
+
+/// The scene's `environment` block as a light source (the sky built, the map read).
+pub fn load_environment(e: &sunbeam_scene::Environment) -> Result<Arc<sunbeam_light::Environment>> {
+    e.validate()?;
+    Ok(Arc::new(match (&e.sky, &e.map) {
+        (Some(s), _) => sunbeam_light::Environment::Sky(Box::new(sunbeam_light::sky::Sky::new(
+            s.sun_elevation_deg,
+            s.sun_azimuth_deg,
+            s.turbidity,
+            e.intensity,
+        ))),
+        (None, Some(m)) => sunbeam_light::Environment::Map(sunbeam_light::io::load(
+            m,
+            e.rotation_deg,
+            e.intensity,
+        )?),
+        (None, None) => {
+            return Err(Error::input(
+                "environment needs exactly one of 'sky' and 'map'",
+            ))
+        }
+    }))
 }
 
 /// Render a scene with the reference settings (`Options::default()`).
@@ -203,6 +236,9 @@ pub fn render_linear(scene: &Scene, opts: &Options) -> Result<LinearImage> {
 
 /// Linear frame of an already prepared scene (see [`render_linear`]).
 pub fn render_prepared_linear(p: &Prepared, opts: &Options) -> Result<LinearImage> {
+    if let Some(env) = &p.environment {
+        return render_environment(p, env.clone(), opts);
+    }
     let s = samples_side(opts.samples)?;
     let [w, h] = opts.size.unwrap_or(p.scene.size);
     let (sw, sh) = (w * s, h * s);
@@ -223,6 +259,81 @@ pub fn render_prepared_linear(p: &Prepared, opts: &Options) -> Result<LinearImag
     }
     .downsample(s))
 }
+
+/// Fragments per band of the environment path (about 100 bytes each).
+const BAND_FRAGMENTS: usize = 4 << 20;
+
+/// The environment path of [`render_prepared_linear`]: bands of output rows, each
+/// rasterised at `s x s` per pixel; every sub-pixel sample is shaded with the
+/// point lights (as without an environment) plus one environment sample
+/// ([`environment::EnvShader::sample`]).
+fn render_environment(
+    p: &Prepared,
+    env: Arc<sunbeam_light::Environment>,
+    opts: &Options,
+) -> Result<LinearImage> {
+    let s = samples_side(opts.samples)?;
+    let [w, h] = opts.size.unwrap_or(p.scene.size);
+    let (sw, sh) = (w * s, h * s);
+    let packs: Vec<_> = p.meshes.iter().map(|(_, m)| m.pack.clone()).collect();
+    let es = environment::EnvShader::new(env, &packs);
+    let shader = shade::Shader::new(p, opts);
+    let scale = p.scene.exposure.exp2();
+    let eye = p.scene.camera.eye;
+    let n = (s * s) as u64;
+    let mut out = LinearImage::new(w, h);
+    let band = (BAND_FRAGMENTS / (sw as usize * s as usize).max(1)).max(1) as u32;
+    let mut y0 = 0;
+    while y0 < h {
+        let y1 = (y0 + band).min(h);
+        let gbuf = raster::rasterise_rows(p, sw, sh, y0 * s..y1 * s);
+        let rows = &mut out.rgb[(y0 * w) as usize..(y1 * w) as usize];
+        for_rows(rows, w as usize, opts.threads, |jr, row| {
+            let y = y0 as usize + jr;
+            for (x, px) in row.iter_mut().enumerate() {
+                let pixel = (y * w as usize + x) as u64;
+                let offset = EnvShader::rng(opts.seed, pixel, u64::MAX).unit();
+                let mut acc = [0.0; 3];
+                for k in 0..n {
+                    let (sx, sy) = ((k % s as u64) as usize, (k / s as u64) as usize);
+                    let f = &gbuf[(jr * s as usize + sy) * sw as usize + x * s as usize + sx];
+                    let mut c = shader.linear(f);
+                    if let Some(mi) = f.mesh {
+                        let mi = mi as usize;
+                        let mat = &p.meshes[mi].1;
+                        let view = shade::normalize([
+                            eye[0] - f.pos[0],
+                            eye[1] - f.pos[1],
+                            eye[2] - f.pos[2],
+                        ]);
+                        if let (Some(fr), Some(wr)) = (shade::frame(f.normal, f.tangent), view) {
+                            let mut rng = EnvShader::rng(opts.seed, pixel, k);
+                            // Stratified wavelengths: sample k in stratum k of n, shifted per pixel.
+                            let lu = (offset + (k as f64 + rng.unit()) / n as f64).fract();
+                            let dw = if mat.pack.is_some() {
+                                mat.diffuse_weight
+                            } else {
+                                1.0
+                            };
+                            let e = es.sample(mi, fr, wr, mat.base_color, dw, lu, &mut rng);
+                            for i in 0..3 {
+                                c[i] += e[i];
+                            }
+                        }
+                    }
+                    for i in 0..3 {
+                        acc[i] += c[i];
+                    }
+                }
+                *px = acc.map(|v| (v / n as f64 * scale) as f32);
+            }
+        });
+        y0 = y1;
+    }
+    Ok(out)
+}
+
+use environment::EnvShader;
 
 /// Run `f(row index, row)` over the rows of `buf` on `threads` workers (0: all
 /// cores, on rayon). Each row is one task; the result does not depend on the count.
@@ -250,7 +361,7 @@ fn for_rows<T: Send>(
 /// Render an already prepared scene (display values). With `opts.samples > 1`
 /// the sub-pixel samples are averaged in linear light before the display transform.
 pub fn render_prepared(p: &Prepared, opts: &Options) -> Image {
-    if opts.samples > 1 {
+    if opts.samples > 1 || p.environment.is_some() {
         if let Ok(lin) = render_prepared_linear(p, opts) {
             return lin.display(opts.curve);
         }

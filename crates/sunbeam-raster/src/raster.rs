@@ -65,13 +65,19 @@ fn clip_near(tri: [ClipVert; 3]) -> Vec<[ClipVert; 3]> {
 
 /// Rasterise every mesh of a prepared scene into a `w x h` G-buffer (row 0 at the top).
 pub fn rasterise(p: &Prepared, w: u32, h: u32) -> Vec<Fragment> {
+    rasterise_rows(p, w, h, 0..h)
+}
+
+/// Rows `rows` of [`rasterise`]'s G-buffer (the same fragments; a band keeps the
+/// memory of a heavily supersampled frame bounded).
+pub fn rasterise_rows(p: &Prepared, w: u32, h: u32, rows: std::ops::Range<u32>) -> Vec<Fragment> {
     let vp = p.scene.camera.view_proj(w, h);
     let mut buf = vec![
         Fragment {
             depth: f64::INFINITY,
             ..Default::default()
         };
-        (w as usize) * (h as usize)
+        (w as usize) * (rows.len())
     ];
     for (mi, (mesh, _)) in p.meshes.iter().enumerate() {
         let clip: Vec<[f64; 4]> = mesh
@@ -90,7 +96,7 @@ pub fn rasterise(p: &Prepared, w: u32, h: u32) -> Vec<Fragment> {
                 }
             });
             for t in clip_near(cv) {
-                raster_triangle(&mut buf, w, h, mi as u32, mesh, idx, &t, &vp);
+                raster_triangle(&mut buf, w, h, &rows, mi as u32, mesh, idx, &t, &vp);
             }
         }
     }
@@ -107,6 +113,7 @@ fn raster_triangle(
     buf: &mut [Fragment],
     w: u32,
     h: u32,
+    rows: &std::ops::Range<u32>,
     mi: u32,
     mesh: &crate::Mesh,
     idx: [usize; 3],
@@ -160,8 +167,12 @@ fn raster_triangle(
     // Pixel i covers centres x = i*ONE + ONE/2.
     let i0 = ((minx - ONE / 2) as f64 / ONE as f64).ceil().max(0.0) as i64;
     let i1 = (((maxx - ONE / 2) as f64 / ONE as f64).floor() as i64).min(w as i64 - 1);
-    let j0 = ((miny - ONE / 2) as f64 / ONE as f64).ceil().max(0.0) as i64;
-    let j1 = (((maxy - ONE / 2) as f64 / ONE as f64).floor() as i64).min(h as i64 - 1);
+    let j0 = ((miny - ONE / 2) as f64 / ONE as f64)
+        .ceil()
+        .max(rows.start as f64) as i64;
+    let j1 = (((maxy - ONE / 2) as f64 / ONE as f64).floor() as i64)
+        .min(h as i64 - 1)
+        .min(rows.end as i64 - 1);
     for j in j0..=j1 {
         let py = j * ONE + ONE / 2;
         for i in i0..=i1 {
@@ -184,7 +195,7 @@ fn raster_triangle(
             if !(0.0..=1.0).contains(&z) {
                 continue;
             }
-            let pix = &mut buf[(j as usize) * w as usize + i as usize];
+            let pix = &mut buf[(j as usize - rows.start as usize) * w as usize + i as usize];
             if z.partial_cmp(&pix.depth) != Some(std::cmp::Ordering::Less) {
                 continue;
             }

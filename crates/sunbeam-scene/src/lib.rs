@@ -246,6 +246,15 @@ impl Scene {
         let text = std::fs::read_to_string(path).map_err(|e| Error::input_file(path, e))?;
         let mut s: Scene = serde_json::from_str(&text)
             .map_err(|e| Error::input_file(path, format!("invalid scene: {e}")))?;
+        // Under an environment, omitted `lights` means none (the sky has its own
+        // sun); otherwise the documented default light.
+        if s.environment.is_some() {
+            let raw: serde_json::Value = serde_json::from_str(&text)
+                .map_err(|e| Error::input_file(path, format!("invalid scene: {e}")))?;
+            if raw.get("lights").is_none() {
+                s.lights.clear();
+            }
+        }
         let base = path.parent().unwrap_or(Path::new(""));
         if let Some(map) = s.environment.as_mut().and_then(|e| e.map.as_mut()) {
             if map.is_relative() {

@@ -199,6 +199,10 @@ pub(crate) struct RenderArgs {
     /// Samples per pixel: a stratified s x s grid averaged in linear light (1, 4, 9, 16, ...).
     #[arg(long, default_value_t = 1)]
     pub(crate) samples: u32,
+    /// Seed of the environment lighting's Monte Carlo sampling (scenes with an
+    /// `environment`; two seeds differ by the estimator's noise only).
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
     /// Mesh (GLB/glTF/OBJ) for the default scene of sunbeam-play --mesh --pack.
     #[arg(long)]
     pub(crate) mesh: Option<PathBuf>,

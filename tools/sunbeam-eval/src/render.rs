@@ -4,6 +4,8 @@
 //! `Scene::default_for`). `--samples N` averages a stratified grid of sub-pixel
 //! samples in linear light (the anti-aliased reference); `-o F.exr` writes the
 //! linear frame (exposure applied, no tone curve) instead of display values.
+//! A scene with an `environment` is lit by Monte Carlo (`--samples` per pixel,
+//! `--seed S`; docs/LIGHTING.md).
 
 use sunbeam_common::{Error, Result};
 use sunbeam_scene::Scene;
@@ -42,6 +44,7 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
     }
     let opts = sunbeam_raster::Options {
         samples: a.samples,
+        seed: a.seed,
         ..Default::default()
     };
     sunbeam_raster::samples_side(a.samples)?;

@@ -1,36 +1,95 @@
-//! A scene with an `environment` (docs/SCENE.md) is refused, not rendered
-//! without its light: exit 2 naming the field, no output.
+//! `sunbeam-eval render` under a scene `environment` (docs/SCENE.md,
+//! docs/LIGHTING.md): a sky-lit scene renders (deterministic for a seed);
+//! bad environments exit 2 naming the file and field, with no output.
 
-use std::process::Command;
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn render(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sunbeam-eval"))
+        .arg("render")
+        .arg(scene)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn scene(env: &str) -> String {
+    format!(
+        r#"{{ "camera": {{ "eye": [0, 0.5, 2.5], "target": [0, 0, 0] }},
+  "meshes": [ {{ "mesh": "builtin:sphere", "base_color": [0.8, 0.8, 0.8] }} ],
+  "environment": {env},
+  "size": [12, 12] }}"#
+    )
+}
 
 #[test]
-fn environment_scenes_are_refused_until_shaded() {
+fn sky_scene_renders_and_bad_environments_are_refused() {
     let d = std::env::temp_dir().join(format!("sb-eval-env-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     let s = d.join("sky.json");
     std::fs::write(
         &s,
-        r#"{ "camera": { "eye": [0, 0, 2], "target": [0, 0, 0] },
-  "meshes": [ { "mesh": "builtin:sphere" } ],
-  "environment": { "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 120, "turbidity": 3 }, "intensity": 1 },
-  "size": [8, 8] }"#,
+        scene(r#"{ "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 120, "turbidity": 3 }, "intensity": 1 }"#),
     )
     .unwrap();
-    let out = d.join("f.png");
-    let o = Command::new(env!("CARGO_BIN_EXE_sunbeam-eval"))
-        .arg("render")
-        .arg(&s)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let (a, b) = (d.join("a.exr"), d.join("b.exr"));
+    for out in [&a, &b] {
+        let o = render(&s, out, &["--samples", "4", "--seed", "7"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
     assert_eq!(
-        o.status.code(),
-        Some(2),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
+        std::fs::read(&a).unwrap(),
+        std::fs::read(&b).unwrap(),
+        "same seed, other frame"
     );
-    assert!(String::from_utf8_lossy(&o.stderr).contains("environment"));
-    assert!(!out.exists());
+    // A white diffuse sphere under the sky is lit (no point light is added).
+    let img = sunbeam_raster_probe(&a);
+    assert!(img > 0.05, "mean value {img}");
+
+    let bad_map = d.join("bad.hdr");
+    std::fs::write(&bad_map, b"not an image").unwrap();
+    let wide = d.join("wide.hdr");
+    std::fs::write(&wide, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 3\n").unwrap();
+    for (env, field, file) in [
+        (
+            r#"{ "map": "missing.exr" }"#,
+            "environment.map",
+            "missing.exr",
+        ),
+        (r#"{ "map": "bad.hdr" }"#, "environment.map", "bad.hdr"),
+        (r#"{ "map": "wide.hdr" }"#, "environment.map", "wide.hdr"),
+        (
+            r#"{ "sky": { "sun_elevation_deg": 30 }, "intensity": -1 }"#,
+            "environment.intensity",
+            "",
+        ),
+        (
+            r#"{ "sky": { "sun_elevation_deg": 30, "turbidity": 40 } }"#,
+            "turbidity",
+            "",
+        ),
+    ] {
+        let sc = d.join("bad.json");
+        std::fs::write(&sc, scene(env)).unwrap();
+        let out = d.join("bad.png");
+        let o = render(&sc, &out, &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{env}: {err}");
+        assert!(err.contains(field) && err.contains(file), "{env}: {err}");
+        assert!(!out.exists(), "{env}: output written");
+    }
     std::fs::remove_dir_all(&d).ok();
+}
+
+/// Mean of the EXR's values (a crude "is it lit" probe, read with `exr`).
+fn sunbeam_raster_probe(path: &Path) -> f64 {
+    let img = sunbeam_raster::LinearImage::read_exr(path).unwrap();
+    img.rgb
+        .iter()
+        .map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0)
+        .sum::<f64>()
+        / img.rgb.len() as f64
 }

@@ -107,6 +107,14 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         return export_shader(lang, &cli);
     }
     let scene = load_scene(&cli)?;
+    // Refused rather than ignored: a GPU frame lit without the scene's environment
+    // would look plausible and be wrong. `--cpu` (the reference) shades it.
+    if scene.environment.is_some() && !cli.cpu {
+        return Err(Error::input(
+            "environment: the player does not shade sky and map lighting yet; \
+             render it with sunbeam-eval render (or --cpu), or light the scene with lights[] (docs/SCENE.md)",
+        ));
+    }
     let st = settings(&cli)?;
     let backend: Backend = cli.backend;
     // The default mode draws with the response maps: a pack with a current map
