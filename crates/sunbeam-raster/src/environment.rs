@@ -18,6 +18,9 @@
 //!
 //! Random numbers come from SplitMix64 seeded by (seed, pixel, sample), so a
 //! frame depends on `--seed` and `--samples` only, not on the thread count.
+//! The wavelengths are stratified over a pixel's samples; stratifying the
+//! directions too (per-pixel permuted grids) was measured and gained nothing
+//! under the sky (docs/LIGHTING.md "Noise"), so they are independent.
 
 use crate::shade::dot;
 use std::f64::consts::PI;
@@ -227,6 +230,29 @@ impl LobeSampler {
     }
 }
 
+/// The uniform numbers of one sample: the hero wavelength's position, the
+/// environment's three, the sun disc's two, the lobe sampler's three (bin, then
+/// the offset inside it).
+#[derive(Debug, Clone, Copy)]
+pub struct Uniforms {
+    pub lambda: f64,
+    pub env: [f64; 3],
+    pub sun: [f64; 2],
+    pub lobe: [f64; 3],
+}
+
+impl Uniforms {
+    /// Independent uniform numbers.
+    pub fn random(rng: &mut SplitMix64) -> Uniforms {
+        Uniforms {
+            lambda: rng.unit(),
+            env: [rng.unit(), rng.unit(), rng.unit()],
+            sun: [rng.unit(), rng.unit()],
+            lobe: [rng.unit(), rng.unit(), rng.unit()],
+        }
+    }
+}
+
 /// The environment and the lobe samplers of a prepared scene's packs.
 pub struct EnvShader {
     pub env: Arc<Environment>,
@@ -264,8 +290,7 @@ impl EnvShader {
 
     /// One sample's linear sRGB radiance towards the viewer for mesh `mi` at a
     /// point with frame `f`, view `wr` (world, unit), base colour and diffuse
-    /// weight `dw`, wavelength position `lambda_u` in [0, 1).
-    #[allow(clippy::too_many_arguments)]
+    /// weight `dw`, from the uniform numbers `u`.
     pub fn sample(
         &self,
         mi: usize,
@@ -273,9 +298,9 @@ impl EnvShader {
         wr: [f64; 3],
         base: [f64; 3],
         dw: f64,
-        lambda_u: f64,
-        rng: &mut SplitMix64,
+        u: &Uniforms,
     ) -> [f64; 3] {
+        let lambda_u = u.lambda;
         let (t, b, n) = f;
         let local = |d: [f64; 3]| [dot(d, t), dot(d, b), dot(d, n)];
         let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
@@ -324,8 +349,7 @@ impl EnvShader {
             Some(s) if s.in_sun(d) => 1.0 / s.sun_solid_angle(),
             _ => 0.0,
         };
-        let (u0, u1, u2) = (rng.unit(), rng.unit(), rng.unit());
-        if let Some((d, p_env)) = self.env.sample(u0, u1, u2) {
+        if let Some((d, p_env)) = self.env.sample(u.env[0], u.env[1], u.env[2]) {
             let wi = local(d);
             if wi[2] > 0.0 && wr_l[2] > 0.0 {
                 if dw > 0.0 {
@@ -339,9 +363,8 @@ impl EnvShader {
                 }
             }
         }
-        let (u3, u4) = (rng.unit(), rng.unit());
         if let (Some(lobe), Some(sky)) = (lobe, sun) {
-            if let Some((d, p_sun)) = sky.sample_sun(u3, u4) {
+            if let Some((d, p_sun)) = sky.sample_sun(u.sun[0], u.sun[1]) {
                 let wi = local(d);
                 if wi[2] > 0.0 && wr_l[2] > 0.0 {
                     add(lobe, d, wi, self.env.pdf(d) + p_sun + lobe_pdf(lobe, wi));
@@ -349,8 +372,7 @@ impl EnvShader {
             }
         }
         if let Some(lobe) = lobe {
-            let u = [rng.unit(), rng.unit(), rng.unit()];
-            if let Some((wi, _)) = lobe.sample(u, wr_l, lambdas[0]) {
+            if let Some((wi, _)) = lobe.sample(u.lobe, wr_l, lambdas[0]) {
                 if wr_l[2] > 0.0 {
                     let d = world(wi);
                     add(

@@ -309,13 +309,17 @@ fn render_environment(
                         if let (Some(fr), Some(wr)) = (shade::frame(f.normal, f.tangent), view) {
                             let mut rng = EnvShader::rng(opts.seed, pixel, k);
                             // Stratified wavelengths: sample k in stratum k of n, shifted per pixel.
-                            let lu = (offset + (k as f64 + rng.unit()) / n as f64).fract();
+                            let lambda = (offset + (k as f64 + rng.unit()) / n as f64).fract();
+                            let u = environment::Uniforms {
+                                lambda,
+                                ..environment::Uniforms::random(&mut rng)
+                            };
                             let dw = if mat.pack.is_some() {
                                 mat.diffuse_weight
                             } else {
                                 1.0
                             };
-                            let e = es.sample(mi, fr, wr, mat.base_color, dw, lu, &mut rng);
+                            let e = es.sample(mi, fr, wr, mat.base_color, dw, &u);
                             for i in 0..3 {
                                 c[i] += e[i];
                             }

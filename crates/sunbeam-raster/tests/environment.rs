@@ -10,7 +10,7 @@ use sunbeam_light::{sky::Sky, EnvMap, Environment};
 use sunbeam_optics::truth::{Params, Truth};
 use sunbeam_optics::{cie, colour, gain};
 use sunbeam_pack::{build::BuildOptions, FieldRef, Model, Pack};
-use sunbeam_raster::environment::EnvShader;
+use sunbeam_raster::environment::{EnvShader, Uniforms};
 use sunbeam_raster::{compare_linear, fixtures, render_prepared_linear, LinearImage, Options};
 
 /// A ridge field like snake skin, scaled down: sinusoidal ridges of `period`
@@ -73,7 +73,11 @@ fn furnace_through_the_renderer() {
         for k in 0..m {
             let mut rng = EnvShader::rng(11, 0, k);
             let lu = (k as f64 + rng.unit()) / m as f64;
-            let c = es.sample(0, f, [0.0, 0.0, 1.0], [0.0; 3], 0.0, lu, &mut rng);
+            let u = Uniforms {
+                lambda: lu,
+                ..Uniforms::random(&mut rng)
+            };
+            let c = es.sample(0, f, [0.0, 0.0, 1.0], [0.0; 3], 0.0, &u);
             y += colour::linear_srgb_to_xyz(c)[1] / m as f64;
         }
         eprintln!("furnace {n} x {dx:e} {model:?}: Y = {y:.5} at the centre");
@@ -136,31 +140,35 @@ fn estimator_matches_quadrature_under_the_sky() {
     let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * nrm[k]);
     let wr = world(wr_l);
     // Monte Carlo.
-    let m = 40_000u64;
+    let m = 200_000u64;
     let mut mc = [0.0; 3];
     for k in 0..m {
         let mut rng = EnvShader::rng(7, 0, k);
         let lu = (k as f64 + rng.unit()) / m as f64;
-        let c = es.sample(0, (t, b, nrm), wr, [0.0; 3], 0.0, lu, &mut rng);
+        let u = Uniforms {
+            lambda: lu,
+            ..Uniforms::random(&mut rng)
+        };
+        let c = es.sample(0, (t, b, nrm), wr, [0.0; 3], 0.0, &u);
         let xyz = colour::linear_srgb_to_xyz(c);
         for i in 0..3 {
             mc[i] += xyz[i] / m as f64;
         }
     }
-    // Quadrature over wi_t = (x, y) in the unit disc: dw = dx dy / cos(theta_i).
+    // Midpoint quadrature over the hemisphere in (theta, phi): dw = sin(theta)
+    // dtheta dphi, bounded integrand (in wi_t = (x, y) the 1 / cos(theta)
+    // Jacobian is singular at the horizon, where this ridge field has orders).
     let a = truth.coherent_area_m2();
-    let g = 160usize;
-    let h = 2.0 / g as f64;
+    let (nt, np) = (110usize, 240usize);
+    let (dth, dph) = (PI / 2.0 / nt as f64, 2.0 * PI / np as f64);
     let norm = cie::d65_y_norm(cie::DEFAULT_RANGE_NM);
     let mut q = [0.0; 3];
-    for iy in 0..g {
-        for ix in 0..g {
-            let (x, y) = (-1.0 + (ix as f64 + 0.5) * h, -1.0 + (iy as f64 + 0.5) * h);
-            let r2 = x * x + y * y;
-            if r2 >= 1.0 {
-                continue;
-            }
-            let wi = [x, y, (1.0 - r2).sqrt()];
+    for it in 0..nt {
+        let th = (it as f64 + 0.5) * dth;
+        for ip in 0..np {
+            let ph = (ip as f64 + 0.5) * dph;
+            let wi = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
+            let cell = th.sin() * dth * dph;
             let gg = gain::g(wi, wr_l, gain::DEFAULT_IOR);
             let d = world(wi);
             for nm in (380..=780).step_by(10) {
@@ -174,7 +182,7 @@ fn estimator_matches_quadrature_under_the_sky() {
                     } else {
                         0.0
                     };
-                let v = sky_only * gg * r * a / (l * l) * h * h / wi[2] * wgt / norm;
+                let v = sky_only * gg * r * a / (l * l) * cell * wgt / norm;
                 let c = cie::cmf_at(l);
                 for i in 0..3 {
                     q[i] += v * c[i];
