@@ -6,7 +6,7 @@
 #   ninja -C examples -f out/build.ninja [-j2] [fields|packs|pictures|frames|sheet|all]
 #
 # Takes the Makefile's variables (BIN, OUT, SHARED, MATERIALS, SIZE, BRDF_SIZE,
-# SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, COLUMNS, SHEET, Q)
+# SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, SKY_SAMPLES, COLUMNS, SHEET, Q)
 # with the same defaults, on the command line only. Paths are relative to
 # examples/ exactly as make sees them, so Ninja runs in examples/ (-C examples)
 # and the tools' depfiles are the same bytes as under make. Ninja reads each
@@ -27,13 +27,14 @@ SYNTH_PIXEL=25nm
 SNAKE_DETAIL=1
 PACK_FLAGS=
 PLAY_FLAGS=
-COLUMNS=4
+SKY_SAMPLES=16
+COLUMNS=5
 SHEET=__default__
 Q=-q
 for a in "$@"; do
   case "$a" in
     BIN=* | OUT=* | SHARED=* | MATERIALS=* | SIZE=* | BRDF_SIZE=* | SYNTH_SIZE=* | SYNTH_PIXEL=* | \
-      SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | COLUMNS=* | SHEET=* | Q=*)
+      SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | SKY_SAMPLES=* | COLUMNS=* | SHEET=* | Q=*)
       printf -v "${a%%=*}" '%s' "${a#*=}" ;;
     *) echo "ninja.sh: unknown argument '$a' (expected VAR=value, see the header)" >&2; exit 1 ;;
   esac
@@ -97,6 +98,12 @@ rule play
   depfile = \${target}.d
   deps = gcc
   description = play \${target}
+rule sky_scene
+  command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake.glb|' \$in > \${outdir}/.\${name}-sky.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-sky.json.tmp.\$\$\$\$ \${target}
+  description = sky_scene \${target}
+rule sky
+  command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$SIZE") --samples $(esc "$SKY_SAMPLES") -o \${target} \$q
+  description = sky \${target}
 rule brdf
   command = rm -f \$tidy && $(esc "$EVAL") brdf \$in --light 60deg,0deg --size $(esc "$BRDF_SIZE") -o \${target} \$q
   description = brdf \${target}
@@ -151,10 +158,17 @@ EOF
     echo "build $o/$m-frame.png: play $o/$m-scene.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/snake.glb $(path "$BIN/sunbeam-play")"
     echo "  target = $(esc "$OUT/$m-frame.png")"
     echo "  tidy = $(esc "$OUT/.$m-frame.png").tmp.*"
+    echo "build $o/$m-sky.json: sky_scene sky-scene.json.in"
+    echo "  target = $o/$m-sky.json"
+    echo "  name = $m"
+    echo "  tidy = $(esc "$OUT/.$m-sky.json").tmp.*"
+    echo "build $o/$m-sky.png: sky $o/$m-sky.json | $o/$m.ktx2 $o/snake.glb $(path "$EVAL")"
+    echo "  target = $(esc "$OUT/$m-sky.png")"
+    echo "  tidy = $(esc "$OUT/.$m-sky.png").tmp.*"
     echo "build $o/snake-$m.glb: bake_pack $o/$m.ktx2 | $o/$m.response.ktx2 $(path "$BIN/sunbeam-bake")"
     echo "  target = $(esc "$OUT/snake-$m.glb")"
     echo "  tidy = $(esc "$OUT/.snake-$m.glb").tmp.*"
-    sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png"
+    sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png $o/$m-sky.png"
   done
   echo "build $o/sunbeam-es.frag: export_shader | $(path "$BIN/sunbeam-play")"
   echo "  target = $(esc "$OUT/sunbeam-es.frag")"
@@ -171,7 +185,7 @@ EOF
   echo "build fields: phony$(list .exr)"
   echo "build packs: phony$(list .ktx2)"
   echo "build pictures: phony$(list -brdf.png -grating.png)"
-  echo "build frames: phony$(list -frame.png)"
+  echo "build frames: phony$(list -frame.png -sky.png)"
   echo "build sheet: phony $o/contact-sheet.png"
   web_in=""; for m in $MATERIALS; do web_in="$web_in $o/snake-$m.glb"; done
   echo "build web: phony $o/sunbeam-es.frag$web_in"
