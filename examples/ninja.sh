@@ -3,10 +3,11 @@
 # as examples/Makefile (byte for byte; tested by tests/ninja.rs), for Ninja users.
 #
 #   examples/ninja.sh [VAR=value ...]           writes $OUT/build.ninja (OUT default: out)
-#   ninja -C examples -f out/build.ninja [-j2] [fields|packs|pictures|frames|sheet|all]
+#   ninja -C examples -f out/build.ninja [-j2] [fields|packs|pictures|frames|sheet|web|turntable|all]
 #
 # Takes the Makefile's variables (BIN, OUT, SHARED, MATERIALS, SIZE, BRDF_SIZE,
-# SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, SKY_SAMPLES, COLUMNS, SHEET, Q)
+# SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, SKY_SAMPLES,
+# TURNTABLE_MATERIAL, TURNTABLE_SIZE, TURNTABLE_FRAMES, COLUMNS, SHEET, Q)
 # with the same defaults, on the command line only. Paths are relative to
 # examples/ exactly as make sees them, so Ninja runs in examples/ (-C examples)
 # and the tools' depfiles are the same bytes as under make. Ninja reads each
@@ -28,13 +29,17 @@ SNAKE_DETAIL=1
 PACK_FLAGS=
 PLAY_FLAGS=
 SKY_SAMPLES=16
+TURNTABLE_MATERIAL=__default__
+TURNTABLE_SIZE=256x144
+TURNTABLE_FRAMES=24
 COLUMNS=5
 SHEET=__default__
 Q=-q
 for a in "$@"; do
   case "$a" in
     BIN=* | OUT=* | SHARED=* | MATERIALS=* | SIZE=* | BRDF_SIZE=* | SYNTH_SIZE=* | SYNTH_PIXEL=* | \
-      SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | SKY_SAMPLES=* | COLUMNS=* | SHEET=* | Q=*)
+      SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | SKY_SAMPLES=* | COLUMNS=* | SHEET=* | Q=* | \
+      TURNTABLE_MATERIAL=* | TURNTABLE_SIZE=* | TURNTABLE_FRAMES=*)
       printf -v "${a%%=*}" '%s' "${a#*=}" ;;
     *) echo "ninja.sh: unknown argument '$a' (expected VAR=value, see the header)" >&2; exit 1 ;;
   esac
@@ -49,6 +54,7 @@ fi
 if [ "$MATERIALS" = __default__ ]; then
   if [ -n "$SHARED" ]; then MATERIALS="veeco elaphe xeno"; else MATERIALS="elaphe xeno"; fi
 fi
+[ "$TURNTABLE_MATERIAL" = __default__ ] && TURNTABLE_MATERIAL=${MATERIALS##* }
 EVAL=$BIN/sunbeam-eval
 [ "$SHEET" = __default__ ] && SHEET="$EVAL sheet"
 
@@ -104,6 +110,9 @@ rule sky_scene
 rule sky
   command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$SIZE") --samples $(esc "$SKY_SAMPLES") -o \${target} \$q
   description = sky \${target}
+rule turntable
+  command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$TURNTABLE_SIZE") --samples $(esc "$SKY_SAMPLES") --turntable $(esc "$TURNTABLE_FRAMES") --axis 0,0,1 -o \${target} \$q
+  description = turntable \${target}
 rule brdf
   command = rm -f \$tidy && $(esc "$EVAL") brdf \$in --light 60deg,0deg --size $(esc "$BRDF_SIZE") -o \${target} \$q
   description = brdf \${target}
@@ -170,6 +179,10 @@ EOF
     echo "  tidy = $(esc "$OUT/.snake-$m.glb").tmp.*"
     sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png $o/$m-sky.png"
   done
+  tm=$TURNTABLE_MATERIAL
+  echo "build $o/$tm-turntable.png: turntable $o/$tm-sky.json | $o/$tm.ktx2 $o/snake.glb $(path "$EVAL")"
+  echo "  target = $(esc "$OUT/$tm-turntable.png")"
+  echo "  tidy = $(esc "$OUT/.$tm-turntable.png").tmp.*"
   echo "build $o/sunbeam-es.frag: export_shader | $(path "$BIN/sunbeam-play")"
   echo "  target = $(esc "$OUT/sunbeam-es.frag")"
   echo "  tidy = $(esc "$OUT/.sunbeam-es.frag").tmp.*"
@@ -189,7 +202,8 @@ EOF
   echo "build sheet: phony $o/contact-sheet.png"
   web_in=""; for m in $MATERIALS; do web_in="$web_in $o/snake-$m.glb"; done
   echo "build web: phony $o/sunbeam-es.frag$web_in"
-  echo "build all: phony $o/contact-sheet.png web"
+  echo "build turntable: phony $o/$tm-turntable.png"
+  echo "build all: phony $o/contact-sheet.png web turntable"
   echo "default all"
 } > "$tmp"
 mv "$tmp" "$OUT/build.ninja"

@@ -125,6 +125,11 @@ for t, exts, samples in [
         for f in sorted(os.listdir(V)):
             if f.endswith(exts):
                 cp(t, os.path.join(V, f))
+# Environment maps (sunbeam-light): Radiance RGBE, flat and run-length encoded.
+hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n"
+put("envmap", "flat.hdr", hdr + b"-Y 2 +X 4\n" + bytes([128, 64, 32, 129]) * 8)
+rle_line = bytes([2, 2, 0, 8]) + b"".join(bytes([128 + 8, v]) for v in (100, 90, 80, 129))
+put("envmap", "rle.hdr", hdr + b"-Y 4 +X 8\n" + rle_line * 4)
 for t in os.listdir(out):
     if t == "detect":
         continue

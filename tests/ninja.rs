@@ -155,9 +155,8 @@ fn ninja_builds_what_make_builds_and_rebuilds_only_dependents() {
     ninja(&build_file, &args);
     let after = mtimes(&by_ninja);
     for (k, t) in &after {
-        let should =
-            k.starts_with("elaphe") && k != "elaphe-scene.json" && k != "elaphe-sky.json"
-                || k == "contact-sheet.png";
+        let should = k.starts_with("elaphe") && k != "elaphe-scene.json" && k != "elaphe-sky.json"
+            || k == "contact-sheet.png";
         assert_eq!(
             before.get(k) != Some(t),
             should,

@@ -90,9 +90,8 @@ fn touching_a_scan_rebuilds_only_its_dependents() {
         .filter(|k| before.get(*k) != after.get(*k))
         .collect();
     for k in after.keys() {
-        let should =
-            k.starts_with("elaphe") && k != "elaphe-scene.json" && k != "elaphe-sky.json"
-                || k == "contact-sheet.png";
+        let should = k.starts_with("elaphe") && k != "elaphe-scene.json" && k != "elaphe-sky.json"
+            || k == "contact-sheet.png";
         assert_eq!(
             before.get(k) != after.get(k),
             should,

@@ -15,12 +15,8 @@ pub fn load(path: &Path, rotation_deg: f64, intensity: f64) -> Result<EnvMap> {
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase());
-    let (w, h, rgb) = match ext.as_deref() {
-        Some("exr") => read_exr(&bytes),
-        Some("hdr") => read_rgbe(&bytes),
-        _ => Err("must be a .hdr or .exr file".to_string()),
-    }
-    .map_err(|e| Error::input_file(path, format!("environment.map: {e}")))?;
+    let (w, h, rgb) = decode(&bytes, ext.as_deref().unwrap_or(""))
+        .map_err(|e| Error::input_file(path, format!("environment.map: {e}")))?;
     EnvMap::new(w, h, rgb, rotation_deg, intensity).map_err(|e| {
         let field = match e {
             crate::EnvError::BadIntensity(_) => "environment.intensity",
@@ -30,7 +26,18 @@ pub fn load(path: &Path, rotation_deg: f64, intensity: f64) -> Result<EnvMap> {
     })
 }
 
-type Pixels = (usize, usize, Vec<[f32; 3]>);
+/// Width, height and row-major RGB texels.
+pub type Pixels = (usize, usize, Vec<[f32; 3]>);
+
+/// Decode a map's bytes by its extension (`exr` or `hdr`, lower case): the
+/// pixels or why not (never a panic; fuzzed by `fuzz/fuzz_targets/envmap.rs`).
+pub fn decode(bytes: &[u8], ext: &str) -> std::result::Result<Pixels, String> {
+    match ext {
+        "exr" => read_exr(bytes),
+        "hdr" => read_rgbe(bytes),
+        _ => Err("must be a .hdr or .exr file".to_string()),
+    }
+}
 
 fn read_exr(bytes: &[u8]) -> std::result::Result<Pixels, String> {
     use exr::prelude::{read, ReadChannels, ReadLayers, Vec2};

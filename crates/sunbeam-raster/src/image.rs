@@ -71,6 +71,42 @@ impl Image {
         Ok(out)
     }
 
+    /// An animated PNG (APNG: 8-bit RGB, looping forever, `fps` frames per
+    /// second) of equally sized frames; deterministic bytes. Viewers without
+    /// APNG show the first frame.
+    pub fn apng_bytes(frames: &[Image], fps: u16) -> Result<Vec<u8>> {
+        let Some(first) = frames.first() else {
+            return Err(Error::usage("an animation needs at least one frame"));
+        };
+        if frames
+            .iter()
+            .any(|f| f.width != first.width || f.height != first.height)
+        {
+            return Err(Error::internal("animation frames differ in size"));
+        }
+        let png_err = |e: png::EncodingError| Error::internal(format!("png: {e}"));
+        let mut out = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut out, first.width, first.height);
+            enc.set_color(png::ColorType::Rgb);
+            enc.set_depth(png::BitDepth::Eight);
+            enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+            enc.set_animated(frames.len() as u32, 0).map_err(png_err)?;
+            enc.set_frame_delay(1, fps.max(1)).map_err(png_err)?;
+            let mut wr = enc.write_header().map_err(png_err)?;
+            for f in frames {
+                let data: Vec<u8> = f
+                    .to_rgba8()
+                    .chunks_exact(4)
+                    .flat_map(|p| [p[0], p[1], p[2]])
+                    .collect();
+                wr.write_image_data(&data).map_err(png_err)?;
+            }
+            wr.finish().map_err(png_err)?;
+        }
+        Ok(out)
+    }
+
     /// Write a PNG atomically.
     pub fn write_png(&self, path: &Path) -> Result<()> {
         sunbeam_common::output::write_atomic(path, &self.png_bytes()?)

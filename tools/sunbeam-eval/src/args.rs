@@ -203,6 +203,20 @@ pub(crate) struct RenderArgs {
     /// `environment`; two seeds differ by the estimator's noise only).
     #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
+    /// A turntable of N frames: the camera orbits the target about its `up`
+    /// axis (lights and environment stay); -o FILE.png is an animated PNG.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=720))]
+    pub(crate) turntable: Option<u32>,
+    /// With --turntable: the orbit's axis `X,Y,Z` through the target (default:
+    /// the camera's `up`).
+    #[arg(long, value_name = "X,Y,Z", requires = "turntable", allow_hyphen_values = true, value_parser = parse_axis)]
+    pub(crate) axis: Option<[f64; 3]>,
+    /// With --turntable: also write each frame as DIR/frame-NNN.png.
+    #[arg(long, value_name = "DIR", requires = "turntable")]
+    pub(crate) frames_dir: Option<PathBuf>,
+    /// With --turntable: frames per second of the animation.
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u16).range(1..=120))]
+    pub(crate) fps: u16,
     /// Mesh (GLB/glTF/OBJ) for the default scene of sunbeam-play --mesh --pack.
     #[arg(long)]
     pub(crate) mesh: Option<PathBuf>,
@@ -234,6 +248,23 @@ impl TruthArgs {
             model: self.model,
             coherence_m: self.coherence,
         })
+    }
+}
+
+/// Parse a non-zero direction `X,Y,Z`.
+pub(crate) fn parse_axis(s: &str) -> std::result::Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| format!("'{s}': {e}"))?;
+    match v[..] {
+        [x, y, z] if [x, y, z].iter().all(|c| c.is_finite()) && x * x + y * y + z * z > 0.0 => {
+            Ok([x, y, z])
+        }
+        _ => Err(format!(
+            "'{s}': give three finite numbers X,Y,Z, not all zero"
+        )),
     }
 }
 

@@ -5,7 +5,10 @@
 //! samples in linear light (the anti-aliased reference); `-o F.exr` writes the
 //! linear frame (exposure applied, no tone curve) instead of display values.
 //! A scene with an `environment` is lit by Monte Carlo (`--samples` per pixel,
-//! `--seed S`; docs/LIGHTING.md).
+//! `--seed S`; docs/LIGHTING.md). `--turntable N` orbits the camera about its
+//! `up` axis (or `--axis`) through the target in N steps and writes an animated PNG
+//! (APNG, written by the `png` crate the renderer already uses) and, with
+//! `--frames-dir`, the frames.
 
 use sunbeam_common::{Error, Result};
 use sunbeam_scene::Scene;
@@ -48,6 +51,9 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
         ..Default::default()
     };
     sunbeam_raster::samples_side(a.samples)?;
+    if let Some(n) = a.turntable {
+        return turntable(&scene, &opts, n, a);
+    }
     let exr = a
         .output
         .extension()
@@ -57,4 +63,58 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
     } else {
         sunbeam_raster::render_with(&scene, &opts)?.write_png(&a.output)
     }
+}
+
+/// The camera's eye turned by `deg` degrees about the axis `up` through `target`
+/// (Rodrigues' rotation).
+fn orbit(eye: [f64; 3], target: [f64; 3], up: [f64; 3], deg: f64) -> [f64; 3] {
+    let n = (up[0] * up[0] + up[1] * up[1] + up[2] * up[2]).sqrt();
+    let k = up.map(|v| v / n);
+    let v = [eye[0] - target[0], eye[1] - target[1], eye[2] - target[2]];
+    let (s, c) = deg.to_radians().sin_cos();
+    let kv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+    let kxv = [
+        k[1] * v[2] - k[2] * v[1],
+        k[2] * v[0] - k[0] * v[2],
+        k[0] * v[1] - k[1] * v[0],
+    ];
+    [0, 1, 2].map(|i| target[i] + v[i] * c + kxv[i] * s + k[i] * kv * (1.0 - c))
+}
+
+fn turntable(
+    scene: &Scene,
+    opts: &sunbeam_raster::Options,
+    n: u32,
+    a: &crate::args::RenderArgs,
+) -> Result<()> {
+    if !a
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        return Err(Error::usage(
+            "--turntable writes an animated PNG: give -o FILE.png",
+        ));
+    }
+    let prepared = sunbeam_raster::prepare(scene)?;
+    let mut frames = Vec::with_capacity(n as usize);
+    for k in 0..n {
+        let mut p = prepared.clone();
+        let c = &scene.camera;
+        let axis = a.axis.unwrap_or(c.up);
+        p.scene.camera.eye = orbit(c.eye, c.target, axis, 360.0 * k as f64 / n as f64);
+        // Keep the camera's roll: its up turns with it.
+        let top = [0, 1, 2].map(|i| c.target[i] + c.up[i]);
+        let turned = orbit(top, c.target, axis, 360.0 * k as f64 / n as f64);
+        p.scene.camera.up = [0, 1, 2].map(|i| turned[i] - c.target[i]);
+        frames.push(sunbeam_raster::render_prepared(&p, opts));
+    }
+    if let Some(dir) = &a.frames_dir {
+        std::fs::create_dir_all(dir).map_err(|e| Error::output_file(dir, e))?;
+        for (k, f) in frames.iter().enumerate() {
+            f.write_png(&dir.join(format!("frame-{k:03}.png")))?;
+        }
+    }
+    let bytes = sunbeam_raster::Image::apng_bytes(&frames, a.fps)?;
+    sunbeam_common::output::write_atomic(&a.output, &bytes)
 }

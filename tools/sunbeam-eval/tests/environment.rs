@@ -93,3 +93,67 @@ fn sunbeam_raster_probe(path: &Path) -> f64 {
         .sum::<f64>()
         / img.rgb.len() as f64
 }
+
+/// `--turntable N`: an animated PNG of N frames (acTL says N), the first frame
+/// equal to the plain render, the others different (the camera moves, the
+/// light stays); `--frames-dir` writes them; bad values are usage errors
+/// (exit 1) with no output.
+#[test]
+fn turntable_writes_an_animated_png() {
+    let d = std::env::temp_dir().join(format!("sb-eval-tt-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let s = d.join("lit.json");
+    std::fs::write(
+        &s,
+        r#"{ "camera": { "eye": [0, 0.5, 2.5], "target": [0, 0, 0] },
+  "lights": [ { "direction": [1, 1, 0.3] } ],
+  "meshes": [ { "mesh": "builtin:sphere", "base_color": [0.8, 0.5, 0.2] } ],
+  "size": [16, 12] }"#,
+    )
+    .unwrap();
+    let (anim, plain, frames) = (d.join("tt.png"), d.join("plain.png"), d.join("frames"));
+    let o = render(&s, &plain, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = render(
+        &s,
+        &anim,
+        &["--turntable", "4", "--frames-dir", frames.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bytes = std::fs::read(&anim).unwrap();
+    let at = bytes
+        .windows(4)
+        .position(|w| w == b"acTL")
+        .expect("an acTL chunk");
+    let n = u32::from_be_bytes(bytes[at + 4..at + 8].try_into().unwrap());
+    assert_eq!(n, 4);
+    assert_eq!(bytes.windows(4).filter(|w| *w == b"fcTL").count(), 4);
+    let f: Vec<Vec<u8>> = (0..4)
+        .map(|k| std::fs::read(frames.join(format!("frame-{k:03}.png"))).unwrap())
+        .collect();
+    assert_eq!(
+        f[0],
+        std::fs::read(&plain).unwrap(),
+        "frame 0 is the scene's own view"
+    );
+    assert_ne!(f[0], f[1]);
+    for bad in [
+        vec!["--turntable", "0"],
+        vec!["--turntable", "3", "--axis", "0,0,0"],
+        vec!["--frames-dir", "x"],
+    ] {
+        let out = d.join("bad.png");
+        let o = render(&s, &out, &bad);
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{bad:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(!out.exists(), "{bad:?}");
+    }
+    let o = render(&s, &d.join("tt.exr"), &["--turntable", "3"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("FILE.png"));
+    std::fs::remove_dir_all(&d).ok();
+}
