@@ -207,6 +207,10 @@ pub(crate) struct RenderArgs {
     /// axis (lights and environment stay); -o FILE.png is an animated PNG.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=720))]
     pub(crate) turntable: Option<u32>,
+    /// Compare the linear frame with REF.exr (CIEDE2000 over its lit pixels,
+    /// printed as `CIEDE2000 mean M p99 P max X over N px`): e.g. two seeds.
+    #[arg(long, value_name = "REF.exr", conflicts_with = "turntable")]
+    pub(crate) compare: Option<PathBuf>,
     /// With --turntable: the orbit's axis `X,Y,Z` through the target (default:
     /// the camera's `up`).
     #[arg(long, value_name = "X,Y,Z", requires = "turntable", allow_hyphen_values = true, value_parser = parse_axis)]

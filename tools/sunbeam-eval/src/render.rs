@@ -58,6 +58,19 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
         .output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if let Some(refp) = &a.compare {
+        let reference = sunbeam_raster::LinearImage::read_exr(refp)?;
+        let lin = sunbeam_raster::render_linear(&scene, &opts)?;
+        let d = sunbeam_raster::compare_linear(&lin, &reference)
+            .map_err(|e| e.context(refp.display()))?;
+        if exr {
+            lin.write_exr(&a.output)?;
+        } else {
+            lin.display(opts.curve).write_png(&a.output)?;
+        }
+        println!("{d}");
+        return Ok(());
+    }
     if exr {
         sunbeam_raster::render_linear(&scene, &opts)?.write_exr(&a.output)
     } else {

@@ -45,6 +45,41 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
         std::fs::read(&b).unwrap(),
         "same seed, other frame"
     );
+    // --compare: the same seed gives the same frame (CIEDE2000 0), another seed not.
+    let o = render(
+        &s,
+        &d.join("c.exr"),
+        &[
+            "--samples",
+            "4",
+            "--seed",
+            "7",
+            "--compare",
+            a.to_str().unwrap(),
+        ],
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && out.contains("CIEDE2000 mean 0.000 p99 0.000"),
+        "{out}"
+    );
+    let o = render(
+        &s,
+        &d.join("c.exr"),
+        &[
+            "--samples",
+            "4",
+            "--seed",
+            "8",
+            "--compare",
+            a.to_str().unwrap(),
+        ],
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && out.contains("CIEDE2000") && !out.contains("max 0.000"),
+        "{out}"
+    );
     // A white diffuse sphere under the sky is lit (no point light is added).
     let img = sunbeam_raster_probe(&a);
     assert!(img > 0.05, "mean value {img}");
