@@ -39,12 +39,16 @@ const TILED_REACH: f64 = 5.0;
 
 /// Draws incoming directions near the diffraction lobes of a pack: a bin of the
 /// pack's stored spectrum with probability proportional to `|sum c_n(t) T_n|^2`
-/// averaged over four phase depths `t` spanning the pack's range (each depth's
-/// share normalised to 1), then a point uniformly in the bin. Bins are fixed in
-/// spatial frequency, so the same table serves every wavelength and view.
+/// at one of up to eight phase depths `t` spanning the pack's range (a table
+/// per depth), then a point in the bin. Bins are fixed in spatial frequency, so
+/// the tables serve every wavelength and view; for a view `wr` and wavelength
+/// the directions can only reach `|t|` in `2 pi H / lambda [cos(theta_r),
+/// 1 + cos(theta_r)]`, so the draw mixes, with equal weights, only the tables
+/// of the depths in that range (the orders' strengths change with `t`).
 pub struct LobeSampler {
     pack: Arc<Pack>,
-    cdf: Vec<f64>,
+    /// One CDF over the bins per phase depth `t_j = -t_max (j + 1/2) / depths`.
+    cdfs: Vec<Vec<f64>>,
     width: usize,
     height: usize,
     /// Coherent area (m^2).
@@ -57,38 +61,36 @@ impl LobeSampler {
         let m = &pack.manifest;
         let (w, h) = (m.crop.width, m.crop.height);
         let layer = m.layer_texels();
-        let mut q = vec![0.0f64; w * h];
-        let depths = 4;
-        for j in 0..depths {
-            let t = -m.t_max * (j as f64 + 0.5) / depths as f64;
-            let c = series::coefficients_f64(m.basis, t, m.terms);
-            let p: Vec<f64> = (0..w * h)
-                .into_par_iter()
-                .map(|b| {
-                    let mut a = [0.0f64; 2];
-                    for (n, cn) in c.iter().enumerate() {
-                        let i = 2 * (n * layer + b);
-                        let (re, im) = (pack.terms[i] as f64, pack.terms[i + 1] as f64);
-                        a[0] += cn[0] * re - cn[1] * im;
-                        a[1] += cn[0] * im + cn[1] * re;
-                    }
-                    a[0] * a[0] + a[1] * a[1]
-                })
-                .collect();
-            let s: f64 = p.iter().sum();
-            if s > 0.0 {
-                for (qi, pi) in q.iter_mut().zip(&p) {
-                    *qi += pi / s;
+        // Up to 8 depths, fewer for very large crops (memory: 8 bytes per bin per depth).
+        let depths = (16_000_000 / (w * h).max(1)).clamp(1, 8);
+        let cdfs: Vec<Vec<f64>> = (0..depths)
+            .map(|j| {
+                let t = -m.t_max * (j as f64 + 0.5) / depths as f64;
+                let c = series::coefficients_f64(m.basis, t, m.terms);
+                let p: Vec<f64> = (0..w * h)
+                    .into_par_iter()
+                    .map(|b| {
+                        let mut a = [0.0f64; 2];
+                        for (n, cn) in c.iter().enumerate() {
+                            let i = 2 * (n * layer + b);
+                            let (re, im) = (pack.terms[i] as f64, pack.terms[i + 1] as f64);
+                            a[0] += cn[0] * re - cn[1] * im;
+                            a[1] += cn[0] * im + cn[1] * re;
+                        }
+                        a[0] * a[0] + a[1] * a[1]
+                    })
+                    .collect();
+                let s: f64 = p.iter().sum();
+                let mut cdf = Vec::with_capacity(w * h + 1);
+                let mut acc = 0.0;
+                cdf.push(0.0);
+                for v in &p {
+                    acc += if s > 0.0 { v / s } else { 1.0 / (w * h) as f64 };
+                    cdf.push(acc);
                 }
-            }
-        }
-        let mut cdf = Vec::with_capacity(w * h + 1);
-        let mut acc = 0.0;
-        cdf.push(0.0);
-        for v in &q {
-            acc += v;
-            cdf.push(acc);
-        }
+                cdf
+            })
+            .collect();
         let area_m2 = match m.model {
             Model::Window => sunbeam_optics::truth::window_coherent_area_m2(
                 m.patch.width,
@@ -101,24 +103,35 @@ impl LobeSampler {
         };
         LobeSampler {
             pack,
-            cdf,
+            cdfs,
             width: w,
             height: h,
             area_m2,
         }
     }
 
-    fn total(&self) -> f64 {
-        self.cdf[self.cdf.len() - 1]
+    /// The depth tables a view and wavelength mix: `[lo, hi]` (inclusive).
+    fn levels(&self, wr_z: f64, lambda_m: f64) -> (usize, usize) {
+        let m = &self.pack.manifest;
+        let d = self.cdfs.len();
+        if !(m.t_max > 0.0) {
+            return (0, d - 1);
+        }
+        let k = 2.0 * std::f64::consts::PI * m.height_half_range_m / lambda_m;
+        let level =
+            |t_abs: f64| ((t_abs / m.t_max * d as f64).floor().max(0.0) as usize).min(d - 1);
+        (level(k * wr_z.max(0.0)), level(k * (1.0 + wr_z.max(0.0))))
     }
 
-    /// Probability of bin `(ix, iy)` (crop indices; 0 outside).
-    fn bin_prob(&self, ix: i64, iy: i64) -> f64 {
+    /// Probability of bin `(ix, iy)` (crop indices; 0 outside) in the mixture
+    /// of the depth tables `lv`.
+    fn bin_prob(&self, lv: (usize, usize), ix: i64, iy: i64) -> f64 {
         if ix < 0 || iy < 0 || ix >= self.width as i64 || iy >= self.height as i64 {
             return 0.0;
         }
         let b = iy as usize * self.width + ix as usize;
-        (self.cdf[b + 1] - self.cdf[b]) / self.total()
+        let sum: f64 = self.cdfs[lv.0..=lv.1].iter().map(|c| c[b + 1] - c[b]).sum();
+        sum / (lv.1 - lv.0 + 1) as f64
     }
 
     /// Density per unit bin area at bin coordinates `kappa`. Window model: the
@@ -126,10 +139,14 @@ impl LobeSampler {
     /// probability spread as the model's Gaussian of `sigma_bins` around it
     /// (the tiled response is exactly such a sum), summed over the bins within
     /// [`TILED_REACH`] sigma.
-    fn pdf_kappa(&self, kx: f64, ky: f64) -> f64 {
+    fn pdf_kappa(&self, lv: (usize, usize), kx: f64, ky: f64) -> f64 {
         let m = &self.pack.manifest;
         match self.tiled_sigma() {
-            None => self.bin_prob(kx.round() as i64 + m.crop.kx, ky.round() as i64 + m.crop.ky),
+            None => self.bin_prob(
+                lv,
+                kx.round() as i64 + m.crop.kx,
+                ky.round() as i64 + m.crop.ky,
+            ),
             Some([sx, sy]) => {
                 let (rx, ry) = (
                     (TILED_REACH * sx).ceil() as i64,
@@ -142,7 +159,7 @@ impl LobeSampler {
                 for by in cy - ry..=cy + ry {
                     let gy = gauss(ky - by as f64, sy);
                     for bx in cx - rx..=cx + rx {
-                        let q = self.bin_prob(bx + m.crop.kx, by + m.crop.ky);
+                        let q = self.bin_prob(lv, bx + m.crop.kx, by + m.crop.ky);
                         if q > 0.0 {
                             p += q * gy * gauss(kx - bx as f64, sx);
                         }
@@ -171,29 +188,32 @@ impl LobeSampler {
 
     /// Solid-angle density (1/sr) of drawing local `wi` for view `wr` at `lambda_m`.
     pub fn pdf(&self, wi: [f64; 3], wr: [f64; 3], lambda_m: f64) -> f64 {
-        if wi[2] <= 0.0 || self.total() <= 0.0 {
+        if wi[2] <= 0.0 {
             return 0.0;
         }
         let m = &self.pack.manifest;
         let (kx, ky) = self.kappa(wi, wr, lambda_m);
+        let lv = self.levels(wr[2], lambda_m);
         // d(kappa_x, kappa_y) = bin_scale^2 / lambda^2 d(u, v), d(u, v) = cos(theta_i) dw.
-        self.pdf_kappa(kx, ky) * m.bin_scale_m[0] * m.bin_scale_m[1] / (lambda_m * lambda_m) * wi[2]
+        self.pdf_kappa(lv, kx, ky) * m.bin_scale_m[0] * m.bin_scale_m[1] / (lambda_m * lambda_m)
+            * wi[2]
     }
 
     /// A local incoming direction for view `wr` at `lambda_m`, with its density;
     /// None when the drawn frequency is evanescent (no direction).
     pub fn sample(&self, u: [f64; 3], wr: [f64; 3], lambda_m: f64) -> Option<([f64; 3], f64)> {
-        let total = self.total();
-        if total <= 0.0 {
-            return None;
-        }
         let m = &self.pack.manifest;
-        let x = u[0] * total;
-        let b = self
-            .cdf
+        // The depth table, then the bin (u[0] split between the two choices).
+        let lv = self.levels(wr[2], lambda_m);
+        let k = lv.1 - lv.0 + 1;
+        let uk = u[0] * k as f64;
+        let li = (lv.0 + uk.floor() as usize).min(lv.1);
+        let cdf = &self.cdfs[li];
+        let x = (uk - uk.floor()) * cdf[cdf.len() - 1];
+        let b = cdf
             .partition_point(|&c| c <= x)
             .saturating_sub(1)
-            .min(self.cdf.len() - 2);
+            .min(cdf.len() - 2);
         let (ix, iy) = ((b % self.width) as i64, (b / self.width) as i64);
         let (ox, oy) = match self.tiled_sigma() {
             None => (u[1] - 0.5, u[2] - 0.5),
