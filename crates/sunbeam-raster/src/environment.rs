@@ -114,7 +114,7 @@ impl LobeSampler {
     fn levels(&self, wr_z: f64, lambda_m: f64) -> (usize, usize) {
         let m = &self.pack.manifest;
         let d = self.cdfs.len();
-        if !(m.t_max > 0.0) {
+        if m.t_max.is_nan() || m.t_max <= 0.0 {
             return (0, d - 1);
         }
         let k = 2.0 * std::f64::consts::PI * m.height_half_range_m / lambda_m;
