@@ -18,9 +18,16 @@ pub enum Environment {
 impl Environment {
     /// Spectral radiance arriving from world direction `d` (unit) at `lambda_m`.
     pub fn spectral(&self, d: [f64; 3], lambda_m: f64) -> f64 {
+        self.spectrum(d).at(lambda_m)
+    }
+
+    /// The spectrum arriving from `d`, for evaluating at several wavelengths
+    /// ([`DirSpectrum::at`] equals [`Environment::spectral`]; the sky model or
+    /// the map lookup runs once).
+    pub fn spectrum(&self, d: [f64; 3]) -> DirSpectrum<'_> {
         match self {
-            Environment::Sky(s) => s.spectral(d, lambda_m),
-            Environment::Map(m) => RgbBasis::get().radiance(m.lookup(d).map(f64::from), lambda_m),
+            Environment::Sky(s) => DirSpectrum::Sky(s, s.spectrum(d)),
+            Environment::Map(m) => DirSpectrum::Rgb(m.lookup(d).map(f64::from)),
         }
     }
 
@@ -53,6 +60,24 @@ impl Environment {
         match self {
             Environment::Sky(s) => s.pdf(d),
             Environment::Map(m) => m.pdf(d),
+        }
+    }
+}
+
+/// The radiance from one direction of an [`Environment`].
+#[derive(Debug, Clone, Copy)]
+pub enum DirSpectrum<'a> {
+    Sky(&'a Sky, crate::sky::SkySpectrum),
+    /// A map texel's linear sRGB, made spectral by [`RgbBasis`].
+    Rgb([f64; 3]),
+}
+
+impl DirSpectrum<'_> {
+    /// Spectral radiance at `lambda_m` (scene units).
+    pub fn at(&self, lambda_m: f64) -> f64 {
+        match self {
+            DirSpectrum::Sky(s, sp) => sp.at(s, lambda_m),
+            DirSpectrum::Rgb(c) => RgbBasis::get().radiance(*c, lambda_m),
         }
     }
 }

@@ -66,6 +66,13 @@ impl std::fmt::Display for EnvError {
 
 impl std::error::Error for EnvError {}
 
+/// The unit direction of polar angle `acos(cos_theta)` from +y and azimuth
+/// `phi` from +x towards +z (the conventions above).
+pub fn direction(cos_theta: f64, phi: f64) -> [f64; 3] {
+    let sin_t = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    [sin_t * phi.cos(), cos_theta, sin_t * phi.sin()]
+}
+
 /// Rotate `d` about +y by `deg` degrees, in the sense of increasing `phi`
 /// (from +x towards +z).
 pub fn rot_y(d: [f64; 3], deg: f64) -> [f64; 3] {
@@ -207,9 +214,8 @@ impl EnvMap {
         let c0 = (PI * j as f64 / self.height as f64).cos();
         let c1 = (PI * (j + 1) as f64 / self.height as f64).cos();
         let cos_t = (c0 + fu * (c1 - c0)).clamp(-1.0, 1.0);
-        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
         let phi = 2.0 * PI * (i as f64 + fi) / self.width as f64;
-        let local = [sin_t * phi.cos(), cos_t, sin_t * phi.sin()];
+        let local = direction(cos_t, phi);
         let d = rot_y(local, self.rotation_deg);
         Some((d, self.pdf(d)))
     }

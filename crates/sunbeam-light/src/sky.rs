@@ -159,11 +159,7 @@ impl Sky {
             let d_omega = (PI / 2.0 / nt as f64) * (2.0 * PI / np as f64) * theta.sin();
             for i in 0..np {
                 let phi = (i as f64 + 0.5) / np as f64 * 2.0 * PI;
-                let d = [
-                    theta.sin() * phi.cos(),
-                    theta.cos(),
-                    theta.sin() * phi.sin(),
-                ];
+                let d = crate::direction(theta.cos(), phi);
                 e_sky += sky.sky_yxy(d)[0] * theta.cos() * d_omega;
             }
         }
@@ -190,11 +186,7 @@ impl Sky {
             let theta = (j as f64 + 0.5) / h as f64 * PI;
             for i in 0..TABLE_W {
                 let phi = (i as f64 + 0.5) / TABLE_W as f64 * 2.0 * PI;
-                let d = [
-                    theta.sin() * phi.cos(),
-                    theta.cos(),
-                    theta.sin() * phi.sin(),
-                ];
+                let d = crate::direction(theta.cos(), phi);
                 let y = sky.sky_luminance(d) as f32;
                 px.push([y, y, y]);
             }
@@ -288,17 +280,16 @@ impl Sky {
 
     /// Spectral radiance arriving from direction `d` at `lambda_m` (scene units).
     pub fn spectral(&self, d: [f64; 3], lambda_m: f64) -> f64 {
-        let mut l = if d[1] > 0.0 {
-            let w = self.sky_weights(d);
-            let b = daylight::basis_at(lambda_m);
-            w[0] * b[0] + w[1] * b[1] + w[2] * b[2]
-        } else {
-            self.ground * cie::d65_at(lambda_m)
-        };
-        if self.in_sun(d) {
-            l += self.sun_scale * self.sun_spectrum_shape(lambda_m);
+        self.spectrum(d).at(self, lambda_m)
+    }
+
+    /// The spectrum arriving from `d`, for evaluating at several wavelengths
+    /// (the sky model runs once per direction, not once per wavelength).
+    pub fn spectrum(&self, d: [f64; 3]) -> SkySpectrum {
+        SkySpectrum {
+            daylight: (d[1] > 0.0).then(|| self.sky_weights(d)),
+            sun: self.in_sun(d),
         }
-        l
     }
 
     /// XYZ of the radiance from `d` (scene units), consistent with [`Sky::spectral`].
@@ -364,6 +355,32 @@ impl Sky {
         };
         let p = self.pdf(d);
         (p > 0.0).then_some((d, p))
+    }
+}
+
+/// The radiance from one direction of a [`Sky`] ([`Sky::spectrum`]).
+#[derive(Debug, Clone, Copy)]
+pub struct SkySpectrum {
+    /// Weights of the CIE daylight basis (None: the ground).
+    daylight: Option<[f64; 3]>,
+    /// The direction lies in the sun's disc.
+    sun: bool,
+}
+
+impl SkySpectrum {
+    /// Spectral radiance at `lambda_m` (scene units); `sky` is the one it came from.
+    pub fn at(&self, sky: &Sky, lambda_m: f64) -> f64 {
+        let mut l = match self.daylight {
+            Some(w) => {
+                let b = daylight::basis_at(lambda_m);
+                w[0] * b[0] + w[1] * b[1] + w[2] * b[2]
+            }
+            None => sky.ground * cie::d65_at(lambda_m),
+        };
+        if self.sun {
+            l += sky.sun_scale * sky.sun_spectrum_shape(lambda_m);
+        }
+        l
     }
 }
 

@@ -1,13 +1,17 @@
 //! Environment lighting in the reference: the integral over incoming directions
-//! by Monte Carlo (docs/LIGHTING.md). Per sub-pixel sample, one wavelength and
-//! two directions:
+//! by Monte Carlo (docs/LIGHTING.md "The reference's estimator"). Per sub-pixel
+//! sample, [`HERO`] wavelengths and up to three directions:
 //!
-//! - the wavelength `lambda` uniform over 380..780 nm, stratified over the
-//!   pixel's samples (a Weyl sequence from a per-pixel random offset);
+//! - a hero wavelength uniform over 380..780 nm, stratified over the pixel's
+//!   samples by the caller, and its rotations by `1 / HERO` of the range (hero
+//!   wavelength sampling, Wilkie et al. 2014): every direction is evaluated at
+//!   all of them;
 //! - one direction from the environment's sampler (sky/sun mixture or the
-//!   map's luminance) and one from the diffraction lobes ([`LobeSampler`]),
-//!   combined by multiple importance sampling with the balance heuristic:
-//!   each contributes `f L / (p_env + p_lobe)`;
+//!   map's luminance), one from the sun's disc (sky only) and one from the
+//!   diffraction lobes ([`LobeSampler`]), combined by multiple importance
+//!   sampling with the balance heuristic: each adds
+//!   `f L / (p_env + p_sun + p_lobe)`, the lobe density being the mean over
+//!   the hero wavelengths;
 //! - the diffraction term is `XYZ += L(wi, lambda) G R(u, v, w, lambda)
 //!   (A / lambda^2) cmf(lambda) / (p_lambda sum D65 ybar)`, `A` the pack's
 //!   coherent area (window: `(sum g)^2 / sum g^2 dx dy`, tiled:
@@ -18,9 +22,9 @@
 //!
 //! Random numbers come from SplitMix64 seeded by (seed, pixel, sample), so a
 //! frame depends on `--seed` and `--samples` only, not on the thread count.
-//! The wavelengths are stratified over a pixel's samples; stratifying the
-//! directions too (per-pixel permuted grids) was measured and gained nothing
-//! under the sky (docs/LIGHTING.md "Noise"), so they are independent.
+//! Stratifying the directions too (per-pixel permuted grids) was measured and
+//! gained nothing under the sky (docs/LIGHTING.md "Noise"), so they are
+//! independent.
 
 use crate::shade::dot;
 use std::f64::consts::PI;
@@ -199,9 +203,9 @@ impl LobeSampler {
             * wi[2]
     }
 
-    /// A local incoming direction for view `wr` at `lambda_m`, with its density;
-    /// None when the drawn frequency is evanescent (no direction).
-    pub fn sample(&self, u: [f64; 3], wr: [f64; 3], lambda_m: f64) -> Option<([f64; 3], f64)> {
+    /// A local incoming direction for view `wr` at `lambda_m` (its density is
+    /// [`LobeSampler::pdf`]); None when the drawn frequency is evanescent.
+    pub fn sample(&self, u: [f64; 3], wr: [f64; 3], lambda_m: f64) -> Option<[f64; 3]> {
         let m = &self.pack.manifest;
         // The depth table, then the bin (u[0] split between the two choices).
         let lv = self.levels(wr[2], lambda_m);
@@ -233,9 +237,7 @@ impl LobeSampler {
         if r2 >= 1.0 {
             return None;
         }
-        let wi = [wx, wy, (1.0 - r2).sqrt()];
-        let p = self.pdf(wi, wr, lambda_m);
-        (p > 0.0).then_some((wi, p))
+        Some([wx, wy, (1.0 - r2).sqrt()])
     }
 
     /// `f_r cos(theta_i) = G R A / lambda^2` (1/sr) for local directions.
@@ -345,10 +347,11 @@ impl EnvShader {
             lambdas.iter().map(|&l| lobe.pdf(wi, wr_l, l)).sum::<f64>() / HERO as f64
         };
         let mut add = |lobe: &LobeSampler, d: [f64; 3], wi: [f64; 3], p_sum: f64| {
+            let radiance = self.env.spectrum(d);
             for &l in &lambdas {
                 let fc = lobe.brdf_cos(wi, wr_l, l);
                 if fc > 0.0 {
-                    let s = self.env.spectral(d, l) * fc * span_nm / (self.norm * p_sum);
+                    let s = radiance.at(l) * fc * span_nm / (self.norm * p_sum);
                     if s.is_finite() {
                         let cmf = cie::cmf_at(l);
                         for c in 0..3 {
@@ -392,7 +395,7 @@ impl EnvShader {
             }
         }
         if let Some(lobe) = lobe {
-            if let Some((wi, _)) = lobe.sample(u.lobe, wr_l, lambdas[0]) {
+            if let Some(wi) = lobe.sample(u.lobe, wr_l, lambdas[0]) {
                 if wr_l[2] > 0.0 {
                     let d = world(wi);
                     add(

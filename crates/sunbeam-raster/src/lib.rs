@@ -32,6 +32,7 @@ pub use image::{compare, Image};
 pub use linear::{compare_linear, LinearImage};
 pub use sunbeam_scene::geometry::Mesh;
 
+use environment::EnvShader;
 use std::path::Path;
 use std::sync::Arc;
 use sunbeam_common::{Error, Result};
@@ -55,8 +56,8 @@ pub struct Options {
     /// Samples per pixel (0 or 1: the pixel centre; else a perfect square `s * s`:
     /// a stratified `s x s` grid of sub-pixel positions, averaged in linear light:
     /// what a camera records, the anti-aliased reference). Under an environment
-    /// each sub-pixel sample also draws one wavelength and two directions
-    /// (docs/LIGHTING.md).
+    /// each sub-pixel sample also draws wavelengths and directions
+    /// ([`environment`], docs/LIGHTING.md).
     pub samples: u32,
     /// Seed of the environment's Monte Carlo sampling (frames with different
     /// seeds differ by the estimator's noise only).
@@ -336,8 +337,6 @@ fn render_environment(
     }
     Ok(out)
 }
-
-use environment::EnvShader;
 
 /// Run `f(row index, row)` over the rows of `buf` on `threads` workers (0: all
 /// cores, on rayon). Each row is one task; the result does not depend on the count.

@@ -10,7 +10,7 @@ use sunbeam_light::{sky::Sky, EnvMap, Environment};
 use sunbeam_optics::truth::{Params, Truth};
 use sunbeam_optics::{cie, colour, gain};
 use sunbeam_pack::{build::BuildOptions, FieldRef, Model, Pack};
-use sunbeam_raster::environment::{EnvShader, Uniforms};
+use sunbeam_raster::environment::{EnvShader, Frame, Uniforms};
 use sunbeam_raster::{compare_linear, fixtures, render_prepared_linear, LinearImage, Options};
 
 /// A ridge field like snake skin, scaled down: sinusoidal ridges of `period`
@@ -37,6 +37,25 @@ fn pack_of(n: usize, dx: f64, data: &[f64], model: Model) -> Arc<Pack> {
         ..BuildOptions::default()
     };
     Arc::new(sunbeam_pack::build(f, &opts, &mut |_, _| {}).unwrap())
+}
+
+/// The estimator's mean XYZ over `m` samples at one shading point (frame `f`,
+/// view `wr`), wavelengths stratified, no diffuse part.
+fn estimate_xyz(es: &EnvShader, f: Frame, wr: [f64; 3], m: u64, seed: u64) -> [f64; 3] {
+    let mut mc = [0.0; 3];
+    for k in 0..m {
+        let mut rng = EnvShader::rng(seed, 0, k);
+        let lu = (k as f64 + rng.unit()) / m as f64;
+        let u = Uniforms {
+            lambda: lu,
+            ..Uniforms::random(&mut rng)
+        };
+        let xyz = colour::linear_srgb_to_xyz(es.sample(0, f, wr, [0.0; 3], 0.0, &u));
+        for i in 0..3 {
+            mc[i] += xyz[i] / m as f64;
+        }
+    }
+    mc
 }
 
 fn mean_y(img: &LinearImage, x0: u32, x1: u32) -> f64 {
@@ -67,19 +86,8 @@ fn furnace_through_the_renderer() {
         let pack = pack_of(n, dx, &vec![0.0; n * n], model);
         let env = Arc::new(Environment::Map(EnvMap::constant([1.0; 3])));
         let es = EnvShader::new(env.clone(), &[Some(pack.clone())]);
-        let m = 200_000u64;
-        let mut y = 0.0;
         let f = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
-        for k in 0..m {
-            let mut rng = EnvShader::rng(11, 0, k);
-            let lu = (k as f64 + rng.unit()) / m as f64;
-            let u = Uniforms {
-                lambda: lu,
-                ..Uniforms::random(&mut rng)
-            };
-            let c = es.sample(0, f, [0.0, 0.0, 1.0], [0.0; 3], 0.0, &u);
-            y += colour::linear_srgb_to_xyz(c)[1] / m as f64;
-        }
+        let y = estimate_xyz(&es, f, [0.0, 0.0, 1.0], 200_000, 11)[1];
         eprintln!("furnace {n} x {dx:e} {model:?}: Y = {y:.5} at the centre");
         assert!((y - 1.0).abs() < 0.01, "{n} px {model:?}: Y = {y}");
         let (mut scene, mesh) = fixtures::quad_scene([16, 16]);
@@ -129,32 +137,16 @@ fn estimator_matches_quadrature_under_the_sky() {
     let tilt: f64 = 0.5;
     let nrm = [0.0, tilt.cos(), tilt.sin()];
     let t = [1.0, 0.0, 0.0];
-    let b = [0.0, -tilt.sin(), tilt.cos()];
+    // b = n x t
     let b = [
         nrm[1] * t[2] - nrm[2] * t[1],
         nrm[2] * t[0] - nrm[0] * t[2],
         nrm[0] * t[1] - nrm[1] * t[0],
-    ]
-    .map(|v| v + 0.0 * b[0]);
+    ];
     let wr_l = [0.2, -0.3, (1.0f64 - 0.04 - 0.09).sqrt()];
     let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * nrm[k]);
     let wr = world(wr_l);
-    // Monte Carlo.
-    let m = 200_000u64;
-    let mut mc = [0.0; 3];
-    for k in 0..m {
-        let mut rng = EnvShader::rng(7, 0, k);
-        let lu = (k as f64 + rng.unit()) / m as f64;
-        let u = Uniforms {
-            lambda: lu,
-            ..Uniforms::random(&mut rng)
-        };
-        let c = es.sample(0, (t, b, nrm), wr, [0.0; 3], 0.0, &u);
-        let xyz = colour::linear_srgb_to_xyz(c);
-        for i in 0..3 {
-            mc[i] += xyz[i] / m as f64;
-        }
-    }
+    let mc = estimate_xyz(&es, (t, b, nrm), wr, 200_000, 7);
     // Midpoint quadrature over the hemisphere in (theta, phi): dw = sin(theta)
     // dtheta dphi, bounded integrand (in wi_t = (x, y) the 1 / cos(theta)
     // Jacobian is singular at the horizon, where this ridge field has orders).

@@ -46,39 +46,25 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
         "same seed, other frame"
     );
     // --compare: the same seed gives the same frame (CIEDE2000 0), another seed not.
-    let o = render(
-        &s,
-        &d.join("c.exr"),
-        &[
+    let compare = |seed: &str| {
+        let args = [
             "--samples",
             "4",
             "--seed",
-            "7",
+            seed,
             "--compare",
             a.to_str().unwrap(),
-        ],
-    );
-    let out = String::from_utf8_lossy(&o.stdout);
+        ];
+        let o = render(&s, &d.join("c.exr"), &args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let same = compare("7");
+    assert!(same.contains("CIEDE2000 mean 0.000 p99 0.000"), "{same}");
+    let other = compare("8");
     assert!(
-        o.status.success() && out.contains("CIEDE2000 mean 0.000 p99 0.000"),
-        "{out}"
-    );
-    let o = render(
-        &s,
-        &d.join("c.exr"),
-        &[
-            "--samples",
-            "4",
-            "--seed",
-            "8",
-            "--compare",
-            a.to_str().unwrap(),
-        ],
-    );
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success() && out.contains("CIEDE2000") && !out.contains("max 0.000"),
-        "{out}"
+        other.contains("CIEDE2000") && !other.contains("max 0.000"),
+        "{other}"
     );
     // A white diffuse sphere under the sky is lit (no point light is added).
     let img = sunbeam_raster_probe(&a);
