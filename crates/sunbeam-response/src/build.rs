@@ -267,7 +267,7 @@ pub fn build(pack: &Pack, o: &Options) -> Response {
         g,
         lw.len(),
         &xyz,
-        1.0,
+        true,
         "XYZ without G: sum_l R(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)",
     )
 }
@@ -300,21 +300,28 @@ pub fn build_sets(pack: &Pack, g: &Grid, ws: &WeightSets) -> Vec<Vec<f32>> {
     }
 }
 
-/// A response map of XYZ texels (negative values, from weights that dip
-/// below zero or rounding, clamped to 0), alpha channel `alpha`.
+/// A response map of XYZ texels. The point map (`point`: alpha 1) clamps
+/// negative values (rounding) to 0; the extended-light maps (alpha 0) keep
+/// them: a basis spectrum that dips below zero (`S1`, `S2`, a map's `D65
+/// b_k`) has texels of either sign, and only the combination `sum_k c_k E_k`
+/// is a colour.
 pub fn to_response(
     pack: &Pack,
     g: Grid,
     lambda_samples: usize,
     xyz: &[f32],
-    alpha: f32,
+    point: bool,
     quantity: &str,
 ) -> Response {
-    let a = half::f16::from_f32(alpha).to_bits();
+    let (a, lo) = if point {
+        (half::f16::ONE.to_bits(), 0.0)
+    } else {
+        (half::f16::ZERO.to_bits(), f32::NEG_INFINITY)
+    };
     let data = xyz
         .chunks_exact(3)
         .flat_map(|c| {
-            let h = |v: f32| half::f16::from_f32(v.max(0.0)).to_bits();
+            let h = |v: f32| half::f16::from_f32(v.max(lo)).to_bits();
             [h(c[0]), h(c[1]), h(c[2]), a]
         })
         .collect();

@@ -37,7 +37,10 @@ pub struct EnvResponse {
     /// `E_0..E_2`, one per basis spectrum (`Info::quantity` says which). Same
     /// texel layout as the point-light map; XYZ in RGB, A = 0.
     pub basis: Vec<Response>,
-    /// `E_sun` for a sky with the sun up.
+    /// `Omega_sun E_sun` for a sky with the sun up: the map of the sun's
+    /// spectrum times the disc's solid angle (the sun's radiance, ~1e5 scene
+    /// units, would overflow f16; times `Omega` it is an irradiance, ~1). A
+    /// sun sample adds `G(wi, wr) * texel` at a point of the disc.
     pub sun: Option<Response>,
     /// The proposal over `(u, v)` built from the maps' luminance.
     pub proposal: Proposal,
@@ -61,8 +64,8 @@ pub fn build_env(pack: &Pack, env: &Environment, opts: &Options) -> EnvResponse 
             g,
             nl,
             &e,
-            0.0,
-            &quantity("the sun's spectral radiance"),
+            false,
+            &quantity("the sun's spectral radiance times its solid angle"),
         )
     });
     let names = match env {
@@ -72,7 +75,7 @@ pub fn build_env(pack: &Pack, env: &Environment, opts: &Options) -> EnvResponse 
     let basis: Vec<Response> = xyz
         .iter()
         .zip(names)
-        .map(|(e, n)| build::to_response(pack, g, nl, e, 0.0, &quantity(n)))
+        .map(|(e, n)| build::to_response(pack, g, nl, e, false, &quantity(n)))
         .collect();
     let proposal = Proposal::from_maps(g, proposal_maps(env, &basis));
     EnvResponse {
@@ -118,7 +121,7 @@ pub fn coherent_area_m2(pack: &Pack) -> f64 {
 
 /// The weight sets of the extended-light maps at `n` midpoint wavelengths:
 /// `A / l^2 B_k(l) cmf(l) / sum_l D65(l) ybar(l)` for the three basis spectra,
-/// then the sun's spectrum when the sun is up. The normalisation is the same
+/// then the sun's spectrum times its disc's solid angle when the sun is up. The normalisation is the same
 /// discrete sum as the point map's, so `B = D65` integrates to `Y = 1` exactly
 /// (Parseval) over the same samples.
 pub fn env_weights(pack: &Pack, env: &Environment, n: usize) -> build::WeightSets {
@@ -145,7 +148,7 @@ pub fn env_weights(pack: &Pack, env: &Environment, n: usize) -> build::WeightSet
         sets.push(
             lambdas
                 .iter()
-                .map(|&l| weight(l, sky.sun_spectral(l)))
+                .map(|&l| weight(l, sky.sun_solid_angle() * sky.sun_spectral(l)))
                 .collect(),
         );
     }
@@ -190,7 +193,8 @@ impl EnvResponse {
                 let wi = [dot(t), dot(b), dot(n)];
                 if wi[2] > 0.0 {
                     let (uu, vv, w) = (-wi[0] - wr_l[0], -wi[1] - wr_l[1], -wi[2] - wr_l[2]);
-                    let f = sky.sun_solid_angle() * gain::g(wi, wr_l, gain::DEFAULT_IOR);
+                    // The map holds Omega_sun E_sun.
+                    let f = gain::g(wi, wr_l, gain::DEFAULT_IOR);
                     let e = e_sun.lookup(uu, vv, w);
                     for a in 0..3 {
                         xyz[a] += f * e[a];
