@@ -166,7 +166,7 @@ impl EnvResponse {
         let (t, b, n) = frame;
         let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
         let mut xyz = [0.0; 3];
-        if !(wr_l[2] > 0.0) {
+        if wr_l[2].is_nan() || wr_l[2] <= 0.0 {
             return xyz;
         }
         // The sky and the map (everything but the sun): one proposal sample.

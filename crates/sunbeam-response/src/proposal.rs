@@ -172,11 +172,11 @@ impl Proposal {
                 }
             }
             let sum: f64 = wts.iter().sum();
-            if !(sum > 0.0) {
+            if sum.is_nan() || sum <= 0.0 {
                 return None;
             }
             let c = pick(l, &cells, &wts)?;
-            if !(wts[c] > 0.0) {
+            if wts[c].is_nan() || wts[c] <= 0.0 {
                 return None;
             }
             prob *= wts[c] / sum;
@@ -242,7 +242,7 @@ impl Proposal {
     pub fn cell_of(&self, uv: [f64; 2]) -> Option<(usize, usize)> {
         let g = &self.grid;
         let r = uv[0].hypot(uv[1]);
-        if !(r < 2.0) {
+        if r.is_nan() || r >= 2.0 {
             return None;
         }
         let theta = uv[1].atan2(uv[0]).rem_euclid(std::f64::consts::TAU);

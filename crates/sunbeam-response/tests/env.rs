@@ -12,7 +12,7 @@ use sunbeam_common::rng::SplitMix64;
 use sunbeam_light::{daylight, sky::Sky, EnvMap, Environment};
 use sunbeam_optics::colour;
 use sunbeam_pack::build::{BuildOptions, FieldRef};
-use sunbeam_pack::{Model, Pack};
+use sunbeam_pack::Pack;
 use sunbeam_raster::environment::{EnvShader, Uniforms};
 use sunbeam_response::env::{build_env, EnvResponse, Frame};
 use sunbeam_response::{Options, Proposal, Response};
@@ -258,4 +258,34 @@ fn twin_agrees_with_the_reference() {
             assert!((a[0] - b[0]).abs() < 0.005 && (a[1] - b[1]).abs() < 0.005);
         }
     }
+}
+
+/// Build time of the extended-light maps against the point map for the
+/// demo-sized pack (synthetic Xenopeltis, 256 x 25 nm = 6.4 um), sky with the
+/// sun (4 weight sets in one pass). Timing only: `--ignored --nocapture`.
+#[test]
+#[ignore]
+fn build_time_demo_pack() {
+    let f = sunbeam_synth::preset("xenopeltis", 256, 25e-9).unwrap();
+    let r = FieldRef {
+        width: f.width,
+        height: f.height,
+        dx: f.dx,
+        dy: f.dy,
+        data: &f.data,
+    };
+    let pack = sunbeam_pack::build(r, &BuildOptions::default(), &mut |_, _| {}).unwrap();
+    let o = Options::default();
+    let t0 = std::time::Instant::now();
+    let point = sunbeam_response::build(&pack, &o);
+    let t1 = std::time::Instant::now();
+    let e = build_env(&pack, &sky(), &o);
+    let t2 = std::time::Instant::now();
+    eprintln!(
+        "grid {:?}: point map {:.2} s, env maps (3 + sun) + proposal {:.2} s, proposal {} floats",
+        point.info.grid,
+        (t1 - t0).as_secs_f64(),
+        (t2 - t1).as_secs_f64(),
+        e.proposal.data.len()
+    );
 }
