@@ -190,6 +190,47 @@ fn proposal_is_a_density_and_samples_follow_it() {
     );
 }
 
+/// The mixture of the proposal and the defensive hemisphere technique
+/// (`EnvResponse::draw`): the density it returns is `density` at the point,
+/// and over the view's disc `|(u, v) + wr_xy| < 1` it integrates to
+/// `DEFENSIVE + (1 - DEFENSIVE) * (the proposal's share inside the disc)`,
+/// checked by a midpoint rule on a polar grid around the disc's centre.
+#[test]
+fn mixture_density_is_consistent() {
+    let e = ridge_env(&sky());
+    let wr = unit([-0.3, 0.2, 0.9]);
+    let mut rng = SplitMix64::new(11);
+    for _ in 0..20_000 {
+        let u = [rng.unit(), rng.unit(), rng.unit()];
+        if let Some((uv, p)) = e.draw(wr, u) {
+            let again = e.density(wr, uv);
+            assert!((p - again).abs() <= 1e-9 * p, "{p} vs {again} at {uv:?}");
+        }
+    }
+    // Integral over the disc (in wi_xy: r from 0 to 1 around -wr_xy).
+    let (nr, nt) = (400, 720);
+    let (mut mix, mut prop) = (0.0, 0.0);
+    for a in 0..nr {
+        // r = sin(x) spacing resolves the 1 / cos(theta_i) at the rim.
+        let x0 = std::f64::consts::FRAC_PI_2 * a as f64 / nr as f64;
+        let x1 = std::f64::consts::FRAC_PI_2 * (a + 1) as f64 / nr as f64;
+        let (r0, r1) = (x0.sin(), x1.sin());
+        let r = 0.5 * (r0 + r1);
+        for b in 0..nt {
+            let t = std::f64::consts::TAU * (b as f64 + 0.5) / nt as f64;
+            let uv = [-r * t.cos() - wr[0], -r * t.sin() - wr[1]];
+            let da = std::f64::consts::TAU / nt as f64 * (r1 * r1 - r0 * r0) / 2.0;
+            mix += e.density(wr, uv) * da;
+            prop += e.proposal.pdf(wr, uv) * da;
+        }
+    }
+    let d = sunbeam_response::env::DEFENSIVE;
+    let want = d + (1.0 - d) * prop;
+    eprintln!("mixture over the disc {mix:.5}, expected {want:.5} (proposal share {prop:.5})");
+    assert!((mix - want).abs() < 0.01, "{mix} vs {want}");
+    assert!(prop > 0.9, "the proposal spends {prop} inside the disc");
+}
+
 /// Frame with the normal up (+y), so the sky lights the patch.
 const FRAME: Frame = ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]);
 
