@@ -13,6 +13,8 @@
 //! # let _ = image;
 //! ```
 
+pub mod accum;
+pub mod env;
 pub mod export;
 pub mod gpu;
 pub mod renderer;
