@@ -33,6 +33,8 @@ use sunbeam_optics::cie;
 pub const SUN_RADIUS_RAD: f64 = 0.004_65;
 /// Reflectance of the grey ground seen below the horizon.
 pub const GROUND_ALBEDO: f64 = 0.2;
+/// D65's chromaticity (CIE 1931 x, y): the ground's colour.
+pub const D65_XY: [f64; 2] = [0.3127, 0.3290];
 /// Probability of sampling the sun's cone when the sun is up.
 pub const SUN_PROB: f64 = 0.5;
 /// Sampling table size (width; height is half).
@@ -68,6 +70,9 @@ pub struct Sky {
     /// XYZ of the sun's disc radiance.
     sun_xyz: [f64; 3],
     ground: f64,
+    /// Daylight weights of the ground: the spectrum at D65's chromaticity with
+    /// luminance `ground` (so sky and ground are both in the span of S0, S1, S2).
+    ground_weights: [f64; 3],
     table: EnvMap,
 }
 
@@ -133,6 +138,7 @@ impl Sky {
             sun_cos_max: SUN_RADIUS_RAD.cos(),
             sun_xyz: [0.0; 3],
             ground: 0.0,
+            ground_weights: [0.0; 3],
             table: EnvMap::constant([0.0; 3]),
         };
         // Sun: luminance (cd/m^2) of its disc and the scale of its spectrum.
@@ -167,6 +173,7 @@ impl Sky {
         let scale = if e_h > 0.0 { intensity * PI / e_h } else { 0.0 };
         sky.scale = scale;
         sky.ground = GROUND_ALBEDO * e_h / PI * scale;
+        sky.ground_weights = sky.daylight_of_luminance(D65_XY, sky.ground);
         // Scene radiance of the sun at lambda = sun_scale * shape(lambda), with
         // Y (scene units) = sun_lum * scale.
         let y_shape: f64 = (cie::DEFAULT_RANGE_NM.0..=cie::DEFAULT_RANGE_NM.1)
@@ -218,18 +225,37 @@ impl Sky {
         }
     }
 
-    /// Weights `w` of S0, S1, S2 such that the sky's spectral radiance in `d` is
-    /// `sum_k w_k S_k(lambda)` (scene units).
+    /// Weights `w` of S0, S1, S2 such that the sky's spectral radiance in `d`
+    /// (above the horizon) is `sum_k w_k S_k(lambda)` (scene units).
     fn sky_weights(&self, d: [f64; 3]) -> [f64; 3] {
         let [y, x, yy] = self.sky_yxy(d);
-        let m = daylight::weights(x, yy);
+        self.daylight_of_luminance([x, yy], y * self.scale)
+    }
+
+    /// Weights of the daylight spectrum of chromaticity `xy` and luminance `y`
+    /// (scene units).
+    fn daylight_of_luminance(&self, xy: [f64; 2], y: f64) -> [f64; 3] {
+        let m = daylight::weights(xy[0], xy[1]);
         let y_basis: f64 = (0..3).map(|k| m[k] * self.basis_xyz[k][1]).sum();
-        let s = if y_basis > 0.0 {
-            y * self.scale / y_basis
-        } else {
-            0.0
-        };
+        let s = if y_basis > 0.0 { y / y_basis } else { 0.0 };
         m.map(|v| v * s)
+    }
+
+    /// Weights `c` of S0, S1, S2 ([`daylight::basis_at`]) such that the
+    /// radiance from `d` without the sun is exactly `sum_k c_k S_k(lambda)`:
+    /// the sky's above the horizon, the ground's (D65's chromaticity) at and
+    /// below it. The extended-light response maps rely on this being exact.
+    pub fn coefficients(&self, d: [f64; 3]) -> [f64; 3] {
+        if d[1] > 0.0 {
+            self.sky_weights(d)
+        } else {
+            self.ground_weights
+        }
+    }
+
+    /// True when the sun is above the horizon (and so shines).
+    pub fn sun_is_up(&self) -> bool {
+        self.sun_up && self.sun_scale > 0.0
     }
 
     /// Relative spectral shape of the sun at the ground (before scaling).
@@ -287,19 +313,16 @@ impl Sky {
     /// (the sky model runs once per direction, not once per wavelength).
     pub fn spectrum(&self, d: [f64; 3]) -> SkySpectrum {
         SkySpectrum {
-            daylight: (d[1] > 0.0).then(|| self.sky_weights(d)),
+            daylight: self.coefficients(d),
             sun: self.in_sun(d),
         }
     }
 
     /// XYZ of the radiance from `d` (scene units), consistent with [`Sky::spectral`].
     pub fn xyz(&self, d: [f64; 3]) -> [f64; 3] {
-        let mut xyz = if d[1] > 0.0 {
-            let w = self.sky_weights(d);
-            [0, 1, 2].map(|c| (0..3).map(|k| w[k] * self.basis_xyz[k][c]).sum())
-        } else {
-            cie::d65_white_xyz(cie::DEFAULT_RANGE_NM).map(|v| v * self.ground)
-        };
+        let w = self.coefficients(d);
+        let mut xyz: [f64; 3] =
+            [0, 1, 2].map(|c| (0..3).map(|k| w[k] * self.basis_xyz[k][c]).sum());
         if self.in_sun(d) {
             let s = self.sun_xyz;
             for c in 0..3 {
@@ -361,8 +384,8 @@ impl Sky {
 /// The radiance from one direction of a [`Sky`] ([`Sky::spectrum`]).
 #[derive(Debug, Clone, Copy)]
 pub struct SkySpectrum {
-    /// Weights of the CIE daylight basis (None: the ground).
-    daylight: Option<[f64; 3]>,
+    /// Weights of the CIE daylight basis (sky or ground, [`Sky::coefficients`]).
+    daylight: [f64; 3],
     /// The direction lies in the sun's disc.
     sun: bool,
 }
@@ -370,13 +393,8 @@ pub struct SkySpectrum {
 impl SkySpectrum {
     /// Spectral radiance at `lambda_m` (scene units); `sky` is the one it came from.
     pub fn at(&self, sky: &Sky, lambda_m: f64) -> f64 {
-        let mut l = match self.daylight {
-            Some(w) => {
-                let b = daylight::basis_at(lambda_m);
-                w[0] * b[0] + w[1] * b[1] + w[2] * b[2]
-            }
-            None => sky.ground * cie::d65_at(lambda_m),
-        };
+        let (w, b) = (self.daylight, daylight::basis_at(lambda_m));
+        let mut l = w[0] * b[0] + w[1] * b[1] + w[2] * b[2];
         if self.sun {
             l += sky.sun_scale * sky.sun_spectrum_shape(lambda_m);
         }

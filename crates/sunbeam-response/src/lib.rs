@@ -14,12 +14,16 @@
 //! texels for DCC tools, see [`exr`].
 
 pub mod build;
+pub mod env;
 pub mod exr;
 pub mod grid;
 pub mod ktx2;
+pub mod proposal;
 
 pub use build::{build, Options};
+pub use env::{build_env, EnvResponse};
 pub use grid::Grid;
+pub use proposal::Proposal;
 
 use serde::{Deserialize, Serialize};
 use sunbeam_common::{Error, Result};
