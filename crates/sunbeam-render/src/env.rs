@@ -142,8 +142,7 @@ impl EnvScene {
                     let omega = sky.sun_solid_angle();
                     let d = sky.sun_direction();
                     let (t, b) = orthonormal(d);
-                    let rgb =
-                        colour::xyz_to_linear_srgb(spectrum_xyz(|l| sky.sun_spectral(l)));
+                    let rgb = colour::xyz_to_linear_srgb(spectrum_xyz(|l| sky.sun_spectral(l)));
                     values.has_sun = 1;
                     values.sun_dir = v4(d, 1.0 - omega / (2.0 * std::f64::consts::PI));
                     values.sun_rgb = v4(rgb, omega);
@@ -242,10 +241,12 @@ impl EnvScene {
             contents: bytemuck::bytes_of(&u),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let tex = |b: u32, v: &wgpu::TextureView| wgpu::BindGroupEntry {
-            binding: b,
-            resource: wgpu::BindingResource::TextureView(v),
-        };
+        fn tex(b: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding: b,
+                resource: wgpu::BindingResource::TextureView(v),
+            }
+        }
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("environment"),
             layout: &self.layout,

@@ -532,7 +532,8 @@ impl Renderer {
                                 )));
                             }
                             let t0 = std::time::Instant::now();
-                            let er = sunbeam_response::env::build_env(pack, env, &settings.response);
+                            let er =
+                                sunbeam_response::env::build_env(pack, env, &settings.response);
                             notes.push(format!(
                                 "built the environment's response maps for meshes[{mi}].pack ({} x {} x {} texels, {} maps, \
                                  {} pyramid levels) in {:.2} s",
@@ -1156,18 +1157,35 @@ impl Offscreen {
         }
     }
 
-    /// Render one frame and wait for it (no readback); a progressive renderer
-    /// adds it to the running sum.
-    pub fn draw(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<()> {
+    /// The progressive sum (environment scenes), for the window's resolve pass.
+    pub fn accumulator(&self) -> Option<&crate::accum::Accumulator> {
+        self.acc.as_ref()
+    }
+
+    /// Record one frame (and, for a progressive renderer, adding it to the sum:
+    /// the frame index is set from the count). The caller submits.
+    pub fn encode_frame(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        r: &Renderer,
+        state: &FrameState,
+    ) {
         r.update(gpu, state, self.width, self.height);
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
         if let Some(a) = &self.acc {
             r.set_frame(gpu, a.count());
         }
-        self.record(&mut enc, r, state);
+        self.record(enc, r, state);
         if let Some(a) = &self.acc {
-            a.add(gpu, &mut enc);
+            a.add(gpu, enc);
         }
+    }
+
+    /// Render one frame and wait for it (no readback); a progressive renderer
+    /// adds it to the running sum.
+    pub fn draw(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<()> {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        self.encode_frame(gpu, &mut enc, r, state);
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
         gpu.take_errors()
@@ -1252,8 +1270,8 @@ mod layout_tests {
     use super::{Globals, MaterialU, SHADER};
     use std::mem::{offset_of, size_of};
 
-    fn wgsl_struct(name: &str) -> (u32, Vec<(String, u32)>) {
-        let module = naga::front::wgsl::parse_str(SHADER).expect("the shader parses");
+    fn wgsl_struct(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+        let module = naga::front::wgsl::parse_str(src).expect("the shader parses");
         for (_, ty) in module.types.iter() {
             if ty.name.as_deref() == Some(name) {
                 if let naga::TypeInner::Struct { members, span } = &ty.inner {
@@ -1271,7 +1289,11 @@ mod layout_tests {
     }
 
     fn check(name: &str, size: usize, rust: &[(&str, usize)]) {
-        let (span, members) = wgsl_struct(name);
+        check_in(SHADER, name, size, rust)
+    }
+
+    fn check_in(src: &str, name: &str, size: usize, rust: &[(&str, usize)]) {
+        let (span, members) = wgsl_struct(src, name);
         assert_eq!(span as usize, size, "{name}: WGSL size vs Rust size");
         let mut matched = 0;
         for (field, off) in rust {
@@ -1360,6 +1382,44 @@ mod layout_tests {
                 resp_rho_scale,
                 resp_footprint
             ),
+        );
+    }
+
+    #[test]
+    fn environment_uniforms_match_the_wgsl() {
+        use crate::env::{EnvGlobals, EnvProposalU};
+        macro_rules! f {
+            ($t:ty; $($n:ident),*) => { [$((stringify!($n), offset_of!($t, $n))),*] };
+        }
+        check(
+            "EnvGlobals",
+            size_of::<EnvGlobals>(),
+            &f!(EnvGlobals; basis_to_rgb, sun_dir, sun_rgb, sun_t, sun_b, table_w, table_h, frame, on, has_sun, samples),
+        );
+        check(
+            "EnvProposal",
+            size_of::<EnvProposalU>(),
+            &f!(EnvProposalU; offsets, pw, ph, top, n_s, n_theta, n_rho, n_s_f, r0, rho_scale, on, has_sun),
+        );
+    }
+
+    #[test]
+    fn accumulation_uniforms_match_the_wgsl() {
+        use crate::accum::{AccU, ResolveU, ACCUMULATE_WGSL, RESOLVE_WGSL};
+        macro_rules! f {
+            ($t:ty; $($n:ident),*) => { [$((stringify!($n), offset_of!($t, $n))),*] };
+        }
+        check_in(
+            ACCUMULATE_WGSL,
+            "AccU",
+            size_of::<AccU>(),
+            &f!(AccU; width, height, count),
+        );
+        check_in(
+            RESOLVE_WGSL,
+            "ResolveU",
+            size_of::<ResolveU>(),
+            &f!(ResolveU; width, inv_n, curve, output),
         );
     }
 }
