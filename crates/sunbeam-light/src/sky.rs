@@ -7,7 +7,10 @@
 //!   the CIE daylight basis at that chromaticity ([`crate::daylight`]), as the
 //!   paper does. Directions at and below the horizon see a grey ground of
 //!   albedo [`GROUND_ALBEDO`] lit by sun and sky (a Lambertian disc: constant
-//!   radiance), with D65's spectral shape.
+//!   radiance): the daylight spectrum at D65's chromaticity ([`D65_XY`]) with
+//!   the luminance of `ground * D65`. Within 1 % of D65's shape, and it keeps
+//!   the whole radiance without the sun exactly in the span of `S0, S1, S2`
+//!   ([`Sky::coefficients`]), which the extended-light response maps need.
 //! - Sun: a disc of angular radius [`SUN_RADIUS_RAD`], the extraterrestrial
 //!   spectrum approximated by a 5778 K black body scaled to 128 klux at
 //!   normal incidence, attenuated along the air mass (Kasten and Young 1989)
@@ -501,6 +504,69 @@ mod tests {
             (est / n as f64 / want - 1.0).abs() < 0.01,
             "{} vs {want}",
             est / n as f64
+        );
+    }
+
+    /// Independent recomputation of the radiance without the sun: above the
+    /// horizon Preetham's `(Y, x, y)` turned into `S0 + M1 S1 + M2 S2` scaled
+    /// to `Y` by a 1 nm sum of its own; at and below it the daylight spectrum
+    /// at D65's chromaticity scaled to `Y = albedo * intensity` (the ground of
+    /// a horizontal white surface of radiance `intensity`). `basis_at .
+    /// coefficients` and `spectral` must both equal it to 1e-9.
+    #[test]
+    fn coefficients_reproduce_the_spectrum() {
+        use crate::Environment;
+        let intensity = 1.7;
+        let sky = Sky::new(35.0, 200.0, 3.5, intensity);
+        let env = Environment::Sky(Box::new(sky.clone()));
+        let norm = cie::d65_y_norm(cie::DEFAULT_RANGE_NM);
+        let luminance_of = |m: [f64; 3]| {
+            (380..=780u32)
+                .map(|nm| {
+                    let b = daylight::basis_at(nm as f64 * 1e-9);
+                    (m[0] * b[0] + m[1] * b[1] + m[2] * b[2]) * cie::cmf_nm(nm)[1]
+                })
+                .sum::<f64>()
+                / norm
+        };
+        let mut r = SplitMix64::new(21);
+        let mut n_ground = 0;
+        for _ in 0..400 {
+            let d = crate::direction(2.0 * r.unit() - 1.0, 2.0 * PI * r.unit());
+            if sky.in_sun(d) {
+                continue;
+            }
+            let (m, y) = if d[1] > 0.0 {
+                let [y, x, yy] = sky.sky_yxy(d);
+                (daylight::weights(x, yy), y * sky.scale)
+            } else {
+                n_ground += 1;
+                (daylight::weights(0.3127, 0.3290), GROUND_ALBEDO * intensity)
+            };
+            let k = y / luminance_of(m);
+            for _ in 0..5 {
+                let l = (380.0 + 400.0 * r.unit()) * 1e-9;
+                let b = daylight::basis_at(l);
+                let want = k * (m[0] * b[0] + m[1] * b[1] + m[2] * b[2]);
+                let c = env.coefficients(d);
+                let bk = env.basis_at(l);
+                let got = c[0] * bk[0] + c[1] * bk[1] + c[2] * bk[2];
+                assert!(
+                    (got / want - 1.0).abs() < 1e-9,
+                    "{d:?} {l}: {got} vs {want}"
+                );
+                let s = env.spectral(d, l);
+                assert!((s / want - 1.0).abs() < 1e-9, "{d:?} {l}: {s} vs {want}");
+            }
+        }
+        assert!(n_ground > 100);
+        // The ground is D65's colour with D65's luminance.
+        let g = sky.xyz([0.0, -1.0, 0.0]);
+        let sum = g[0] + g[1] + g[2];
+        assert!((g[0] / sum - 0.3127).abs() < 1e-3 && (g[1] / sum - 0.3290).abs() < 1e-3);
+        assert!(
+            (g[1] / (GROUND_ALBEDO * intensity) - 1.0).abs() < 2e-3,
+            "{g:?}"
         );
     }
 

@@ -255,20 +255,74 @@ impl Powers {
 /// (G_e + G_o) + i (H_e + H_o)` and `A(-f) = (G_e - G_o) + i (H_o - H_e)`: one
 /// interpolation and one set of dot products give both texels, half the work.
 pub fn build(pack: &Pack, o: &Options) -> Response {
-    let m = &pack.manifest;
     let g = o.grid.unwrap_or_else(|| auto_grid(pack, o.budget_bytes));
     let lw = wavelength_weights(o.lambda_samples);
+    let ws = WeightSets {
+        lambdas: lw.iter().map(|l| l.0).collect(),
+        sets: vec![lw.iter().map(|l| l.1).collect()],
+    };
+    let xyz = build_sets(pack, &g, &ws).pop().expect("one weight set");
+    to_response(
+        pack,
+        g,
+        lw.len(),
+        &xyz,
+        true,
+        "XYZ without G: sum_l R(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)",
+    )
+}
+
+/// Several colour integrals of the same `R`: wavelengths (metres) and, per
+/// set, one XYZ weight per wavelength (`texel_s = sum_l R(.., l) set_s[l]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WeightSets {
+    pub lambdas: Vec<f64>,
+    pub sets: Vec<Vec<[f64; 3]>>,
+}
+
+/// The texels (XYZ, `f32`, response-map order) of every weight set of `ws` on
+/// grid `g`, in one pass over the pack's `R`: the interpolation of the terms
+/// and the powers `|A|^2`, the expensive part, are shared; each set only adds
+/// its own multiply-add per (texel, wavelength). Set `s`'s texels do not
+/// depend on the other sets (same operations in the same order), so
+/// [`build`] through here gives the same bytes as a set of its own.
+pub fn build_sets(pack: &Pack, g: &Grid, ws: &WeightSets) -> Vec<Vec<f32>> {
     let terms = Terms::new(pack);
-    let coef = coefficients(pack, &g, &lw, &terms);
-    let xyz = match m.model {
-        Model::Window => window_by_rays(pack, &g, &lw, &terms, &coef),
-        Model::Tiled => tiled_by_rows(pack, &g, &lw, &terms, &coef),
+    let coef = coefficients(pack, g, &ws.lambdas, &terms);
+    let wt: Vec<Vec<[f32; 3]>> = ws
+        .sets
+        .iter()
+        .map(|s| s.iter().map(|w| w.map(|v| v as f32)).collect())
+        .collect();
+    match pack.manifest.model {
+        Model::Window => window_by_rays(pack, g, &ws.lambdas, &wt, &terms, &coef),
+        Model::Tiled => tiled_by_rows(pack, g, &ws.lambdas, &wt, &terms, &coef),
+    }
+}
+
+/// A response map of XYZ texels. The point map (`point`: alpha 1) clamps
+/// negative values (rounding) to 0; the extended-light maps (alpha 0) keep
+/// them: a basis spectrum that dips below zero (`S1`, `S2`, a map's `D65
+/// b_k`) has texels of either sign, and only the combination `sum_k c_k E_k`
+/// is a colour.
+pub fn to_response(
+    pack: &Pack,
+    g: Grid,
+    lambda_samples: usize,
+    xyz: &[f32],
+    point: bool,
+    quantity: &str,
+) -> Response {
+    let (a, lo) = if point {
+        (half::f16::ONE.to_bits(), 0.0)
+    } else {
+        (half::f16::ZERO.to_bits(), f32::NEG_INFINITY)
     };
     let data = xyz
         .chunks_exact(3)
         .flat_map(|c| {
-            let h = |v: f32| half::f16::from_f32(v.max(0.0)).to_bits();
-            [h(c[0]), h(c[1]), h(c[2]), half::f16::ONE.to_bits()]
+            let h = |v: f32| half::f16::from_f32(v.max(lo)).to_bits();
+            [h(c[0]), h(c[1]), h(c[2]), a]
         })
         .collect();
     Response {
@@ -277,11 +331,10 @@ pub fn build(pack: &Pack, o: &Options) -> Response {
             version: VERSION,
             generator: format!("sunbeam-response {}", env!("CARGO_PKG_VERSION")),
             grid: g,
-            lambda_samples: lw.len(),
+            lambda_samples,
             lambda_range_nm: [cie::DEFAULT_RANGE_NM.0, cie::DEFAULT_RANGE_NM.1],
-            quantity: "XYZ without G: sum_l R(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)"
-                .to_string(),
-            pack: m.clone(),
+            quantity: quantity.to_string(),
+            pack: pack.manifest.clone(),
         },
         data,
     }
@@ -382,7 +435,7 @@ impl TapBuf {
 
 /// `c_n(t) = i^n a_n` (`a_n` real in both bases) for every (radius row,
 /// wavelength, `s`), terms in [`Terms`]' order: `[j][l][n][k]`.
-fn coefficients(pack: &Pack, g: &Grid, lw: &[(f64, [f64; 3])], terms: &Terms) -> Vec<f32> {
+fn coefficients(pack: &Pack, g: &Grid, lambdas: &[f64], terms: &Terms) -> Vec<f32> {
     let m = &pack.manifest;
     let (nt, ne) = (terms.nt, terms.ne);
     (0..g.n_rho)
@@ -390,8 +443,8 @@ fn coefficients(pack: &Pack, g: &Grid, lw: &[(f64, [f64; 3])], terms: &Terms) ->
         .flat_map_iter(|j| {
             let r = g.r_at(j);
             let wmax = (4.0 - r * r).max(0.0).sqrt();
-            let mut coef = vec![0.0f32; lw.len() * g.n_s * nt];
-            for (l, (lambda, _)) in lw.iter().enumerate() {
+            let mut coef = vec![0.0f32; lambdas.len() * g.n_s * nt];
+            for (l, lambda) in lambdas.iter().enumerate() {
                 for k in 0..g.n_s {
                     let w = -g.s_at(k) * wmax;
                     let t = std::f64::consts::TAU / lambda * w * m.height_half_range_m;
@@ -422,16 +475,19 @@ const RAY_SAMPLES_PER_BIN: f64 = 8.0;
 fn window_by_rays(
     pack: &Pack,
     g: &Grid,
-    lw: &[(f64, [f64; 3])],
+    lambdas: &[f64],
+    wts: &[Vec<[f32; 3]>],
     terms: &Terms,
     coef: &[f32],
-) -> Vec<f32> {
+) -> Vec<Vec<f32>> {
     let m = &pack.manifest;
-    let (nt, ne, ns, nl) = (terms.nt, terms.ne, g.n_s, lw.len());
+    let (nt, ne, ns, nl) = (terms.nt, terms.ne, g.n_s, lambdas.len());
+    // Per set, a column of n_rho * ns XYZ texels.
+    let (nsets, stride) = (wts.len(), g.n_rho * ns * 3);
     let kb = KbTable::new(m.kernel.taps, m.kernel.beta);
     let paired = g.n_theta.is_multiple_of(2);
     let n_direct = if paired { g.n_theta / 2 } else { g.n_theta };
-    let lambda_min = lw.iter().map(|l| l.0).fold(f64::INFINITY, f64::min);
+    let lambda_min = lambdas.iter().copied().fold(f64::INFINITY, f64::min);
     let cols: Vec<(Vec<f32>, Vec<f32>)> = (0..n_direct)
         .into_par_iter()
         .map(|i| {
@@ -453,13 +509,13 @@ fn window_by_rays(
                 );
                 terms.interpolate(pack, &kb, (a.0 * q, a.1 * q), &mut tb, gs, hs);
             }
-            let mut col = vec![0.0f32; g.n_rho * ns * 3];
-            let mut col_m = vec![0.0f32; if paired { g.n_rho * ns * 3 } else { 0 }];
+            let mut col = vec![0.0f32; nsets * stride];
+            let mut col_m = vec![0.0f32; if paired { nsets * stride } else { 0 }];
             let (mut gr, mut hi) = (vec![0.0f32; nt], vec![0.0f32; nt]);
             let mut pw = Powers::new(ns);
             for j in 0..g.n_rho {
                 let r = g.r_at(j);
-                for (l, (lambda, wt)) in lw.iter().enumerate() {
+                for (l, lambda) in lambdas.iter().enumerate() {
                     let x = r / lambda / dq + 1.0;
                     let p0 = (x.floor() as usize).max(1);
                     if p0 + 2 >= n_q {
@@ -480,17 +536,18 @@ fn window_by_rays(
                         axpy(&mut hi, wv, &ray_h[o..o + nt]);
                     }
                     let cl = &coef[(j * nl + l) * ns * nt..(j * nl + l + 1) * ns * nt];
-                    let wt = wt.map(|v| v as f32);
                     pw.eval(cl, &gr, &hi, ne);
                     for k in 0..ns {
                         let (p, q) = pw.at(k);
-                        let o = (j * ns + k) * 3;
-                        for c in 0..3 {
-                            col[o + c] += p * wt[c];
-                        }
-                        if paired {
+                        for (si, wt) in wts.iter().enumerate() {
+                            let (wt, o) = (wt[l], si * stride + (j * ns + k) * 3);
                             for c in 0..3 {
-                                col_m[o + c] += q * wt[c];
+                                col[o + c] += p * wt[c];
+                            }
+                            if paired {
+                                for c in 0..3 {
+                                    col_m[o + c] += q * wt[c];
+                                }
                             }
                         }
                     }
@@ -499,21 +556,23 @@ fn window_by_rays(
             (col, col_m)
         })
         .collect();
-    let mut xyz = vec![0.0f32; g.texels() * 3];
-    for (i, (col, col_m)) in cols.iter().enumerate() {
-        for j in 0..g.n_rho {
-            for k in 0..ns {
-                let src = (j * ns + k) * 3;
-                let at = |i: usize| ((k * g.n_rho + j) * g.n_theta + i) * 3;
-                xyz[at(i)..at(i) + 3].copy_from_slice(&col[src..src + 3]);
-                if paired {
-                    xyz[at(i + n_direct)..at(i + n_direct) + 3]
-                        .copy_from_slice(&col_m[src..src + 3]);
+    let mut out = vec![vec![0.0f32; g.texels() * 3]; nsets];
+    for (si, xyz) in out.iter_mut().enumerate() {
+        for (i, (col, col_m)) in cols.iter().enumerate() {
+            for j in 0..g.n_rho {
+                for k in 0..ns {
+                    let src = si * stride + (j * ns + k) * 3;
+                    let at = |i: usize| ((k * g.n_rho + j) * g.n_theta + i) * 3;
+                    xyz[at(i)..at(i) + 3].copy_from_slice(&col[src..src + 3]);
+                    if paired {
+                        xyz[at(i + n_direct)..at(i + n_direct) + 3]
+                            .copy_from_slice(&col_m[src..src + 3]);
+                    }
                 }
             }
         }
     }
-    xyz
+    out
 }
 
 /// The tiled model (a Gaussian-weighted sum of per-bin powers, not an
@@ -522,12 +581,15 @@ fn window_by_rays(
 fn tiled_by_rows(
     pack: &Pack,
     g: &Grid,
-    lw: &[(f64, [f64; 3])],
+    lambdas: &[f64],
+    wts: &[Vec<[f32; 3]>],
     terms: &Terms,
     coef: &[f32],
-) -> Vec<f32> {
+) -> Vec<Vec<f32>> {
     let m = &pack.manifest;
-    let (nt, ne, ns, nl) = (terms.nt, terms.ne, g.n_s, lw.len());
+    let (nt, ne, ns, nl) = (terms.nt, terms.ne, g.n_s, lambdas.len());
+    // Per set, a row of n_theta * ns XYZ texels.
+    let (nsets, stride) = (wts.len(), g.n_theta * ns * 3);
     let cw = m.crop.width;
     let kb = KbTable::new(m.kernel.taps, m.kernel.beta);
     let paired = g.n_theta.is_multiple_of(2);
@@ -536,14 +598,14 @@ fn tiled_by_rows(
         .into_par_iter()
         .map(|j| {
             let r = g.r_at(j);
-            let mut out = vec![0.0f32; g.n_theta * ns * 3];
+            let mut out = vec![0.0f32; nsets * stride];
             let mut tb = TapBuf::new(m.kernel.taps);
             let (mut rs, mut rm) = (vec![0.0f32; ns], vec![0.0f32; ns]);
             let mut pw = Powers::new(ns);
             for i in 0..n_direct {
                 let th = g.theta_at(i);
                 let (cu, su) = (r * th.cos(), r * th.sin());
-                for (l, (lambda, wt)) in lw.iter().enumerate() {
+                for (l, lambda) in lambdas.iter().enumerate() {
                     let kx = -cu / lambda * m.bin_scale_m[0];
                     let ky = -su / lambda * m.bin_scale_m[1];
                     if !taps(pack, &kb, kx, 0, &mut tb.ix, &mut tb.wx)
@@ -570,12 +632,14 @@ fn tiled_by_rows(
                             }
                         }
                     }
-                    let wt = wt.map(|v| v as f32);
                     let mut add = |i: usize, rr: &[f32]| {
-                        for (k, rk) in rr.iter().enumerate() {
-                            let o = (k * g.n_theta + i) * 3;
-                            for c in 0..3 {
-                                out[o + c] += rk * wt[c];
+                        for (si, wt) in wts.iter().enumerate() {
+                            let wt = wt[l];
+                            for (k, rk) in rr.iter().enumerate() {
+                                let o = si * stride + (k * g.n_theta + i) * 3;
+                                for c in 0..3 {
+                                    out[o + c] += rk * wt[c];
+                                }
                             }
                         }
                     };
@@ -588,17 +652,19 @@ fn tiled_by_rows(
             out
         })
         .collect();
-    let mut xyz = vec![0.0f32; g.texels() * 3];
-    for (j, row) in rows.iter().enumerate() {
-        for k in 0..ns {
-            for i in 0..g.n_theta {
-                let (src, dst) = (
-                    (k * g.n_theta + i) * 3,
-                    ((k * g.n_rho + j) * g.n_theta + i) * 3,
-                );
-                xyz[dst..dst + 3].copy_from_slice(&row[src..src + 3]);
+    let mut out = vec![vec![0.0f32; g.texels() * 3]; nsets];
+    for (si, xyz) in out.iter_mut().enumerate() {
+        for (j, row) in rows.iter().enumerate() {
+            for k in 0..ns {
+                for i in 0..g.n_theta {
+                    let (src, dst) = (
+                        si * stride + (k * g.n_theta + i) * 3,
+                        ((k * g.n_rho + j) * g.n_theta + i) * 3,
+                    );
+                    xyz[dst..dst + 3].copy_from_slice(&row[src..src + 3]);
+                }
             }
         }
     }
-    xyz
+    out
 }

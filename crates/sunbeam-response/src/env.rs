@@ -21,7 +21,8 @@ use crate::build::{self, Options};
 use crate::grid::Grid;
 use crate::Response;
 use sunbeam_light::Environment;
-use sunbeam_pack::Pack;
+use sunbeam_optics::{cie, colour, gain};
+use sunbeam_pack::{Model, Pack};
 
 pub use crate::proposal::Proposal;
 
@@ -36,7 +37,10 @@ pub struct EnvResponse {
     /// `E_0..E_2`, one per basis spectrum (`Info::quantity` says which). Same
     /// texel layout as the point-light map; XYZ in RGB, A = 0.
     pub basis: Vec<Response>,
-    /// `E_sun` for a sky with the sun up.
+    /// `Omega_sun E_sun` for a sky with the sun up: the map of the sun's
+    /// spectrum times the disc's solid angle (the sun's radiance, ~1e5 scene
+    /// units, would overflow f16; times `Omega` it is an irradiance, ~1). A
+    /// sun sample adds `G(wi, wr) * texel` at a point of the disc.
     pub sun: Option<Response>,
     /// The proposal over `(u, v)` built from the maps' luminance.
     pub proposal: Proposal,
@@ -47,8 +51,108 @@ pub struct EnvResponse {
 /// `opts.grid` or the one [`build::auto_grid`] picks under `opts.budget_bytes`
 /// (the same grid as the point map's).
 pub fn build_env(pack: &Pack, env: &Environment, opts: &Options) -> EnvResponse {
-    let _ = (pack, env, opts, build::DEFAULT_LAMBDA_SAMPLES);
-    unimplemented!("build_env: step 3")
+    let g = opts
+        .grid
+        .unwrap_or_else(|| build::auto_grid(pack, opts.budget_bytes));
+    let ws = env_weights(pack, env, opts.lambda_samples);
+    let nl = ws.lambdas.len();
+    let mut xyz = build::build_sets(pack, &g, &ws);
+    let sun = env.sun().map(|_| {
+        let e = xyz.pop().expect("the sun's set");
+        build::to_response(
+            pack,
+            g,
+            nl,
+            &e,
+            false,
+            &quantity("the sun's spectral radiance times its solid angle"),
+        )
+    });
+    let names = match env {
+        Environment::Sky(_) => ["S0", "S1", "S2"],
+        Environment::Map(_) => ["D65 b_r", "D65 b_g", "D65 b_b"],
+    };
+    let basis: Vec<Response> = xyz
+        .iter()
+        .zip(names)
+        .map(|(e, n)| build::to_response(pack, g, nl, e, false, &quantity(n)))
+        .collect();
+    let proposal = Proposal::from_maps(g, proposal_maps(env, &basis));
+    EnvResponse {
+        grid: g,
+        basis,
+        sun,
+        proposal,
+    }
+}
+
+/// `Info::quantity` of an extended-light map for basis spectrum `b`.
+fn quantity(b: &str) -> String {
+    format!(
+        "XYZ without G: sum_l R(u, v, w, l) (A / l^2) B(l) cmf(l) / sum_l D65(l) ybar(l), B = {b}"
+    )
+}
+
+/// The maps whose luminance the proposal follows: `E_0` for the sky (`S0` is
+/// close to the mean daylight), `E_0 + E_1 + E_2` for a map (D65).
+fn proposal_maps<'a>(env: &Environment, basis: &'a [Response]) -> Vec<&'a Response> {
+    match env {
+        Environment::Sky(_) => vec![&basis[0]],
+        Environment::Map(_) => basis.iter().collect(),
+    }
+}
+
+/// The pack's coherent area `A` (m^2), as the reference's
+/// `LobeSampler::area_m2`: window `(sum g)^2 / sum g^2 dx dy`, tiled
+/// `1 / (2 pi sigma_f^2)` (docs/LIGHTING.md "The factor").
+pub fn coherent_area_m2(pack: &Pack) -> f64 {
+    let m = &pack.manifest;
+    match m.model {
+        Model::Window => sunbeam_optics::truth::window_coherent_area_m2(
+            m.patch.width,
+            m.patch.height,
+            m.patch.dx_m,
+            m.patch.dy_m,
+            m.window_sigma_m,
+        ),
+        Model::Tiled => sunbeam_optics::truth::tiled_coherent_area_m2(m.sigma_f_per_m),
+    }
+}
+
+/// The weight sets of the extended-light maps at `n` midpoint wavelengths:
+/// `A / l^2 B_k(l) cmf(l) / sum_l D65(l) ybar(l)` for the three basis spectra,
+/// then the sun's spectrum times its disc's solid angle when the sun is up. The normalisation is the same
+/// discrete sum as the point map's, so `B = D65` integrates to `Y = 1` exactly
+/// (Parseval) over the same samples.
+pub fn env_weights(pack: &Pack, env: &Environment, n: usize) -> build::WeightSets {
+    let a = coherent_area_m2(pack);
+    let lw = build::wavelength_weights(n);
+    let lambdas: Vec<f64> = lw.iter().map(|l| l.0).collect();
+    let norm: f64 = lambdas
+        .iter()
+        .map(|&l| cie::d65_at(l) * cie::cmf_at(l)[1])
+        .sum();
+    let weight = |l: f64, b: f64| {
+        let f = a / (l * l) * b / norm;
+        cie::cmf_at(l).map(|c| c * f)
+    };
+    let mut sets: Vec<Vec<[f64; 3]>> = (0..3)
+        .map(|k| {
+            lambdas
+                .iter()
+                .map(|&l| weight(l, env.basis_at(l)[k]))
+                .collect()
+        })
+        .collect();
+    if let Some(sky) = env.sun() {
+        sets.push(
+            lambdas
+                .iter()
+                .map(|&l| weight(l, sky.sun_solid_angle() * sky.sun_spectral(l)))
+                .collect(),
+        );
+    }
+    build::WeightSets { lambdas, sets }
 }
 
 impl EnvResponse {
@@ -59,7 +163,45 @@ impl EnvResponse {
     /// expectation is the reference's (`sunbeam_raster::environment`) specular
     /// part for the same pack and environment.
     pub fn sample(&self, env: &Environment, frame: Frame, wr_l: [f64; 3], u: [f64; 5]) -> [f64; 3] {
-        let _ = (env, frame, wr_l, u);
-        unimplemented!("EnvResponse::sample: step 5")
+        let (t, b, n) = frame;
+        let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
+        let mut xyz = [0.0; 3];
+        if !(wr_l[2] > 0.0) {
+            return xyz;
+        }
+        // The sky and the map (everything but the sun): one proposal sample.
+        if let Some((uv, pdf)) = self.proposal.sample(wr_l, [u[0], u[1], u[2]]) {
+            let (wx, wy) = (-uv[0] - wr_l[0], -uv[1] - wr_l[1]);
+            let r2 = wx * wx + wy * wy;
+            if r2 < 1.0 && pdf > 0.0 {
+                let wi = [wx, wy, (1.0 - r2).sqrt()];
+                let w = -(wi[2] + wr_l[2]);
+                let c = env.coefficients(world(wi));
+                let f = gain::g(wi, wr_l, gain::DEFAULT_IOR) / (wi[2] * pdf);
+                for (ck, ek) in c.iter().zip(&self.basis) {
+                    let e = ek.lookup(uv[0], uv[1], w);
+                    for a in 0..3 {
+                        xyz[a] += f * ck * e[a];
+                    }
+                }
+            }
+        }
+        // The sun: a point of its disc; d(u, v) = cos(theta_i) dw cancels 1 / cos.
+        if let (Some(sky), Some(e_sun)) = (env.sun(), &self.sun) {
+            if let Some((d, _)) = sky.sample_sun(u[3], u[4]) {
+                let dot = |a: [f64; 3]| a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
+                let wi = [dot(t), dot(b), dot(n)];
+                if wi[2] > 0.0 {
+                    let (uu, vv, w) = (-wi[0] - wr_l[0], -wi[1] - wr_l[1], -wi[2] - wr_l[2]);
+                    // The map holds Omega_sun E_sun.
+                    let f = gain::g(wi, wr_l, gain::DEFAULT_IOR);
+                    let e = e_sun.lookup(uu, vv, w);
+                    for a in 0..3 {
+                        xyz[a] += f * e[a];
+                    }
+                }
+            }
+        }
+        colour::xyz_to_linear_srgb(xyz)
     }
 }

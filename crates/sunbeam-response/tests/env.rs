@@ -1,0 +1,261 @@
+//! The extended-light maps, the proposal and the CPU twin of the player's
+//! estimator (docs/PACK_FORMAT.md "Extended-light maps"), each against a truth
+//! the code under test does not produce: Parseval's theorem (the BRDF of a lobe
+//! inside the disc integrates to the light's luminance), quadrature of the
+//! proposal's density and a histogram of its samples, and the reference
+//! renderer's Monte Carlo estimator (`sunbeam_raster::environment::EnvShader`,
+//! the pack's own `R`, no map) at one shading point.
+
+use std::f64::consts::PI;
+use std::sync::{Arc, OnceLock};
+use sunbeam_common::rng::SplitMix64;
+use sunbeam_light::{daylight, sky::Sky, EnvMap, Environment};
+use sunbeam_optics::colour;
+use sunbeam_pack::build::{BuildOptions, FieldRef};
+use sunbeam_pack::{Model, Pack};
+use sunbeam_raster::environment::{EnvShader, Uniforms};
+use sunbeam_response::env::{build_env, EnvResponse, Frame};
+use sunbeam_response::{Options, Proposal, Response};
+
+/// Sinusoidal ridges of `period` along x, `amp` peak to peak, on an `n x n`
+/// grid of `dx` (as the reference's tests build them).
+fn ridges(n: usize, dx: f64, period: f64, amp: f64) -> Vec<f64> {
+    (0..n * n)
+        .map(|k| {
+            let (i, j) = ((k % n) as f64, (k / n) as f64);
+            0.5 * amp * (1.0 + (2.0 * PI * (i * dx) / period + 0.3 * (0.7 * j).sin()).sin())
+        })
+        .collect()
+}
+
+fn pack_of(n: usize, dx: f64, data: &[f64]) -> Arc<Pack> {
+    let f = FieldRef {
+        width: n,
+        height: n,
+        dx,
+        dy: dx,
+        data,
+    };
+    Arc::new(sunbeam_pack::build(f, &BuildOptions::default(), &mut |_, _| {}).unwrap())
+}
+
+/// The 3.2 um, 1.3 um period ridge patch of docs/LIGHTING.md "Noise".
+fn ridge_pack() -> Arc<Pack> {
+    static P: OnceLock<Arc<Pack>> = OnceLock::new();
+    P.get_or_init(|| pack_of(32, 0.1e-6, &ridges(32, 0.1e-6, 1.3e-6, 0.3e-6)))
+        .clone()
+}
+
+fn sky() -> Environment {
+    Environment::Sky(Box::new(Sky::new(40.0, 30.0, 3.0, 1.0)))
+}
+
+fn white() -> Environment {
+    Environment::Map(EnvMap::constant([1.0; 3]))
+}
+
+/// `int E_Y d(u, v)` of `maps` summed, at constant `w`, by a midpoint rule
+/// over a fine polar grid (4 x 4 points per texel cell, `r dr dtheta`).
+fn integral_y(maps: &[&Response], w: f64) -> f64 {
+    let g = maps[0].info.grid;
+    let (na, nr) = (4 * g.n_theta, 4 * (g.n_rho - 1));
+    let mut sum = 0.0;
+    for jr in 0..nr {
+        let j = jr / 4;
+        let (a, b) = (g.r_at(j), g.r_at(j + 1));
+        let f = (jr % 4) as f64;
+        let (r_lo, r_hi) = (a + (b - a) * f / 4.0, a + (b - a) * (f + 1.0) / 4.0);
+        let r = 0.5 * (r_lo + r_hi);
+        let dr = r_hi - r_lo;
+        for ia in 0..na {
+            let th = 2.0 * PI * (ia as f64 + 0.5) / na as f64;
+            let y: f64 = maps
+                .iter()
+                .map(|m| m.lookup(r * th.cos(), r * th.sin(), w)[1])
+                .sum();
+            sum += y * r * dr * 2.0 * PI / na as f64;
+        }
+    }
+    sum
+}
+
+/// Parseval: for a lobe inside the disc, `int E_Y d(u, v)` is the Y of the
+/// basis spectrum (the BRDF `G R A / l^2` integrates to 1 over `d^2 f`):
+/// 1 for D65 (the sum of a map's three bases), and the Y of S0, S1, S2 from
+/// the daylight table (1 nm sums, not the map's 96 samples) for the sky; for a
+/// flat patch and a shallow ridge patch (orders within `r < 1.6`, where the
+/// slice `w = -1.2` is not clamped in `s`).
+#[test]
+fn parseval_the_maps_integrate_to_the_light() {
+    let flat = pack_of(32, 0.2e-6, &[0.0; 32 * 32]);
+    let ridge = pack_of(48, 0.125e-6, &ridges(48, 0.125e-6, 2.0e-6, 0.1e-6));
+    let want_sky = daylight::basis_xyz().map(|b| b[1]);
+    for (name, pack) in [("flat", flat), ("ridge", ridge)] {
+        let o = Options::default();
+        let e = build_env(&pack, &white(), &o);
+        assert!(e.sun.is_none());
+        let d65 = integral_y(&e.basis.iter().collect::<Vec<_>>(), -1.2);
+        eprintln!("{name}: D65 {d65:.5}");
+        assert!((d65 - 1.0).abs() < 0.01, "{name}: {d65}");
+        let e = build_env(&pack, &sky(), &o);
+        assert!(e.sun.is_some());
+        for k in 0..3 {
+            let y = integral_y(&[&e.basis[k]], -1.2);
+            eprintln!("{name}: S{k} {y:.5} vs {:.5}", want_sky[k]);
+            assert!(
+                (y - want_sky[k]).abs() < 0.01 * want_sky[0],
+                "{name} S{k}: {y} vs {}",
+                want_sky[k]
+            );
+        }
+    }
+}
+
+fn ridge_env(env: &Environment) -> EnvResponse {
+    let e = build_env(&ridge_pack(), env, &Options::default());
+    for m in e.basis.iter().chain(&e.sun) {
+        m.validate().unwrap();
+    }
+    e
+}
+
+fn unit(v: [f64; 3]) -> [f64; 3] {
+    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    v.map(|x| x / l)
+}
+
+/// The proposal's density integrates to 1 over the disc `|(u, v)| < 2`
+/// (midpoint rule on a polar grid not aligned with the cells), a histogram of
+/// its samples over 64 coarse bins matches the same quadrature per bin
+/// (chi-square within 5 sigma of its mean), and `sample`'s density equals
+/// `pdf` at the sample.
+#[test]
+fn proposal_is_a_density_and_samples_follow_it() {
+    let e = ridge_env(&sky());
+    let p: &Proposal = &e.proposal;
+    let wr = unit([-0.3, 0.2, 0.9]);
+    let redges = [0.0, 0.05, 0.1, 0.2, 0.4, 0.7, 1.0, 1.4, 2.0];
+    let bin = |uv: [f64; 2]| {
+        let r = uv[0].hypot(uv[1]);
+        let rb = redges.iter().rposition(|&e| r >= e)?;
+        if rb >= 8 {
+            return None;
+        }
+        let th = uv[1].atan2(uv[0]).rem_euclid(2.0 * PI);
+        Some(rb * 8 + ((th / (2.0 * PI) * 8.0) as usize).min(7))
+    };
+    let (na, nr) = (1000, 1400);
+    let mut expect = [0.0f64; 64];
+    let mut total = 0.0;
+    for jr in 0..nr {
+        let r = 2.0 * (jr as f64 + 0.5) / nr as f64;
+        let dr = 2.0 / nr as f64;
+        for ia in 0..na {
+            let th = 2.0 * PI * (ia as f64 + 0.3) / na as f64;
+            let uv = [r * th.cos(), r * th.sin()];
+            let d = p.pdf(wr, uv) * r * dr * 2.0 * PI / na as f64;
+            total += d;
+            if let Some(b) = bin(uv) {
+                expect[b] += d;
+            }
+        }
+    }
+    eprintln!("integral of pdf: {total:.5}");
+    assert!((total - 1.0).abs() < 0.01, "{total}");
+    let n = 200_000;
+    let mut hist = [0.0f64; 64];
+    let mut rng = SplitMix64::new(3);
+    for _ in 0..n {
+        let (uv, pdf) = p.sample(wr, [rng.unit(), rng.unit(), rng.unit()]).unwrap();
+        let again = p.pdf(wr, uv);
+        assert!(
+            (pdf - again).abs() <= 1e-9 * pdf,
+            "{pdf} vs {again} at {uv:?}"
+        );
+        hist[bin(uv).unwrap()] += 1.0;
+    }
+    let (mut chi2, mut dof) = (0.0, 0);
+    for b in 0..64 {
+        let ex = expect[b] / total * n as f64;
+        if ex > 20.0 {
+            chi2 += (hist[b] - ex).powi(2) / ex;
+            dof += 1;
+        }
+    }
+    eprintln!("chi2 {chi2:.1} over {dof} bins");
+    assert!(dof > 30);
+    assert!(
+        chi2 < dof as f64 + 5.0 * (2.0 * dof as f64).sqrt(),
+        "{chi2} / {dof}"
+    );
+}
+
+/// Frame with the normal up (+y), so the sky lights the patch.
+const FRAME: Frame = ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]);
+
+fn world(d: [f64; 3]) -> [f64; 3] {
+    let (t, b, n) = FRAME;
+    [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k])
+}
+
+/// Mean XYZ and the per-sample relative standard deviation of Y of the twin.
+fn twin(e: &EnvResponse, env: &Environment, wr: [f64; 3], n: usize) -> ([f64; 3], f64) {
+    let mut rng = SplitMix64::new(17);
+    let (mut sum, mut sy2) = ([0.0; 3], 0.0);
+    for _ in 0..n {
+        let u = [0; 5].map(|_| rng.unit());
+        let xyz = colour::linear_srgb_to_xyz(e.sample(env, FRAME, wr, u));
+        for c in 0..3 {
+            sum[c] += xyz[c];
+        }
+        sy2 += xyz[1] * xyz[1];
+    }
+    let mean = sum.map(|v| v / n as f64);
+    let var = sy2 / n as f64 - mean[1] * mean[1];
+    (mean, var.max(0.0).sqrt() / mean[1])
+}
+
+/// The reference's mean XYZ (no diffuse part), wavelengths stratified.
+fn reference(env: &Environment, wr: [f64; 3], n: u64) -> [f64; 3] {
+    let es = EnvShader::new(Arc::new(env.clone()), &[Some(ridge_pack())]);
+    let wr_w = world(wr);
+    let mut mc = [0.0; 3];
+    for k in 0..n {
+        let mut rng = EnvShader::rng(5, 0, k);
+        let lu = (k as f64 + rng.unit()) / n as f64;
+        let u = Uniforms {
+            lambda: lu,
+            ..Uniforms::random(&mut rng)
+        };
+        let xyz = colour::linear_srgb_to_xyz(es.sample(0, FRAME, wr_w, [0.0; 3], 0.0, &u));
+        for i in 0..3 {
+            mc[i] += xyz[i] / n as f64;
+        }
+    }
+    mc
+}
+
+/// The twin's expectation is the reference's: under the sky (with its sun)
+/// and a constant white map, at two views of the ridge patch, Y within 2 %
+/// and chromaticity within 0.005.
+#[test]
+fn twin_agrees_with_the_reference() {
+    for (name, env) in [("sky", sky()), ("white", white())] {
+        let e = ridge_env(&env);
+        for wr in [unit([0.0, 0.0, 1.0]), unit([-0.2, 0.3, 0.8])] {
+            let (t, rel) = twin(&e, &env, wr, 400_000);
+            let r = reference(&env, wr, 200_000);
+            let xy = |v: [f64; 3]| {
+                let s = v[0] + v[1] + v[2];
+                [v[0] / s, v[1] / s]
+            };
+            let (a, b) = (xy(t), xy(r));
+            eprintln!(
+                "{name} wr {wr:.3?}: twin Y {:.5} xy {a:.4?} (per-sample rel std {rel:.2}), reference Y {:.5} xy {b:.4?}, ratio {:.4}",
+                t[1], r[1], t[1] / r[1]
+            );
+            assert!((t[1] / r[1] - 1.0).abs() < 0.02, "{name}: {t:?} vs {r:?}");
+            assert!((a[0] - b[0]).abs() < 0.005 && (a[1] - b[1]).abs() < 0.005);
+        }
+    }
+}
