@@ -15,7 +15,8 @@
 // averaged over the pixel's footprint; or, without a map, from the Cartesian
 // response table (crates/sunbeam-render/src/table.rs, `--mode table`); 3 = direct (the sum above per fragment);
 // 1 = thesis (fixed term count, 5 nm samples, nearest texel, no interpolation);
-// 2 = Lambert (base colour only).
+// 2 = Lambert (base colour only). Under a scene environment the default mode
+// adds shaders/environment.wgsl's estimate (group 2).
 
 const MAX_TERMS: u32 = 64u;
 const MAX_TAPS: u32 = 16u;
@@ -502,6 +503,11 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
             diff = xyz_to_rgb(xyz);
         }
         rgb = rgb + g.lights[i].w * (dw * base * cos_i + (1.0 - dw) * diff);
+    }
+    // The scene's environment (shaders/environment.wgsl): one Monte Carlo
+    // estimate per frame, accumulated by the caller.
+    if (envg.on == 1u) {
+        rgb = rgb + env_shade(t, b, n, wr_l, base, dw, diffract, vec2<u32>(in.clip.xy));
     }
     return display(rgb);
 }

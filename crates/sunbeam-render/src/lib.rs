@@ -13,6 +13,8 @@
 //! # let _ = image;
 //! ```
 
+pub mod accum;
+pub mod env;
 pub mod export;
 pub mod gpu;
 pub mod renderer;
@@ -100,7 +102,8 @@ impl FrameTimes {
 }
 
 /// Time `frames` offscreen frames (the first is reported apart) and return the
-/// last image in linear light.
+/// last image in linear light (environment scenes: one frame of samples, the
+/// sum reset before each frame, as while the camera moves).
 pub fn bench_headless(
     gpu: &Gpu,
     p: &Prepared,
@@ -115,8 +118,14 @@ pub fn bench_headless(
     gpu.wait()?;
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
     let mut times = Vec::new();
+    for n in &r.notes {
+        log::info!("{n}");
+    }
     for _ in 0..frames.max(1) {
         let t = Instant::now();
+        // Progressive (environment) frames as while moving: every frame starts
+        // the sum again, so each one costs what an interactive frame does.
+        target.reset();
         target.draw(gpu, &r, &state)?;
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }

@@ -14,10 +14,12 @@ use wgpu::util::DeviceExt;
 
 /// The WGSL source: the response-map material (shaders/response_map.wgsl, also
 /// what `--export-shader` translates) and the player's shading
-/// (shaders/diffraction.wgsl).
+/// (shaders/diffraction.wgsl), and the environment's estimator
+/// (shaders/environment.wgsl).
 pub const SHADER: &str = concat!(
     include_str!("../../../shaders/response_map.wgsl"),
-    include_str!("../../../shaders/diffraction.wgsl")
+    include_str!("../../../shaders/diffraction.wgsl"),
+    include_str!("../../../shaders/environment.wgsl")
 );
 
 /// Most lights a frame shades with.
@@ -84,6 +86,8 @@ pub struct Settings {
     /// Default mode: average the response over the pixel's footprint (up to 4 x 4
     /// samples) instead of reading it at the pixel centre.
     pub footprint: bool,
+    /// Environment: proposal samples per pixel per frame (crate::env).
+    pub env_samples: u32,
 }
 
 /// Default wavelength sample count (docs/PLAY.md: chosen by measurement).
@@ -100,6 +104,7 @@ impl Default for Settings {
             response: Default::default(),
             msaa: 4,
             footprint: true,
+            env_samples: crate::env::DEFAULT_ENV_SAMPLES,
         }
     }
 }
@@ -197,6 +202,8 @@ struct GpuMesh {
     ibuf: wgpu::Buffer,
     count: u32,
     bind: wgpu::BindGroup,
+    /// Bind group 2: the environment (this mesh's pack's maps, or stand-ins).
+    env_bind: wgpu::BindGroup,
 }
 
 /// Smallest term count whose truncation bound stays below `tol` for every |t| up to `t`.
@@ -230,10 +237,13 @@ pub struct Renderer {
     meshes: Vec<GpuMesh>,
     settings: Settings,
     n_lambda: u32,
+    env: crate::env::EnvScene,
     /// Colour target format the pipeline writes.
     pub format: wgpu::TextureFormat,
     /// Notes for the user (packs cut to MAX_TERMS, ...).
     pub warnings: Vec<String>,
+    /// What start-up did that took time (environment maps built, ...).
+    pub notes: Vec<String>,
 }
 
 /// Depth format of every pass.
@@ -267,6 +277,24 @@ impl Renderer {
             mapped_at_creation: false,
         });
         let [gl0, gl1] = bind_group_layouts(device);
+        // The environment (docs/PLAY.md "Environment"): the default mode shades
+        // it progressively; the Lambert baseline ignores it.
+        let environment = match settings.mode {
+            Mode::Default => p.environment.clone(),
+            Mode::Lambert => None,
+            m => {
+                if p.environment.is_some() {
+                    return Err(Error::usage(format!(
+                        "environment: the player shades sky and map lighting in the default mode only (not --mode {})",
+                        format!("{m:?}").to_lowercase()
+                    )));
+                }
+                None
+            }
+        };
+        let env_scene = crate::env::EnvScene::new(gpu, environment.clone(), settings.env_samples);
+        let mut notes = Vec::new();
+        let mut env_maps: Vec<(*const Pack, Arc<crate::env::EnvMaps>)> = Vec::new();
         // Response maps: angle repeats, radius and s clamp, trilinear.
         let resp_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("response map"),
@@ -492,15 +520,54 @@ impl Renderer {
                     },
                 ],
             });
+            let maps = match (&environment, &mat.pack) {
+                (Some(env), Some(pack)) => {
+                    let key = Arc::as_ptr(pack);
+                    match env_maps.iter().find(|(k, _)| *k == key) {
+                        Some((_, m)) => Some(m.clone()),
+                        None => {
+                            if !pack.has_terms() {
+                                return Err(Error::internal(format!(
+                                    "meshes[{mi}].pack: the environment's maps need the pack's terms (read it whole)"
+                                )));
+                            }
+                            let t0 = std::time::Instant::now();
+                            let er =
+                                sunbeam_response::env::build_env(pack, env, &settings.response);
+                            notes.push(format!(
+                                "built the environment's response maps for meshes[{mi}].pack ({} x {} x {} texels, {} maps, \
+                                 {} pyramid levels) in {:.2} s",
+                                er.grid.n_theta,
+                                er.grid.n_rho,
+                                er.grid.n_s,
+                                er.basis.len() + usize::from(er.sun.is_some()),
+                                er.proposal.offsets.len(),
+                                t0.elapsed().as_secs_f64()
+                            ));
+                            let m = Arc::new(crate::env::EnvMaps::new(gpu, &er)?);
+                            env_maps.push((key, m.clone()));
+                            Some(m)
+                        }
+                    }
+                }
+                _ => None,
+            };
+            let env_bind = env_scene.bind(gpu, maps.as_deref());
             meshes.push(GpuMesh {
                 vbuf,
                 ibuf,
                 count: mesh.indices.len() as u32,
                 bind,
+                env_bind,
             });
         }
 
-        let pipeline = render_pipeline(device, [&gl0, &gl1], format, settings.msaa)?;
+        let pipeline = render_pipeline(
+            device,
+            [&gl0, &gl1, &env_scene.layout],
+            format,
+            settings.msaa,
+        )?;
         Ok(Renderer {
             pipeline,
             globals,
@@ -508,9 +575,24 @@ impl Renderer {
             meshes,
             settings: settings.clone(),
             n_lambda: spec.len() as u32,
+            env: env_scene,
             format,
             warnings,
+            notes,
         })
+    }
+
+    /// True when frames are Monte Carlo estimates to accumulate (a scene
+    /// environment in the default mode): see crate::accum.
+    pub fn progressive(&self) -> bool {
+        self.env.env.is_some()
+    }
+
+    /// Set the frame index that seeds the next frame's random numbers.
+    pub fn set_frame(&self, gpu: &Gpu, frame: u32) {
+        if self.progressive() {
+            self.env.set_frame(gpu, frame);
+        }
     }
 
     /// Upload the per-frame uniforms for a `w x h` target.
@@ -649,6 +731,7 @@ impl Renderer {
                 continue;
             }
             rp.set_bind_group(1, &m.bind, &[]);
+            rp.set_bind_group(2, &m.env_bind, &[]);
             rp.set_vertex_buffer(0, m.vbuf.slice(..));
             rp.set_index_buffer(m.ibuf.slice(..), wgpu::IndexFormat::Uint32);
             rp.draw_indexed(0..m.count, 0, 0..1);
@@ -825,7 +908,7 @@ fn mesh_buffers(
 /// The pipeline of shaders/diffraction.wgsl for a colour format and sample count.
 fn render_pipeline(
     device: &wgpu::Device,
-    layouts: [&wgpu::BindGroupLayout; 2],
+    layouts: [&wgpu::BindGroupLayout; 3],
     format: wgpu::TextureFormat,
     msaa: u32,
 ) -> Result<wgpu::RenderPipeline> {
@@ -836,7 +919,7 @@ fn render_pipeline(
     });
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("diffraction"),
-        bind_group_layouts: &[Some(layouts[0]), Some(layouts[1])],
+        bind_group_layouts: &[Some(layouts[0]), Some(layouts[1]), Some(layouts[2])],
         immediate_size: 0,
     });
     let vlayout = wgpu::VertexBufferLayout {
@@ -891,7 +974,7 @@ fn render_pipeline(
 }
 
 /// A 3D RGBA16F texture holding a response map.
-fn response_texture(gpu: &Gpu, r: &sunbeam_response::Response) -> wgpu::TextureView {
+pub(crate) fn response_texture(gpu: &Gpu, r: &sunbeam_response::Response) -> wgpu::TextureView {
     let g = r.info.grid;
     texture_3d(
         gpu,
@@ -900,7 +983,7 @@ fn response_texture(gpu: &Gpu, r: &sunbeam_response::Response) -> wgpu::TextureV
     )
 }
 
-fn texture_3d(gpu: &Gpu, size: [u32; 3], data: &[u16]) -> wgpu::TextureView {
+pub(crate) fn texture_3d(gpu: &Gpu, size: [u32; 3], data: &[u16]) -> wgpu::TextureView {
     gpu.device
         .create_texture_with_data(
             &gpu.queue,
@@ -993,6 +1076,8 @@ pub struct Offscreen {
     depth: wgpu::TextureView,
     readback: wgpu::Buffer,
     padded_row: u32,
+    /// The running sum of a progressive renderer (environment scenes).
+    acc: Option<crate::accum::Accumulator>,
 }
 
 /// Colour format of offscreen frames (linear values; MSAA-resolvable everywhere).
@@ -1018,10 +1103,19 @@ impl Offscreen {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: OFFSCREEN_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
         let view = tex.create_view(&Default::default());
+        let acc = if r.progressive() {
+            Some(crate::accum::Accumulator::new(
+                gpu, &view, width, height, true,
+            )?)
+        } else {
+            None
+        };
         let ms = r.msaa();
         let msaa = (ms > 1).then(|| colour_view(gpu, width, height, OFFSCREEN_FORMAT, ms));
         let padded_row = (width * 8).div_ceil(256) * 256;
@@ -1040,7 +1134,20 @@ impl Offscreen {
             depth: depth_view_ms(gpu, width, height, ms),
             readback,
             padded_row,
+            acc,
         })
+    }
+
+    /// Frames in the progressive sum (0 for a renderer that does not accumulate).
+    pub fn frames(&self) -> u32 {
+        self.acc.as_ref().map_or(0, |a| a.count())
+    }
+
+    /// Start the progressive sum again (camera, light or exposure changed).
+    pub fn reset(&self) {
+        if let Some(a) = &self.acc {
+            a.reset();
+        }
     }
 
     fn record(&self, enc: &mut wgpu::CommandEncoder, r: &Renderer, state: &FrameState) {
@@ -1050,11 +1157,35 @@ impl Offscreen {
         }
     }
 
-    /// Render one frame and wait for it (no readback).
-    pub fn draw(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<()> {
+    /// The progressive sum (environment scenes), for the window's resolve pass.
+    pub fn accumulator(&self) -> Option<&crate::accum::Accumulator> {
+        self.acc.as_ref()
+    }
+
+    /// Record one frame (and, for a progressive renderer, adding it to the sum:
+    /// the frame index is set from the count). The caller submits.
+    pub fn encode_frame(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        r: &Renderer,
+        state: &FrameState,
+    ) {
         r.update(gpu, state, self.width, self.height);
+        if let Some(a) = &self.acc {
+            r.set_frame(gpu, a.count());
+        }
+        self.record(enc, r, state);
+        if let Some(a) = &self.acc {
+            a.add(gpu, enc);
+        }
+    }
+
+    /// Render one frame and wait for it (no readback); a progressive renderer
+    /// adds it to the running sum.
+    pub fn draw(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<()> {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        self.record(&mut enc, r, state);
+        self.encode_frame(gpu, &mut enc, r, state);
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
         gpu.take_errors()
@@ -1065,13 +1196,19 @@ impl Offscreen {
         Ok(self.render_linear(gpu, r, state)?.display(r.curve()))
     }
 
-    /// Render one frame and read it back in linear light (exposure applied).
+    /// Render one frame and read it back in linear light (exposure applied); a
+    /// progressive renderer adds it to the running sum and returns the mean of
+    /// the frames since the last reset (the settled frame).
     pub fn render_linear(
         &self,
         gpu: &Gpu,
         r: &Renderer,
         state: &FrameState,
     ) -> Result<LinearImage> {
+        if let Some(a) = &self.acc {
+            self.draw(gpu, r, state)?;
+            return a.read(gpu);
+        }
         r.update(gpu, state, self.width, self.height);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         self.record(&mut enc, r, state);
@@ -1133,8 +1270,8 @@ mod layout_tests {
     use super::{Globals, MaterialU, SHADER};
     use std::mem::{offset_of, size_of};
 
-    fn wgsl_struct(name: &str) -> (u32, Vec<(String, u32)>) {
-        let module = naga::front::wgsl::parse_str(SHADER).expect("the shader parses");
+    fn wgsl_struct(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+        let module = naga::front::wgsl::parse_str(src).expect("the shader parses");
         for (_, ty) in module.types.iter() {
             if ty.name.as_deref() == Some(name) {
                 if let naga::TypeInner::Struct { members, span } = &ty.inner {
@@ -1152,7 +1289,11 @@ mod layout_tests {
     }
 
     fn check(name: &str, size: usize, rust: &[(&str, usize)]) {
-        let (span, members) = wgsl_struct(name);
+        check_in(SHADER, name, size, rust)
+    }
+
+    fn check_in(src: &str, name: &str, size: usize, rust: &[(&str, usize)]) {
+        let (span, members) = wgsl_struct(src, name);
         assert_eq!(span as usize, size, "{name}: WGSL size vs Rust size");
         let mut matched = 0;
         for (field, off) in rust {
@@ -1241,6 +1382,44 @@ mod layout_tests {
                 resp_rho_scale,
                 resp_footprint
             ),
+        );
+    }
+
+    #[test]
+    fn environment_uniforms_match_the_wgsl() {
+        use crate::env::{EnvGlobals, EnvProposalU};
+        macro_rules! f {
+            ($t:ty; $($n:ident),*) => { [$((stringify!($n), offset_of!($t, $n))),*] };
+        }
+        check(
+            "EnvGlobals",
+            size_of::<EnvGlobals>(),
+            &f!(EnvGlobals; basis_to_rgb, sun_dir, sun_rgb, sun_t, sun_b, table_w, table_h, frame, on, has_sun, samples),
+        );
+        check(
+            "EnvProposal",
+            size_of::<EnvProposalU>(),
+            &f!(EnvProposalU; offsets, pw, ph, top, n_s, n_theta, n_rho, n_s_f, r0, rho_scale, on, has_sun),
+        );
+    }
+
+    #[test]
+    fn accumulation_uniforms_match_the_wgsl() {
+        use crate::accum::{AccU, ResolveU, ACCUMULATE_WGSL, RESOLVE_WGSL};
+        macro_rules! f {
+            ($t:ty; $($n:ident),*) => { [$((stringify!($n), offset_of!($t, $n))),*] };
+        }
+        check_in(
+            ACCUMULATE_WGSL,
+            "AccU",
+            size_of::<AccU>(),
+            &f!(AccU; width, height, count),
+        );
+        check_in(
+            RESOLVE_WGSL,
+            "ResolveU",
+            size_of::<ResolveU>(),
+            &f!(ResolveU; width, inv_n, curve, output),
         );
     }
 }

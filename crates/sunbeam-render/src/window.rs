@@ -9,8 +9,11 @@
 //! optionally writes the last swapchain image (`--screenshot`), keeps the window up
 //! for `--hold-secs`, then exits (the Xvfb test uses this).
 
+use crate::accum::Resolve;
 use crate::gpu::{Backend, Gpu, INSTALL_HINT};
-use crate::renderer::{colour_view, depth_view_ms, FrameState, Renderer, Settings};
+use crate::renderer::{
+    colour_view, depth_view_ms, FrameState, Mode, Offscreen, Renderer, Settings, OFFSCREEN_FORMAT,
+};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -79,6 +82,11 @@ struct Gfx {
     /// The multisampled colour target (MSAA), resolved into the surface.
     msaa: Option<wgpu::TextureView>,
     can_copy: bool,
+    /// Environment scenes: the float frame target with its running sum, and the
+    /// pass that resolves the mean onto the surface (crate::accum).
+    progressive: Option<(Offscreen, Resolve)>,
+    /// What the running sum was drawn with (a change resets it).
+    drawn: Option<(FrameState, u32, u32)>,
 }
 
 struct App {
@@ -159,10 +167,30 @@ impl App {
             config.usage |= wgpu::TextureUsages::COPY_SRC;
         }
         surface.configure(&gpu.device, &config);
-        let renderer = Renderer::new(&gpu, &self.prepared, &self.opts.settings, config.format)?;
+        // Environment scenes draw Monte Carlo frames into a float target and
+        // accumulate them; the surface gets the resolved mean.
+        let progressive =
+            self.prepared.environment.is_some() && self.opts.settings.mode == Mode::Default;
+        let format = if progressive {
+            OFFSCREEN_FORMAT
+        } else {
+            config.format
+        };
+        let renderer = Renderer::new(&gpu, &self.prepared, &self.opts.settings, format)?;
         for w in &renderer.warnings {
             eprintln!("sunbeam-play: warning: {w}");
         }
+        for n in &renderer.notes {
+            eprintln!("sunbeam-play: {n}");
+        }
+        let progressive = if renderer.progressive() {
+            Some((
+                Offscreen::new(&gpu, &renderer, config.width, config.height)?,
+                Resolve::new(&gpu, config.format)?,
+            ))
+        } else {
+            None
+        };
         eprintln!(
             "sunbeam-play: {} | surface {:?} {}x{}",
             gpu.describe(),
@@ -184,6 +212,8 @@ impl App {
             depth,
             msaa,
             can_copy,
+            progressive,
+            drawn: None,
         });
         Ok(())
     }
@@ -204,16 +234,36 @@ impl App {
         };
         let view = frame.texture.create_view(&Default::default());
         self.state.camera.eye = self.orbit.eye();
-        g.renderer
-            .update(&g.gpu, &self.state, g.config.width, g.config.height);
         let mut enc = g.gpu.device.create_command_encoder(&Default::default());
-        match &g.msaa {
-            Some(ms) => g
-                .renderer
-                .encode(&mut enc, ms, Some(&view), &g.depth, &self.state),
-            None => g
-                .renderer
-                .encode(&mut enc, &view, None, &g.depth, &self.state),
+        if let Some((off, resolve)) = &g.progressive {
+            // Any change of camera, light, exposure or size starts the sum again.
+            let now = (self.state.clone(), g.config.width, g.config.height);
+            if g.drawn.as_ref() != Some(&now) {
+                off.reset();
+                g.drawn = Some(now);
+            }
+            off.encode_frame(&g.gpu, &mut enc, &g.renderer, &self.state);
+            if let Some(acc) = off.accumulator() {
+                resolve.encode(
+                    &g.gpu,
+                    &mut enc,
+                    acc,
+                    &view,
+                    g.config.format,
+                    g.renderer.curve(),
+                );
+            }
+        } else {
+            g.renderer
+                .update(&g.gpu, &self.state, g.config.width, g.config.height);
+            match &g.msaa {
+                Some(ms) => g
+                    .renderer
+                    .encode(&mut enc, ms, Some(&view), &g.depth, &self.state),
+                None => g
+                    .renderer
+                    .encode(&mut enc, &view, None, &g.depth, &self.state),
+            }
         }
         let counted = self.opts.frames.is_some_and(|n| self.frame + 1 == n);
         let shot = if counted && g.can_copy {
@@ -283,8 +333,12 @@ impl App {
         self.frame += 1;
         if self.last_title.elapsed() > Duration::from_millis(500) || self.frame == 1 {
             let ms = self.times.last().copied().unwrap_or(0.0);
+            let acc = match &g.progressive {
+                Some((off, _)) => format!(" - {} frames accumulated", off.frames()),
+                None => String::new(),
+            };
             g.window.set_title(&format!(
-                "{} - {:.1} ms/frame ({:.0} fps) - EV {:+.2}",
+                "{} - {:.1} ms/frame ({:.0} fps) - EV {:+.2}{acc}",
                 self.opts.title,
                 ms,
                 1e3 / ms.max(1e-3),
@@ -339,6 +393,16 @@ impl ApplicationHandler for App {
                     g.depth = depth_view_ms(&g.gpu, sz.width, sz.height, ms);
                     g.msaa = (ms > 1)
                         .then(|| colour_view(&g.gpu, sz.width, sz.height, g.config.format, ms));
+                    if let Some((off, _)) = &mut g.progressive {
+                        match Offscreen::new(&g.gpu, &g.renderer, sz.width, sz.height) {
+                            Ok(o) => *off = o,
+                            Err(e) => {
+                                self.fail(el, e);
+                                return;
+                            }
+                        }
+                        g.drawn = None;
+                    }
                     g.window.request_redraw();
                 }
             }

@@ -37,7 +37,8 @@ pub(crate) struct Cli {
     /// Frame size WxH (headless: default the scene's size; window: initial size).
     #[arg(long, value_name = "WxH", value_parser = sunbeam_common::units::parse_size)]
     pub(crate) size: Option<(usize, usize)>,
-    /// Headless: frames rendered (the last one is written). Window: exit after N frames.
+    /// Headless: frames rendered (the last one is written; environment scenes: the
+    /// average of the N frames). Window: exit after N frames.
     #[arg(long)]
     pub(crate) frames: Option<u32>,
     /// Window: seconds to keep showing after --frames.
@@ -56,6 +57,10 @@ pub(crate) struct Cli {
     /// Same as --mode lambert.
     #[arg(long)]
     pub(crate) lambert: bool,
+    /// Environment scenes: proposal samples of the diffraction lobes per pixel per
+    /// frame (the sun and the diffuse part take one each).
+    #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_SAMPLES)]
+    pub(crate) env_samples: u32,
     /// Wavelength samples of the default mode.
     #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES)]
     pub(crate) lambda_samples: usize,

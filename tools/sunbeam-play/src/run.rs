@@ -72,7 +72,11 @@ fn settings(cli: &Cli) -> Result<Settings> {
     if !(1..=4).contains(&cli.supersample) {
         return Err(Error::usage("--supersample must be 1..4"));
     }
+    if cli.env_samples == 0 || cli.env_samples > 64 {
+        return Err(Error::usage("--env-samples must be 1..64"));
+    }
     Ok(Settings {
+        env_samples: cli.env_samples,
         mode,
         lambda_samples: cli.lambda_samples,
         curve,
@@ -107,19 +111,12 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         return export_shader(lang, &cli);
     }
     let scene = load_scene(&cli)?;
-    // Refused rather than ignored: a GPU frame lit without the scene's environment
-    // would look plausible and be wrong. `--cpu` (the reference) shades it.
-    if scene.environment.is_some() && !cli.cpu {
-        return Err(Error::input(
-            "environment: the player does not shade sky and map lighting yet; \
-             render it with sunbeam-eval render (or --cpu), or light the scene with lights[] (docs/SCENE.md)",
-        ));
-    }
     let st = settings(&cli)?;
     let backend: Backend = cli.backend;
     // The default mode draws with the response maps: a pack with a current map
-    // beside it is read as its manifest only (the CPU renderer needs the terms).
-    let prepared = if st.mode == Mode::Default && !cli.cpu {
+    // beside it is read as its manifest only (the CPU renderer needs the terms,
+    // and so does building the environment's maps).
+    let prepared = if st.mode == Mode::Default && !cli.cpu && scene.environment.is_none() {
         sunbeam_raster::prepare_with(&scene, &sunbeam_render::response::load_pack)?
     } else {
         sunbeam_raster::prepare(&scene)?
@@ -173,6 +170,20 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             report["frame_ms_mean"] = times.mean_ms().into();
             report["frame_ms"] = times.rest_ms.clone().into();
             report["msaa"] = st.msaa.into();
+            // Environment scenes: the Lambert baseline in the same run (same
+            // load on the machine), and the ratio.
+            let lambert = if prepared.environment.is_some() && st.mode == Mode::Default {
+                let lst = Settings {
+                    mode: Mode::Lambert,
+                    ..st.clone()
+                };
+                let (lt, _) = sunbeam_render::bench_headless(&gpu, &prepared, &lst, size, frames)?;
+                report["lambert_frame_ms_median"] = lt.median_ms().into();
+                report["ratio_to_lambert"] = (times.median_ms() / lt.median_ms().max(1e-9)).into();
+                Some(lt.median_ms())
+            } else {
+                None
+            };
             if !cli.json {
                 println!(
                     "{} {:?} {}x{}: setup {:.0} ms, first frame {:.1} ms, then median {:.2} ms / mean {:.2} ms over {} frames ({:.1} fps)",
@@ -187,6 +198,14 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
                     times.rest_ms.len(),
                     1e3 / times.median_ms().max(1e-6)
                 );
+                if let Some(l) = lambert {
+                    println!(
+                        "environment (accumulation reset every frame): median {:.2} ms vs --lambert {:.2} ms in the same run: {:.2}x",
+                        times.median_ms(),
+                        l,
+                        times.median_ms() / l.max(1e-9)
+                    );
+                }
             }
             img
         } else {
@@ -200,6 +219,11 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             for w in &r.warnings {
                 eprintln!("sunbeam-play: warning: {w}");
             }
+            if !cli.quiet {
+                for n in &r.notes {
+                    eprintln!("sunbeam-play: {n}");
+                }
+            }
             report["setup_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
             let k = cli.supersample.max(1);
             let target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;
@@ -207,7 +231,12 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             for _ in 1..cli.frames.unwrap_or(1).max(1) {
                 target.draw(&gpu, &r, &state)?;
             }
-            target.render_linear(&gpu, &r, &state)?.downsample(k)
+            let img = target.render_linear(&gpu, &r, &state)?.downsample(k);
+            if r.progressive() {
+                // The environment's Monte Carlo frames, averaged (the settled frame).
+                report["accumulated_frames"] = target.frames().into();
+            }
+            img
         }
     };
     if let Some(refp) = &cli.compare {

@@ -1,0 +1,405 @@
+//! Environment lighting on the GPU (docs/PLAY.md "Environment",
+//! shaders/environment.wgsl): per pack the extended-light maps `E_0..E_2` (+
+//! `E_sun`) and the proposal pyramid of `sunbeam_response::env::build_env`; per
+//! scene the coefficient table of the environment, the 3x3 matrix from basis
+//! coefficients to linear sRGB and the sun's disc. Bind group 2 of the
+//! diffraction pipeline (a stand-in without an environment).
+
+use crate::gpu::Gpu;
+use std::sync::Arc;
+use sunbeam_common::{Error, Result};
+use sunbeam_light::Environment;
+use sunbeam_optics::{cie, colour};
+use sunbeam_response::env::EnvResponse;
+use wgpu::util::DeviceExt;
+
+/// Rows of the sky's coefficient table (its width is twice this).
+pub const SKY_TABLE_HEIGHT: usize = 256;
+/// Most pyramid levels the uniform holds.
+pub const MAX_LEVELS: usize = 16;
+/// Proposal samples per pixel per frame (the sun and the diffuse part take one each).
+pub const DEFAULT_ENV_SAMPLES: u32 = 1;
+
+/// shaders/environment.wgsl `EnvGlobals`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
+pub(crate) struct EnvGlobals {
+    pub(crate) basis_to_rgb: [[f32; 4]; 3],
+    pub(crate) sun_dir: [f32; 4],
+    pub(crate) sun_rgb: [f32; 4],
+    pub(crate) sun_t: [f32; 4],
+    pub(crate) sun_b: [f32; 4],
+    pub(crate) table_w: u32,
+    pub(crate) table_h: u32,
+    pub(crate) frame: u32,
+    pub(crate) on: u32,
+    pub(crate) has_sun: u32,
+    pub(crate) samples: u32,
+    pub(crate) _e0: u32,
+    pub(crate) _e1: u32,
+}
+
+/// shaders/environment.wgsl `EnvProposal`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
+pub(crate) struct EnvProposalU {
+    pub(crate) offsets: [[u32; 4]; 4],
+    pub(crate) pw: u32,
+    pub(crate) ph: u32,
+    pub(crate) top: u32,
+    pub(crate) n_s: u32,
+    pub(crate) n_theta: f32,
+    pub(crate) n_rho: f32,
+    pub(crate) n_s_f: f32,
+    pub(crate) r0: f32,
+    pub(crate) rho_scale: f32,
+    pub(crate) on: u32,
+    pub(crate) has_sun: u32,
+    pub(crate) _p0: u32,
+}
+
+/// XYZ (scene units, the response maps' normalisation: 1 nm sums over
+/// 380..780 nm divided by `sum D65 ybar`) of a spectrum.
+fn spectrum_xyz(f: impl Fn(f64) -> f64) -> [f64; 3] {
+    let range = cie::DEFAULT_RANGE_NM;
+    let norm = cie::d65_y_norm(range);
+    let mut xyz = [0.0; 3];
+    for nm in range.0..=range.1 {
+        let s = f(nm as f64 * 1e-9) / norm;
+        let c = cie::cmf_nm(nm);
+        for k in 0..3 {
+            xyz[k] += s * c[k];
+        }
+    }
+    xyz
+}
+
+/// The matrix from basis coefficients to linear sRGB: for a map the identity
+/// (its coefficients are its linear RGB), for the sky `XYZ -> RGB` of the XYZ of
+/// `S0, S1, S2`.
+pub fn basis_to_rgb(env: &Environment) -> [[f64; 3]; 3] {
+    match env {
+        Environment::Map(_) => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        Environment::Sky(_) => {
+            let cols: [[f64; 3]; 3] = std::array::from_fn(|k| {
+                colour::xyz_to_linear_srgb(spectrum_xyz(|l| env.basis_at(l)[k]))
+            });
+            std::array::from_fn(|r| std::array::from_fn(|k| cols[k][r]))
+        }
+    }
+}
+
+fn orthonormal(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let a = if d[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let dot = a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
+    let t = [a[0] - dot * d[0], a[1] - dot * d[1], a[2] - dot * d[2]];
+    let l = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+    let t = t.map(|v| v / l);
+    let b = [
+        d[1] * t[2] - d[2] * t[1],
+        d[2] * t[0] - d[0] * t[2],
+        d[0] * t[1] - d[1] * t[0],
+    ];
+    (t, b)
+}
+
+fn v4(v: [f64; 3], w: f64) -> [f32; 4] {
+    [v[0] as f32, v[1] as f32, v[2] as f32, w as f32]
+}
+
+/// The scene-wide part: uniforms, coefficient table, layout, sampler, stand-ins.
+pub(crate) struct EnvScene {
+    pub(crate) layout: wgpu::BindGroupLayout,
+    pub(crate) globals: wgpu::Buffer,
+    pub(crate) values: EnvGlobals,
+    table: wgpu::TextureView,
+    sampler: wgpu::Sampler,
+    dummy_map: wgpu::TextureView,
+    dummy_buf: wgpu::Buffer,
+    pub(crate) env: Option<Arc<Environment>>,
+}
+
+impl EnvScene {
+    pub(crate) fn new(gpu: &Gpu, env: Option<Arc<Environment>>, samples: u32) -> EnvScene {
+        let device = &gpu.device;
+        let layout = layout(device);
+        let mut values = EnvGlobals {
+            samples: samples.max(1),
+            table_w: 1,
+            table_h: 1,
+            ..Default::default()
+        };
+        let (tw, th, tdata) = match &env {
+            Some(e) => {
+                values.on = 1;
+                let m = basis_to_rgb(e);
+                values.basis_to_rgb = std::array::from_fn(|r| v4(m[r], 0.0));
+                if let Some(sky) = e.sun() {
+                    let omega = sky.sun_solid_angle();
+                    let d = sky.sun_direction();
+                    let (t, b) = orthonormal(d);
+                    let rgb = colour::xyz_to_linear_srgb(spectrum_xyz(|l| sky.sun_spectral(l)));
+                    values.has_sun = 1;
+                    values.sun_dir = v4(d, 1.0 - omega / (2.0 * std::f64::consts::PI));
+                    values.sun_rgb = v4(rgb, omega);
+                    values.sun_t = v4(t, 0.0);
+                    values.sun_b = v4(b, 0.0);
+                }
+                e.coefficient_table(SKY_TABLE_HEIGHT)
+            }
+            None => (1, 1, vec![0.0f32; 4]),
+        };
+        values.table_w = tw as u32;
+        values.table_h = th as u32;
+        let globals = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("environment globals"),
+            contents: bytemuck::bytes_of(&values),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let table = device
+            .create_texture_with_data(
+                &gpu.queue,
+                &wgpu::TextureDescriptor {
+                    label: Some("environment coefficients"),
+                    size: wgpu::Extent3d {
+                        width: tw as u32,
+                        height: th as u32,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba32Float,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                },
+                wgpu::util::TextureDataOrder::LayerMajor,
+                bytemuck::cast_slice(&tdata),
+            )
+            .create_view(&Default::default());
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("environment maps"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let dummy_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("no pyramid"),
+            contents: bytemuck::cast_slice(&[0.0f32; 4]),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        EnvScene {
+            layout,
+            globals,
+            values,
+            table,
+            sampler,
+            dummy_map: crate::renderer::texture_3d(gpu, [1, 1, 1], &[0; 4]),
+            dummy_buf,
+            env,
+        }
+    }
+
+    /// Set the frame index (the random numbers' seed) for the next frame.
+    pub(crate) fn set_frame(&self, gpu: &Gpu, frame: u32) {
+        let mut v = self.values;
+        v.frame = frame;
+        gpu.queue
+            .write_buffer(&self.globals, 0, bytemuck::bytes_of(&v));
+    }
+
+    /// Bind group 2 of a mesh: its pack's maps and pyramid, or stand-ins (the
+    /// diffuse part only).
+    pub(crate) fn bind(&self, gpu: &Gpu, maps: Option<&EnvMaps>) -> wgpu::BindGroup {
+        let device = &gpu.device;
+        let (u, pyr, views): (EnvProposalU, &wgpu::Buffer, [&wgpu::TextureView; 4]) = match maps {
+            Some(m) => (
+                m.uniform,
+                &m.pyramid,
+                [
+                    &m.views[0],
+                    &m.views[1],
+                    &m.views[2],
+                    m.sun.as_ref().unwrap_or(&self.dummy_map),
+                ],
+            ),
+            None => (
+                EnvProposalU::default(),
+                &self.dummy_buf,
+                [&self.dummy_map; 4],
+            ),
+        };
+        let ubuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("environment proposal"),
+            contents: bytemuck::bytes_of(&u),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        fn tex(b: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding: b,
+                resource: wgpu::BindingResource::TextureView(v),
+            }
+        }
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("environment"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.globals.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: ubuf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: pyr.as_entire_binding(),
+                },
+                tex(3, views[0]),
+                tex(4, views[1]),
+                tex(5, views[2]),
+                tex(6, views[3]),
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+                tex(8, &self.table),
+            ],
+        })
+    }
+}
+
+/// One pack's maps and pyramid on the GPU.
+pub(crate) struct EnvMaps {
+    uniform: EnvProposalU,
+    pyramid: wgpu::Buffer,
+    views: [wgpu::TextureView; 3],
+    sun: Option<wgpu::TextureView>,
+}
+
+impl EnvMaps {
+    pub(crate) fn new(gpu: &Gpu, r: &EnvResponse) -> Result<EnvMaps> {
+        let p = &r.proposal;
+        let g = r.grid;
+        if p.offsets.is_empty() || p.offsets.len() > MAX_LEVELS || r.basis.len() != 3 {
+            return Err(Error::internal(format!(
+                "environment maps: {} basis maps, {} pyramid levels (the player takes 3 and up to {MAX_LEVELS})",
+                r.basis.len(),
+                p.offsets.len()
+            )));
+        }
+        let bytes = (p.data.len() * 4) as u64;
+        if bytes > gpu.device.limits().max_storage_buffer_binding_size {
+            return Err(Error::input(format!(
+                "the proposal pyramid ({} MiB) exceeds this GPU's storage buffer limit",
+                bytes >> 20
+            )));
+        }
+        let mut offsets = [[0u32; 4]; 4];
+        for (l, &o) in p.offsets.iter().enumerate() {
+            offsets[l / 4][l % 4] = o as u32;
+        }
+        let uniform = EnvProposalU {
+            offsets,
+            pw: p.pw as u32,
+            ph: p.ph as u32,
+            top: (p.offsets.len() - 1) as u32,
+            n_s: p.n_s as u32,
+            n_theta: g.n_theta as f32,
+            n_rho: g.n_rho as f32,
+            n_s_f: g.n_s as f32,
+            r0: g.r0 as f32,
+            rho_scale: g.rho_scale() as f32,
+            on: 1,
+            has_sun: u32::from(r.sun.is_some()),
+            _p0: 0,
+        };
+        let pyramid = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("proposal pyramid"),
+                contents: bytemuck::cast_slice(if p.data.is_empty() {
+                    &[0.0f32][..]
+                } else {
+                    &p.data
+                }),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        let view = |m: &sunbeam_response::Response| crate::renderer::response_texture(gpu, m);
+        Ok(EnvMaps {
+            uniform,
+            pyramid,
+            views: [view(&r.basis[0]), view(&r.basis[1]), view(&r.basis[2])],
+            sun: r.sun.as_ref().map(view),
+        })
+    }
+}
+
+/// Bind group layout 2 (shaders/environment.wgsl).
+fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let uniform = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let map = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D3,
+            multisampled: false,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("environment"),
+        entries: &[
+            uniform(0),
+            uniform(1),
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            map(3),
+            map(4),
+            map(5),
+            map(6),
+            wgpu::BindGroupLayoutEntry {
+                binding: 7,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 8,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+        ],
+    })
+}

@@ -1,0 +1,371 @@
+// Sunbeam environment lighting in the player (docs/PLAY.md "Environment";
+// contract: docs/LIGHTING.md, crates/sunbeam-response/src/env.rs).
+//
+// Appended to shaders/response_map.wgsl + shaders/diffraction.wgsl (it uses
+// their Globals `g`, SbGrid, sb_resp_coords and sb_gain). Per pixel and frame,
+// for a surface with local frame (t, b, n) and view wr (local):
+//
+// - diffraction: `samples` draws (u, v) from the proposal pyramid (hierarchical
+//   sample warping over the dual cells of the polar grid, the same descent as
+//   sunbeam_response::env::Proposal), wi = (-u - wr_x, -v - wr_y, sqrt(..)),
+//   XYZ += [G / wi_z] sum_k c_k(wi) E_k(u, v, w) / pdf(u, v), with c_k from the
+//   coefficient table and E_k the extended-light response maps (same coordinates
+//   and sampler as the point-light map);
+// - the sun (sky only): one direction uniform on its disc,
+//   XYZ += G(wi, wr) [Omega_sun E_sun](u, v, w) (the map holds the product);
+// - diffuse: one cosine-weighted direction, base * L_rgb(d) (the irradiance
+//   estimate pi L over pi), plus the sun's base / pi * Omega cos(theta_sun) rgb_sun.
+//
+// Random numbers: the PCG hash (Jarzynski and Olano 2020, "Hash functions for
+// GPU rendering") of the pixel, the frame index (frames accumulated since the
+// last reset) and the sample's dimension: env_rand(k) = pcg(seed ^ pcg(k)),
+// seed = pcg(x ^ pcg(y ^ pcg(frame))).
+
+struct EnvGlobals {
+    // rows of the matrix basis coefficients -> linear sRGB (L_rgb(d) = M c(d))
+    basis_to_rgb: array<vec4<f32>, 3>,
+    // xyz: towards the sun's centre (world, unit); w: cos of its angular radius
+    sun_dir: vec4<f32>,
+    // rgb: linear sRGB radiance of the disc; w: its solid angle (sr)
+    sun_rgb: vec4<f32>,
+    // an orthonormal pair perpendicular to sun_dir (disc sampling)
+    sun_t: vec4<f32>,
+    sun_b: vec4<f32>,
+    // coefficient table size (texels, width = 2 height)
+    table_w: u32,
+    table_h: u32,
+    // frames accumulated since the last reset (the random numbers' seed)
+    frame: u32,
+    // 1: the scene has an environment
+    on: u32,
+    // 1: a sky with the sun up
+    has_sun: u32,
+    // proposal samples per pixel per frame
+    samples: u32,
+    _e0: u32,
+    _e1: u32,
+};
+
+struct EnvProposal {
+    // offset of level l in `pyramid` at offsets[l / 4][l % 4] (levels 0..=top)
+    offsets: array<vec4<u32>, 4>,
+    // padded cell counts of level 0 (angle, radius), top level index, s layers
+    pw: u32,
+    ph: u32,
+    top: u32,
+    n_s: u32,
+    // the maps' grid: texels along angle, radius, s; radial warp
+    n_theta: f32,
+    n_rho: f32,
+    n_s_f: f32,
+    r0: f32,
+    rho_scale: f32,
+    // 1: this mesh has a pack and maps (diffraction under the environment)
+    on: u32,
+    // 1: E_sun is bound
+    has_sun: u32,
+    _p0: u32,
+};
+
+@group(2) @binding(0) var<uniform> envg: EnvGlobals;
+@group(2) @binding(1) var<uniform> envp: EnvProposal;
+// level l, layer k, cell (x, y) at offsets[l] + (k * H_l + y) * W_l + x
+@group(2) @binding(2) var<storage, read> pyramid: array<f32>;
+// E_0, E_1, E_2 and E_sun: XYZ per basis spectrum, as the point map's texels
+@group(2) @binding(3) var env_e0: texture_3d<f32>;
+@group(2) @binding(4) var env_e1: texture_3d<f32>;
+@group(2) @binding(5) var env_e2: texture_3d<f32>;
+@group(2) @binding(6) var env_esun: texture_3d<f32>;
+@group(2) @binding(7) var env_smp: sampler;
+// coefficients c_0..c_2 per texel (equirectangular, theta from +y, phi = atan2(z, x))
+@group(2) @binding(8) var env_table: texture_2d<f32>;
+
+const ENV_PI: f32 = 3.141592653589793;
+
+// ---------------------------------------------------------------- random numbers
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+var<private> env_seed: u32;
+
+fn env_seed_at(px: vec2<u32>, frame: u32) {
+    env_seed = pcg(px.x ^ pcg(px.y ^ pcg(frame)));
+}
+
+// Uniform in [0, 1) for dimension k of this pixel and frame.
+fn env_rand(k: u32) -> f32 {
+    return f32(pcg(env_seed ^ pcg(k)) >> 8u) * (1.0 / 16777216.0);
+}
+
+// ---------------------------------------------------------------- lookups
+fn env_grid() -> SbGrid {
+    return SbGrid(vec3<f32>(envp.n_theta, envp.n_rho, envp.n_s_f), envp.r0, envp.rho_scale, g.f0);
+}
+
+// Trilinear read of one map at texel coordinates c (as sb_resp_sample).
+fn env_map(tex: texture_3d<f32>, c: vec3<f32>, gr: SbGrid) -> vec3<f32> {
+    let n = gr.n;
+    let cc = vec3<f32>(c.x, clamp(c.y, 0.0, n.y - 1.0), clamp(c.z, 0.0, n.z - 1.0));
+    return textureSampleLevel(tex, env_smp, (cc + 0.5) / n, 0.0).xyz;
+}
+
+// Coefficients c_k of the radiance from world direction d: the texel that
+// contains it (no filtering, as EnvMap::lookup).
+fn env_coefficients(d: vec3<f32>) -> vec3<f32> {
+    let w = envg.table_w;
+    let h = envg.table_h;
+    let theta = acos(clamp(d.y, -1.0, 1.0));
+    var phi = atan2(d.z, d.x);
+    if (phi < 0.0) {
+        phi = phi + SB_TAU;
+    }
+    let i = min(u32(phi / SB_TAU * f32(w)), w - 1u);
+    let j = min(u32(theta / ENV_PI * f32(h)), h - 1u);
+    return textureLoad(env_table, vec2<u32>(i, j), 0).xyz;
+}
+
+fn env_basis_rgb(c: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(envg.basis_to_rgb[0].xyz, c), dot(envg.basis_to_rgb[1].xyz, c), dot(envg.basis_to_rgb[2].xyz, c));
+}
+
+// ---------------------------------------------------------------- the proposal
+fn env_r_at(rho: f32) -> f32 {
+    return min(envp.r0 * sinh(rho * envp.rho_scale), 2.0);
+}
+
+// The largest radius of the visible disc (|(u, v) - p| < 1, p = -wr_xy, |p| < 1)
+// along angle th.
+fn env_r_max(p: vec2<f32>, th: f32) -> f32 {
+    let pe = dot(p, vec2<f32>(cos(th), sin(th)));
+    return pe + sqrt(max(1.0 - dot(p, p) + pe * pe, 0.0));
+}
+
+fn env_w(l: u32) -> u32 {
+    return max(envp.pw >> l, 1u);
+}
+
+fn env_h(l: u32) -> u32 {
+    return max(envp.ph >> l, 1u);
+}
+
+fn env_offset(l: u32) -> u32 {
+    return envp.offsets[l / 4u][l % 4u];
+}
+
+// e(c) of cell (x, y) of level l for view wr: the stored sum interpolated
+// between the two s layers of the cell centre's w, times G / max(wi_z, 0.05).
+fn env_cell_weight(l: u32, x: u32, y: u32, wr: vec3<f32>) -> f32 {
+    let wl = env_w(l);
+    let hl = env_h(l);
+    let xf = (f32(x) + 0.5) * f32(envp.pw) / f32(wl);
+    let yf = (f32(y) + 0.5) * f32(envp.ph) / f32(hl);
+    if (l == 0u && (xf >= envp.n_theta || yf >= envp.n_rho - 1.0)) {
+        return 0.0;
+    }
+    let theta = SB_TAU * xf / envp.n_theta;
+    let r = env_r_at(yf / (envp.n_rho - 1.0));
+    let uv = r * vec2<f32>(cos(theta), sin(theta));
+    var wxy = -uv - wr.xy;
+    let len = length(wxy);
+    // Visibility (a departure from the contract's descent, measured: with the
+    // clamped gain alone ~94 % of the draws end in cells beyond the visible
+    // disc on a ridge pack under a white map). Light arrives only from (u, v)
+    // within the unit disc around p = -wr_xy, i.e. r < r_max(theta); a cell
+    // (angles [th0, th0 + span], radii [r_lo, r_hi]) weighs its share of area
+    // below r_max at its centre angle (at least 1e-3), and 0 only when no point
+    // of it is visible. The density is this descent's own: still unbiased.
+    let sx = f32(envp.pw) / f32(wl);
+    let sy = f32(envp.ph) / f32(hl);
+    let y_lo = min(f32(y) * sy, envp.n_rho - 1.0);
+    let y_hi = min(f32(y + 1u) * sy, envp.n_rho - 1.0);
+    let r_lo = env_r_at(y_lo / (envp.n_rho - 1.0));
+    let r_hi = env_r_at(y_hi / (envp.n_rho - 1.0));
+    if (!(r_hi > r_lo)) {
+        return 0.0;
+    }
+    let pc = -wr.xy;
+    let span = SB_TAU * sx / envp.n_theta;
+    let th0 = SB_TAU * f32(x) * sx / envp.n_theta;
+    var r_any = length(pc) + 1.0;
+    if (span < ENV_PI) {
+        var ap = atan2(pc.y, pc.x) - th0;
+        ap = ap - SB_TAU * floor(ap / SB_TAU);
+        if (ap > span) {
+            r_any = max(env_r_max(pc, th0), env_r_max(pc, th0 + span));
+        }
+    }
+    if (r_lo >= r_any) {
+        return 0.0;
+    }
+    let rm = env_r_max(pc, theta);
+    let vis = max(clamp((rm * rm - r_lo * r_lo) / (r_hi * r_hi - r_lo * r_lo), 0.0, 1.0), 1e-3);
+    if (len > 0.999) {
+        wxy = wxy * (0.999 / len);
+    }
+    let wz = sqrt(max(1.0 - dot(wxy, wxy), 0.0));
+    let wi = vec3<f32>(wxy, wz);
+    let w = -(wz + wr.z);
+    let s = clamp(-w / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
+    let sc = s * f32(envp.n_s - 1u);
+    let k0 = min(u32(floor(sc)), envp.n_s - 1u);
+    let k1 = min(k0 + 1u, envp.n_s - 1u);
+    let f = sc - f32(k0);
+    let o = env_offset(l);
+    let e0 = pyramid[o + (k0 * hl + y) * wl + x];
+    let e1 = pyramid[o + (k1 * hl + y) * wl + x];
+    return vis * mix(e0, e1, f) * sb_gain(wi, wr, g.f0) / max(wz, 0.05);
+}
+
+struct EnvDraw {
+    uv: vec2<f32>,
+    // density over (u, v); 0: no sample
+    pdf: f32,
+};
+
+// One (u, v) from the pyramid for view wr and uniforms u (contract: "Descent").
+// The child at each level is picked with a fresh uniform env_rand(q + 3 + l)
+// (the contract rescales one u0; f32 would run out of bits over ~10 levels).
+fn env_descend(wr: vec3<f32>, u: vec3<f32>, q: u32) -> EnvDraw {
+    var out: EnvDraw;
+    out.pdf = 0.0;
+    out.uv = vec2<f32>(0.0);
+    var x = 0u;
+    var y = 0u;
+    var p = 1.0;
+    for (var l = envp.top; l > 0u; l = l - 1u) {
+        let lc = l - 1u;
+        var u0 = u.x;
+        if (l != envp.top) {
+            u0 = env_rand(q + 3u + l);
+        }
+        var nx = 1u;
+        if (env_w(lc) > env_w(l)) {
+            nx = 2u;
+        }
+        var ny = 1u;
+        if (env_h(lc) > env_h(l)) {
+            ny = 2u;
+        }
+        let x0 = x * nx;
+        let y0 = y * ny;
+        var e = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
+        var total = 0.0;
+        for (var c = 0u; c < 4u; c = c + 1u) {
+            let cx = c & 1u;
+            let cy = c >> 1u;
+            if (cx < nx && cy < ny) {
+                e[c] = env_cell_weight(lc, x0 + cx, y0 + cy, wr);
+                total = total + e[c];
+            }
+        }
+        if (!(total > 0.0)) {
+            return out;
+        }
+        let target_ = u0 * total;
+        // the first child whose cumulative weight passes u0 * total
+        var acc = 0.0;
+        var pick = 4u;
+        var last = 0u;
+        var acc_last = 0.0;
+        for (var c = 0u; c < 4u; c = c + 1u) {
+            if (pick == 4u && e[c] > 0.0) {
+                if (acc + e[c] > target_) {
+                    pick = c;
+                } else {
+                    last = c;
+                    acc_last = acc;
+                    acc = acc + e[c];
+                }
+            }
+        }
+        if (pick == 4u) {
+            pick = last;
+            acc = acc_last;
+        }
+        let pe = e[pick];
+        p = p * pe / total;
+        x = x0 + (pick & 1u);
+        y = y0 + (pick >> 1u);
+    }
+    let rj = env_r_at(f32(y) / (envp.n_rho - 1.0));
+    let rj1 = env_r_at(f32(y + 1u) / (envp.n_rho - 1.0));
+    let area = (SB_TAU / envp.n_theta) * (rj1 * rj1 - rj * rj) / 2.0;
+    if (!(area > 0.0)) {
+        return out;
+    }
+    let theta = SB_TAU * (f32(x) + u.y) / envp.n_theta;
+    let r = sqrt(rj * rj + u.z * (rj1 * rj1 - rj * rj));
+    out.uv = r * vec2<f32>(cos(theta), sin(theta));
+    out.pdf = p / area;
+    return out;
+}
+
+// ---------------------------------------------------------------- the estimator
+// Linear sRGB leaving the surface towards the viewer under the environment (both
+// parts, dw applied): frame (t, b, n), local view wr, base colour, diffuse weight
+// dw, diffract: the mesh has a pack's maps.
+fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, px: vec2<u32>) -> vec3<f32> {
+    if (envg.on == 0u || wr.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    env_seed_at(px, envg.frame);
+    var rgb = vec3<f32>(0.0);
+    // Diffuse: one cosine-weighted direction (pdf cos / pi) plus the sun's disc.
+    if (dw > 0.0) {
+        let r = sqrt(env_rand(0u));
+        let phi = SB_TAU * env_rand(1u);
+        let wl = vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(1.0 - r * r, 0.0)));
+        let d = wl.x * t + wl.y * b + wl.z * n;
+        var irr_over_pi = env_basis_rgb(env_coefficients(d));
+        if (envg.has_sun == 1u) {
+            let cs = max(dot(envg.sun_dir.xyz, n), 0.0);
+            irr_over_pi = irr_over_pi + envg.sun_rgb.xyz * envg.sun_rgb.w * cs / ENV_PI;
+        }
+        rgb = rgb + dw * base * irr_over_pi;
+    }
+    if (!(diffract && envp.on == 1u && dw < 1.0)) {
+        return rgb;
+    }
+    let gr = env_grid();
+    var xyz = vec3<f32>(0.0);
+    let ns = max(envg.samples, 1u);
+    for (var k = 0u; k < ns; k = k + 1u) {
+        let q = 8u + 32u * k;
+        let dr = env_descend(wr, vec3<f32>(env_rand(q), env_rand(q + 1u), env_rand(q + 2u)), q);
+        if (!(dr.pdf > 0.0)) {
+            continue;
+        }
+        let wxy = -dr.uv - wr.xy;
+        let r2 = dot(wxy, wxy);
+        if (r2 >= 1.0) {
+            continue;
+        }
+        let wi = vec3<f32>(wxy, sqrt(1.0 - r2));
+        let uvw = vec3<f32>(dr.uv, -(wi.z + wr.z));
+        let d = wi.x * t + wi.y * b + wi.z * n;
+        let c = env_coefficients(d);
+        let rc = sb_resp_coords(uvw, gr);
+        let e = c.x * env_map(env_e0, rc, gr) + c.y * env_map(env_e1, rc, gr) + c.z * env_map(env_e2, rc, gr);
+        let wgt = sb_gain(wi, wr, g.f0) / (wi.z * dr.pdf);
+        xyz = xyz + e * wgt;
+    }
+    xyz = xyz / f32(ns);
+    if (envg.has_sun == 1u && envp.has_sun == 1u) {
+        // Uniform on the disc (Sky::sample_sun).
+        let ct = 1.0 - env_rand(2u) * (1.0 - envg.sun_dir.w);
+        let st = sqrt(max(1.0 - ct * ct, 0.0));
+        let ph = SB_TAU * env_rand(3u);
+        let d = st * (cos(ph) * envg.sun_t.xyz + sin(ph) * envg.sun_b.xyz) + ct * envg.sun_dir.xyz;
+        let wi = vec3<f32>(dot(d, t), dot(d, b), dot(d, n));
+        if (wi.z > 0.0) {
+            let uvw = -wi - wr;
+            let rc = sb_resp_coords(uvw, gr);
+            // the map holds Omega_sun E_sun (EnvResponse::sun)
+            xyz = xyz + sb_gain(wi, wr, g.f0) * env_map(env_esun, rc, gr);
+        }
+    }
+    return rgb + (1.0 - dw) * xyz_to_rgb(xyz);
+}
