@@ -5,9 +5,11 @@
 // their Globals `g`, SbGrid, sb_resp_coords and sb_gain). Per pixel and frame,
 // for a surface with local frame (t, b, n) and view wr (local):
 //
-// - diffraction: `samples` draws (u, v) from the proposal pyramid (hierarchical
-//   sample warping over the dual cells of the polar grid, the same descent as
-//   sunbeam_response::env::Proposal), wi = (-u - wr_x, -v - wr_y, sqrt(..)),
+// - diffraction: `samples` draws (u, v), each from the proposal pyramid
+//   (hierarchical sample warping over the dual cells of the polar grid, the
+//   same cell weights and density as sunbeam_response::Proposal) or, with
+//   probability ENV_DEFENSIVE, uniform over the hemisphere, weighed by the
+//   mixture's density (EnvResponse::draw / density); wi = (-u - wr_x, -v - wr_y, sqrt(..)),
 //   XYZ += [G / wi_z] sum_k c_k(wi) E_k(u, v, w) / pdf(u, v), with c_k from the
 //   coefficient table and E_k the extended-light response maps (same coordinates
 //   and sampler as the point-light map);
@@ -155,68 +157,174 @@ fn env_offset(l: u32) -> u32 {
     return envp.offsets[l / 4u][l % 4u];
 }
 
-// e(c) of cell (x, y) of level l for view wr: the stored sum interpolated
-// between the two s layers of the cell centre's w, times G / max(wi_z, 0.05).
+// True when level-l cell with real extent [x0, x1] x [y0, y1] (level-0 cell
+// units) meets the view's disc |(u, v) + wr_xy| < 1: exact distance from the
+// disc's centre p = -wr_xy to the cell's annular sector
+// (Proposal::reaches_disc).
+fn env_reaches_disc(x0: f32, x1: f32, y0: f32, y1: f32, wr: vec3<f32>) -> bool {
+    let n1 = envp.n_rho - 1.0;
+    let ra = env_r_at(y0 / n1);
+    let rb = env_r_at(y1 / n1);
+    let ta = SB_TAU * x0 / envp.n_theta;
+    let tb = SB_TAU * x1 / envp.n_theta;
+    let p = -wr.xy;
+    let rp = length(p);
+    var tp = atan2(p.y, p.x);
+    if (tp < 0.0) {
+        tp = tp + SB_TAU;
+    }
+    var d = 0.0;
+    if (rp == 0.0 || (tp >= ta && tp <= tb)) {
+        d = max(max(ra - rp, rp - rb), 0.0);
+    } else {
+        let ea = vec2<f32>(cos(ta), sin(ta));
+        let eb = vec2<f32>(cos(tb), sin(tb));
+        let sa = clamp(dot(p, ea), ra, rb);
+        let sb = clamp(dot(p, eb), ra, rb);
+        d = min(length(p - sa * ea), length(p - sb * eb));
+    }
+    return d < 1.0;
+}
+
+// e(c) of cell (x, y) of level l for view wr (Proposal::weight): 0 when the
+// cell holds no real cell or misses the view's disc; else the mean, over its
+// four sub-points (fractions 0.25 / 0.75 of its real extent) inside the disc,
+// of the stored value interpolated between the two s layers of that point
+// times G / max(wi_z, 0.05); 0.05 * max(v G) when no sub-point is inside.
+// Sub-points, not the centre: across a coarse cell G / cos, s and the rim
+// change, and centre weights starved the lit cells by factors of 30-400.
 fn env_cell_weight(l: u32, x: u32, y: u32, wr: vec3<f32>) -> f32 {
     let wl = env_w(l);
     let hl = env_h(l);
-    let xf = (f32(x) + 0.5) * f32(envp.pw) / f32(wl);
-    let yf = (f32(y) + 0.5) * f32(envp.ph) / f32(hl);
-    if (l == 0u && (xf >= envp.n_theta || yf >= envp.n_rho - 1.0)) {
+    let sx = envp.pw / wl;
+    let sy = envp.ph / hl;
+    let x0 = f32(x * sx);
+    let x1 = min(f32((x + 1u) * sx), envp.n_theta);
+    let y0 = f32(y * sy);
+    let y1 = min(f32((y + 1u) * sy), envp.n_rho - 1.0);
+    if (!(x0 < x1 && y0 < y1)) {
         return 0.0;
     }
-    let theta = SB_TAU * xf / envp.n_theta;
-    let r = env_r_at(yf / (envp.n_rho - 1.0));
-    let uv = r * vec2<f32>(cos(theta), sin(theta));
-    var wxy = -uv - wr.xy;
-    let len = length(wxy);
-    // Visibility (a departure from the contract's descent, measured: with the
-    // clamped gain alone ~94 % of the draws end in cells beyond the visible
-    // disc on a ridge pack under a white map). Light arrives only from (u, v)
-    // within the unit disc around p = -wr_xy, i.e. r < r_max(theta); a cell
-    // (angles [th0, th0 + span], radii [r_lo, r_hi]) weighs its share of area
-    // below r_max at its centre angle (at least 1e-3), and 0 only when no point
-    // of it is visible. The density is this descent's own: still unbiased.
-    let sx = f32(envp.pw) / f32(wl);
-    let sy = f32(envp.ph) / f32(hl);
-    let y_lo = min(f32(y) * sy, envp.n_rho - 1.0);
-    let y_hi = min(f32(y + 1u) * sy, envp.n_rho - 1.0);
-    let r_lo = env_r_at(y_lo / (envp.n_rho - 1.0));
-    let r_hi = env_r_at(y_hi / (envp.n_rho - 1.0));
-    if (!(r_hi > r_lo)) {
+    if (!env_reaches_disc(x0, x1, y0, y1, wr)) {
         return 0.0;
     }
-    let pc = -wr.xy;
-    let span = SB_TAU * sx / envp.n_theta;
-    let th0 = SB_TAU * f32(x) * sx / envp.n_theta;
-    var r_any = length(pc) + 1.0;
-    if (span < ENV_PI) {
-        var ap = atan2(pc.y, pc.x) - th0;
-        ap = ap - SB_TAU * floor(ap / SB_TAU);
-        if (ap > span) {
-            r_any = max(env_r_max(pc, th0), env_r_max(pc, th0 + span));
+    let o = env_offset(l);
+    let n1 = envp.n_rho - 1.0;
+    var sum = 0.0;
+    var n_in = 0u;
+    var fallback = 0.0;
+    for (var q = 0u; q < 4u; q = q + 1u) {
+        let fx = select(0.25, 0.75, (q & 1u) == 1u);
+        let fy = select(0.25, 0.75, (q >> 1u) == 1u);
+        let theta = SB_TAU * (x0 + fx * (x1 - x0)) / envp.n_theta;
+        let r = env_r_at((y0 + fy * (y1 - y0)) / n1);
+        var wxy = -r * vec2<f32>(cos(theta), sin(theta)) - wr.xy;
+        let len = length(wxy);
+        let inside = len < 1.0;
+        if (len > 0.999) {
+            wxy = wxy * (0.999 / len);
+        }
+        let wz = sqrt(max(1.0 - dot(wxy, wxy), 0.0));
+        let wi = vec3<f32>(wxy, wz);
+        let s = clamp((wz + wr.z) / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
+        let sc = s * f32(envp.n_s - 1u);
+        let k0 = min(u32(floor(sc)), max(envp.n_s, 2u) - 2u);
+        let k1 = min(k0 + 1u, envp.n_s - 1u);
+        let f = sc - f32(k0);
+        let v = mix(pyramid[o + (k0 * hl + y) * wl + x], pyramid[o + (k1 * hl + y) * wl + x], f);
+        let gain = sb_gain(wi, wr, g.f0);
+        if (inside) {
+            sum = sum + v * gain / max(wz, 0.05);
+            n_in = n_in + 1u;
+        } else {
+            fallback = max(fallback, v * gain);
         }
     }
-    if (r_lo >= r_any) {
+    if (n_in > 0u) {
+        return sum / f32(n_in);
+    }
+    return fallback * 0.05;
+}
+
+// Density per unit (u, v) with which env_descend draws uv for view wr
+// (Proposal::pdf): the descent repeated along the level-0 cell holding uv.
+fn env_pdf(wr: vec3<f32>, uv: vec2<f32>) -> f32 {
+    let r = length(uv);
+    if (!(r < 2.0)) {
         return 0.0;
     }
-    let rm = env_r_max(pc, theta);
-    let vis = max(clamp((rm * rm - r_lo * r_lo) / (r_hi * r_hi - r_lo * r_lo), 0.0, 1.0), 1e-3);
-    if (len > 0.999) {
-        wxy = wxy * (0.999 / len);
+    var th = atan2(uv.y, uv.x);
+    if (th < 0.0) {
+        th = th + SB_TAU;
     }
-    let wz = sqrt(max(1.0 - dot(wxy, wxy), 0.0));
-    let wi = vec3<f32>(wxy, wz);
-    let w = -(wz + wr.z);
-    let s = clamp(-w / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
-    let sc = s * f32(envp.n_s - 1u);
-    let k0 = min(u32(floor(sc)), envp.n_s - 1u);
-    let k1 = min(k0 + 1u, envp.n_s - 1u);
-    let f = sc - f32(k0);
-    let o = env_offset(l);
-    let e0 = pyramid[o + (k0 * hl + y) * wl + x];
-    let e1 = pyramid[o + (k1 * hl + y) * wl + x];
-    return vis * mix(e0, e1, f) * sb_gain(wi, wr, g.f0) / max(wz, 0.05);
+    let i = min(u32(th / SB_TAU * envp.n_theta), u32(envp.n_theta) - 1u);
+    let nr = u32(envp.n_rho);
+    var j = min(u32(asinh(r / envp.r0) / envp.rho_scale * (envp.n_rho - 1.0)), nr - 2u);
+    // The cell's radii are r_at(j), r_at(j + 1): settle rounding at the edges.
+    if (j > 0u && r < env_r_at(f32(j) / (envp.n_rho - 1.0))) {
+        j = j - 1u;
+    }
+    if (j + 2u < nr && r >= env_r_at(f32(j + 1u) / (envp.n_rho - 1.0))) {
+        j = j + 1u;
+    }
+    var p = 1.0;
+    var x = 0u;
+    var y = 0u;
+    for (var l = envp.top; l > 0u; l = l - 1u) {
+        let lc = l - 1u;
+        var nx = 1u;
+        if (env_w(lc) > env_w(l)) {
+            nx = 2u;
+        }
+        var ny = 1u;
+        if (env_h(lc) > env_h(l)) {
+            ny = 2u;
+        }
+        let x0 = x * nx;
+        let y0 = y * ny;
+        let want = vec2<u32>(i / (envp.pw / env_w(lc)), j / (envp.ph / env_h(lc)));
+        var total = 0.0;
+        var mine = 0.0;
+        for (var c = 0u; c < 4u; c = c + 1u) {
+            let cx = c & 1u;
+            let cy = c >> 1u;
+            if (cx < nx && cy < ny) {
+                let e = env_cell_weight(lc, x0 + cx, y0 + cy, wr);
+                total = total + e;
+                if (x0 + cx == want.x && y0 + cy == want.y) {
+                    mine = e;
+                }
+            }
+        }
+        if (!(total > 0.0 && mine > 0.0)) {
+            return 0.0;
+        }
+        p = p * mine / total;
+        x = want.x;
+        y = want.y;
+    }
+    let rj = env_r_at(f32(j) / (envp.n_rho - 1.0));
+    let rj1 = env_r_at(f32(j + 1u) / (envp.n_rho - 1.0));
+    let area = (SB_TAU / envp.n_theta) * (rj1 * rj1 - rj * rj) / 2.0;
+    if (!(area > 0.0)) {
+        return 0.0;
+    }
+    return p / area;
+}
+
+// Share of the draws uniform over the hemisphere (env::DEFENSIVE): bounds the
+// integrand's 1 / cos(theta_i), which the proposal follows only at its
+// cells' sub-points.
+const ENV_DEFENSIVE: f32 = 0.25;
+
+// Density per unit (u, v) of a direction uniform over the hemisphere.
+fn env_hemi_pdf(wr: vec3<f32>, uv: vec2<f32>) -> f32 {
+    let wxy = -uv - wr.xy;
+    let r2 = dot(wxy, wxy);
+    if (r2 >= 1.0) {
+        return 0.0;
+    }
+    return 1.0 / (SB_TAU * sqrt(1.0 - r2));
 }
 
 struct EnvDraw {
@@ -334,22 +442,38 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     let ns = max(envg.samples, 1u);
     for (var k = 0u; k < ns; k = k + 1u) {
         let q = 8u + 32u * k;
-        let dr = env_descend(wr, vec3<f32>(env_rand(q), env_rand(q + 1u), env_rand(q + 2u)), q);
-        if (!(dr.pdf > 0.0)) {
+        // One-sample MIS over the mixture (EnvResponse::draw / density).
+        var uvd = vec2<f32>(0.0);
+        var pdf = 0.0;
+        if (env_rand(q + 30u) < ENV_DEFENSIVE) {
+            let z = env_rand(q + 1u);
+            let ph = SB_TAU * env_rand(q + 2u);
+            let sr = sqrt(max(1.0 - z * z, 0.0));
+            uvd = -sr * vec2<f32>(cos(ph), sin(ph)) - wr.xy;
+            pdf = ENV_DEFENSIVE * env_hemi_pdf(wr, uvd) + (1.0 - ENV_DEFENSIVE) * env_pdf(wr, uvd);
+        } else {
+            let dr = env_descend(wr, vec3<f32>(env_rand(q), env_rand(q + 1u), env_rand(q + 2u)), q);
+            if (!(dr.pdf > 0.0)) {
+                continue;
+            }
+            uvd = dr.uv;
+            pdf = ENV_DEFENSIVE * env_hemi_pdf(wr, uvd) + (1.0 - ENV_DEFENSIVE) * dr.pdf;
+        }
+        if (!(pdf > 0.0)) {
             continue;
         }
-        let wxy = -dr.uv - wr.xy;
+        let wxy = -uvd - wr.xy;
         let r2 = dot(wxy, wxy);
         if (r2 >= 1.0) {
             continue;
         }
         let wi = vec3<f32>(wxy, sqrt(1.0 - r2));
-        let uvw = vec3<f32>(dr.uv, -(wi.z + wr.z));
+        let uvw = vec3<f32>(uvd, -(wi.z + wr.z));
         let d = wi.x * t + wi.y * b + wi.z * n;
         let c = env_coefficients(d);
         let rc = sb_resp_coords(uvw, gr);
         let e = c.x * env_map(env_e0, rc, gr) + c.y * env_map(env_e1, rc, gr) + c.z * env_map(env_e2, rc, gr);
-        let wgt = sb_gain(wi, wr, g.f0) / (wi.z * dr.pdf);
+        let wgt = sb_gain(wi, wr, g.f0) / (wi.z * pdf);
         xyz = xyz + e * wgt;
     }
     xyz = xyz / f32(ns);
