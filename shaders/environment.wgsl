@@ -439,13 +439,27 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     }
     let gr = env_grid();
     var xyz = vec3<f32>(0.0);
-    let ns = max(envg.samples, 1u);
+    // The first frame after a reset (every frame while the view moves) is the
+    // preview: one direction uniform over the hemisphere, no descent (the
+    // descent costs ~10x a Lambert frame on lavapipe). Unbiased as well, so
+    // it stays in the running mean; later frames use the mixture.
+    let preview = envg.frame == 0u;
+    var ns = max(envg.samples, 1u);
+    if (preview) {
+        ns = 1u;
+    }
     for (var k = 0u; k < ns; k = k + 1u) {
         let q = 8u + 32u * k;
         // One-sample MIS over the mixture (EnvResponse::draw / density).
         var uvd = vec2<f32>(0.0);
         var pdf = 0.0;
-        if (env_rand(q + 30u) < ENV_DEFENSIVE) {
+        if (preview) {
+            let z = env_rand(q + 1u);
+            let ph = SB_TAU * env_rand(q + 2u);
+            let sr = sqrt(max(1.0 - z * z, 0.0));
+            uvd = -sr * vec2<f32>(cos(ph), sin(ph)) - wr.xy;
+            pdf = env_hemi_pdf(wr, uvd);
+        } else if (env_rand(q + 30u) < ENV_DEFENSIVE) {
             let z = env_rand(q + 1u);
             let ph = SB_TAU * env_rand(q + 2u);
             let sr = sqrt(max(1.0 - z * z, 0.0));
