@@ -137,7 +137,12 @@ pub fn prepared(scene: Scene, mesh: Mesh, pack: Option<Arc<Pack>>) -> Prepared {
 }
 
 fn scene_for(mesh_name: &str, mesh: &Mesh, size: [u32; 2]) -> Scene {
-    let mut s = Scene::default_for(mesh_name.into(), Some("pack".into()), mesh.bounds());
+    let mut s = Scene::default_lit(
+        mesh_name.into(),
+        Some("pack".into()),
+        mesh.bounds(),
+        sunbeam_scene::DefaultLighting::Point,
+    );
     s.size = size;
     s
 }

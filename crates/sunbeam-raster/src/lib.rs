@@ -125,10 +125,15 @@ pub fn mesh_bounds(path: &Path) -> Result<([f64; 3], [f64; 3])> {
     Ok(load_mesh(path)?.bounds())
 }
 
-/// The scene the `--mesh M --pack P` form of `sunbeam-play` and `sunbeam-eval render` draws.
-pub fn default_scene(mesh: &Path, pack: Option<&Path>) -> Result<Scene> {
+/// The scene the `--mesh M --pack P` form of `sunbeam-play` and `sunbeam-eval
+/// render` draws under `lighting` (their `--lighting`, default sky).
+pub fn default_scene(
+    mesh: &Path,
+    pack: Option<&Path>,
+    lighting: sunbeam_scene::DefaultLighting,
+) -> Result<Scene> {
     let b = mesh_bounds(mesh)?;
-    let mut s = Scene::default_for(mesh.to_path_buf(), pack.map(Path::to_path_buf), b);
+    let mut s = Scene::default_lit(mesh.to_path_buf(), pack.map(Path::to_path_buf), b, lighting);
     s.validate()?;
     Ok(s)
 }

@@ -172,10 +172,11 @@ fn response_map_at_scale(name: &str, n: usize, pixel: f64) {
     };
     let pack = sunbeam_pack::build::build(fr, &Default::default(), &mut |_, _| {}).unwrap();
     let mesh = sunbeam_raster::Mesh::uv_sphere(96, 48);
-    let mut scene = sunbeam_scene::Scene::default_for(
+    let mut scene = sunbeam_scene::Scene::default_lit(
         "builtin:sphere".into(),
         Some("pack".into()),
         mesh.bounds(),
+        sunbeam_scene::DefaultLighting::Point,
     );
     scene.camera.eye = [0.0, 0.0, 1.6];
     scene.camera.target = [0.0, 0.0, 0.0];

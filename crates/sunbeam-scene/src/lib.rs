@@ -203,11 +203,65 @@ impl Light {
     }
 }
 
+/// What lights the default scene of `--mesh M --pack P` (the tools' `--lighting`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DefaultLighting {
+    /// The built-in sky with its sun ([`Scene::default_sky`]): what makes the
+    /// whole body of a snake shimmer (docs/LIGHTING.md).
+    Sky,
+    /// One directional D65 light ([`Light::default_light`]), exposure 0.
+    Point,
+}
+
+impl std::str::FromStr for DefaultLighting {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "sky" => Ok(DefaultLighting::Sky),
+            "point" => Ok(DefaultLighting::Point),
+            _ => Err(format!("unknown lighting '{s}' (sky or point)")),
+        }
+    }
+}
+
 impl Scene {
-    /// The scene the `--mesh M --pack P` form of the tools renders: the default
-    /// camera looks at the mesh's bounding box centre from +z (the caller passes
-    /// the bounds once the mesh is loaded), the default light, exposure 0.
+    /// The environment of the default scene: the sun 35 degrees up, 70 degrees
+    /// from +x towards +z (above, a little right of and behind a camera on +z,
+    /// as the point light), turbidity 3, intensity 1.
+    pub fn default_sky() -> Environment {
+        Environment {
+            sky: Some(Sky {
+                sun_elevation_deg: 35.0,
+                sun_azimuth_deg: 70.0,
+                turbidity: 3.0,
+            }),
+            map: None,
+            rotation_deg: 0.0,
+            intensity: 1.0,
+        }
+    }
+
+    /// Exposure of the sky-lit default scene (stops): the sun's diffraction
+    /// orders are several times the radiance of a white diffuser.
+    pub const DEFAULT_SKY_EXPOSURE: f64 = -1.0;
+
+    /// The scene the `--mesh M --pack P` form of the tools renders: lit by the
+    /// built-in sky ([`Scene::default_sky`], no point light, exposure
+    /// [`Scene::DEFAULT_SKY_EXPOSURE`]); the camera as [`Scene::default_lit`].
     pub fn default_for(mesh: PathBuf, pack: Option<PathBuf>, bounds: ([f64; 3], [f64; 3])) -> Self {
+        Scene::default_lit(mesh, pack, bounds, DefaultLighting::Sky)
+    }
+
+    /// The default scene under `lighting`: the default camera looks at the
+    /// mesh's bounding box centre from +z (the caller passes the bounds once
+    /// the mesh is loaded); `Point`: the default light, exposure 0; `Sky`: the
+    /// default sky, no point light.
+    pub fn default_lit(
+        mesh: PathBuf,
+        pack: Option<PathBuf>,
+        bounds: ([f64; 3], [f64; 3]),
+        lighting: DefaultLighting,
+    ) -> Self {
         let (lo, hi) = bounds;
         let c = [
             (lo[0] + hi[0]) / 2.0,
@@ -220,7 +274,7 @@ impl Scene {
         let r = if r > 0.0 && r.is_finite() { r } else { 1.0 };
         let fov = default_fov();
         let dist = r / (fov.to_radians() / 2.0).sin() * 1.05;
-        Scene {
+        let mut scene = Scene {
             camera: Camera {
                 eye: [c[0], c[1], c[2] + dist],
                 target: c,
@@ -238,7 +292,13 @@ impl Scene {
             background: default_background(),
             size: default_size(),
             environment: None,
+        };
+        if lighting == DefaultLighting::Sky {
+            scene.lights.clear();
+            scene.environment = Some(Scene::default_sky());
+            scene.exposure = Scene::DEFAULT_SKY_EXPOSURE;
         }
+        scene
     }
 
     /// Read a scene file; relative paths are resolved against its folder.
@@ -324,6 +384,30 @@ mod tests {
             r#"{"camera":{"eye":[0,0,3],"target":[0,0,0]},"meshes":[],"bogus":1}"#
         )
         .is_err());
+    }
+
+    /// The default scene is sky-lit (issue #13); `point` keeps the old one.
+    /// The sun must be above the horizon and in front of the camera (+z), or
+    /// the default frame is dark.
+    #[test]
+    fn default_scene_is_sky_lit_and_point_is_available() {
+        let b = ([-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]);
+        let mut s = Scene::default_for("m.glb".into(), Some("p.ktx2".into()), b);
+        s.validate().unwrap();
+        assert!(s.lights.is_empty());
+        let sky = s.environment.as_ref().and_then(|e| e.sky.as_ref()).unwrap();
+        assert!(sky.sun_elevation_deg > 10.0 && sky.sun_elevation_deg < 80.0);
+        let az = sky.sun_azimuth_deg.to_radians();
+        assert!(az.sin() > 0.5, "sun behind the camera on +z: {az}");
+        assert!(s.exposure < 0.0);
+        let mut p = Scene::default_lit("m.glb".into(), None, b, DefaultLighting::Point);
+        p.validate().unwrap();
+        assert!(p.environment.is_none());
+        assert_eq!(p.lights.len(), 1);
+        assert_eq!(p.exposure, 0.0);
+        assert_eq!(p.camera.eye, s.camera.eye);
+        assert_eq!("sky".parse::<DefaultLighting>(), Ok(DefaultLighting::Sky));
+        assert!("bogus".parse::<DefaultLighting>().is_err());
     }
 
     fn env_scene(env: &str) -> Result<Scene> {

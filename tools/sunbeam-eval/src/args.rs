@@ -196,9 +196,14 @@ pub(crate) struct RenderArgs {
     /// Output: FRAME.png (display values) or FRAME.exr (linear light, exposure applied).
     #[arg(short, long)]
     pub(crate) output: PathBuf,
-    /// Samples per pixel: a stratified s x s grid averaged in linear light (1, 4, 9, 16, ...).
-    #[arg(long, default_value_t = 1)]
-    pub(crate) samples: u32,
+    /// Samples per pixel: a stratified s x s grid averaged in linear light (1, 4, 9, 16, ...);
+    /// default 1, or 16 for a scene with an `environment` (Monte Carlo).
+    #[arg(long)]
+    pub(crate) samples: Option<u32>,
+    /// What lights the default scene of --mesh/--pack: the built-in sky (default) or the
+    /// point light (docs/SCENE.md "The default scene").
+    #[arg(long, default_value = "sky", value_parser = clap::builder::PossibleValuesParser::new(["sky", "point"]))]
+    pub(crate) lighting: String,
     /// Seed of the environment lighting's Monte Carlo sampling (scenes with an
     /// `environment`; two seeds differ by the estimator's noise only).
     #[arg(long, default_value_t = 1)]

@@ -11,7 +11,12 @@
 //! `--frames-dir`, the frames.
 
 use sunbeam_common::{Error, Result};
-use sunbeam_scene::Scene;
+use sunbeam_scene::{DefaultLighting, Scene};
+
+/// `--lighting` (clap has checked the value).
+fn lighting(a: &crate::args::RenderArgs) -> Result<DefaultLighting> {
+    a.lighting.parse().map_err(Error::usage)
+}
 
 pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
     let mut scene = match (&a.scene, &a.mesh) {
@@ -28,7 +33,7 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
             }
             Scene::load(s)?
         }
-        (None, Some(m)) => sunbeam_raster::default_scene(m, a.pack.as_deref())?,
+        (None, Some(m)) => sunbeam_raster::default_scene(m, a.pack.as_deref(), lighting(a)?)?,
         (None, None) => {
             return Err(Error::usage(
                 "nothing to render: give SCENE.json or --mesh M.glb --pack P.ktx2",
@@ -45,12 +50,16 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
         scene.size = [w as u32, h as u32];
         scene.validate()?;
     }
+    // Monte Carlo under an environment needs more than one sample per pixel.
+    let samples = a
+        .samples
+        .unwrap_or(if scene.environment.is_some() { 16 } else { 1 });
     let opts = sunbeam_raster::Options {
-        samples: a.samples,
+        samples,
         seed: a.seed,
         ..Default::default()
     };
-    sunbeam_raster::samples_side(a.samples)?;
+    sunbeam_raster::samples_side(samples)?;
     if let Some(n) = a.turntable {
         return turntable(&scene, &opts, n, a);
     }

@@ -18,6 +18,10 @@ pub(crate) struct Cli {
     /// Pack (KTX2/EXR) for the default scene.
     #[arg(long)]
     pub(crate) pack: Option<PathBuf>,
+    /// What lights the default scene of --mesh/--pack: the built-in sky (default) or the
+    /// point light (docs/SCENE.md "The default scene").
+    #[arg(long, default_value = "sky", value_parser = clap::builder::PossibleValuesParser::new(["sky", "point"]))]
+    pub(crate) lighting: String,
     /// Render offscreen (no window) and write -o.
     #[arg(long)]
     pub(crate) headless: bool,

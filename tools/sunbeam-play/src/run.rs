@@ -26,7 +26,11 @@ fn load_scene(cli: &Cli) -> Result<Scene> {
             }
             Scene::load(s)?
         }
-        (None, Some(m)) => sunbeam_raster::default_scene(m, cli.pack.as_deref())?,
+        (None, Some(m)) => sunbeam_raster::default_scene(
+            m,
+            cli.pack.as_deref(),
+            cli.lighting.parse().map_err(Error::usage)?,
+        )?,
         (None, None) => {
             return Err(Error::usage(
                 "nothing to render: give SCENE.json or --mesh M.glb --pack P.ktx2",

@@ -269,3 +269,53 @@ fn bad_environments_exit_2() {
         assert!(!out.exists(), "{name}");
     }
 }
+
+/// The default scene of `--mesh --pack` is sky-lit (issue #13): the player
+/// builds the environment's maps and accumulates; `--lighting point` keeps the
+/// point-lit scene (no environment, nothing accumulated); a bad value is a
+/// usage error naming the flag.
+#[test]
+fn default_scene_is_sky_lit() {
+    if !have_gpu() {
+        return;
+    }
+    let dir = tmp("default");
+    ridge_pack(&dir);
+    let run = |extra: &[&str]| {
+        Command::new(BIN)
+            .args(["--mesh", "builtin:sphere", "--pack"])
+            .arg(dir.join("ridge.ktx2"))
+            .args([
+                "--headless",
+                "--size",
+                "32x32",
+                "--frames",
+                "3",
+                "--json",
+                "-o",
+            ])
+            .arg(dir.join("f.png"))
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = run(&[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("built the environment's response maps"),
+        "{err}"
+    );
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["accumulated_frames"].as_u64(), Some(3), "{r}");
+    let o = run(&["--lighting", "point"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        r["accumulated_frames"].as_u64().unwrap_or(0) == 0,
+        "point-lit frames do not accumulate: {r}"
+    );
+    let o = run(&["--lighting", "moon"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--lighting"));
+}
