@@ -6,7 +6,7 @@
 #   ninja -C examples -f out/build.ninja [-j2] [fields|packs|pictures|frames|sheet|web|turntable|all]
 #
 # Takes the Makefile's variables (BIN, OUT, SHARED, MATERIALS, SIZE, BRDF_SIZE,
-# SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, SKY_SAMPLES,
+# SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, SKY_SAMPLES, PLAY_SKY_FRAMES,
 # TURNTABLE_MATERIAL, TURNTABLE_SIZE, TURNTABLE_FRAMES, COLUMNS, SHEET, Q)
 # with the same defaults, on the command line only. Paths are relative to
 # examples/ exactly as make sees them, so Ninja runs in examples/ (-C examples)
@@ -29,16 +29,17 @@ SNAKE_DETAIL=1
 PACK_FLAGS=
 PLAY_FLAGS=
 SKY_SAMPLES=16
+PLAY_SKY_FRAMES=32
 TURNTABLE_MATERIAL=__default__
 TURNTABLE_SIZE=256x144
 TURNTABLE_FRAMES=24
-COLUMNS=5
+COLUMNS=6
 SHEET=__default__
 Q=-q
 for a in "$@"; do
   case "$a" in
     BIN=* | OUT=* | SHARED=* | MATERIALS=* | SIZE=* | BRDF_SIZE=* | SYNTH_SIZE=* | SYNTH_PIXEL=* | \
-      SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | SKY_SAMPLES=* | COLUMNS=* | SHEET=* | Q=* | \
+      SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | SKY_SAMPLES=* | PLAY_SKY_FRAMES=* | COLUMNS=* | SHEET=* | Q=* | \
       TURNTABLE_MATERIAL=* | TURNTABLE_SIZE=* | TURNTABLE_FRAMES=*)
       printf -v "${a%%=*}" '%s' "${a#*=}" ;;
     *) echo "ninja.sh: unknown argument '$a' (expected VAR=value, see the header)" >&2; exit 1 ;;
@@ -110,6 +111,11 @@ rule sky_scene
 rule sky
   command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$SIZE") --samples $(esc "$SKY_SAMPLES") -o \${target} \$q
   description = sky \${target}
+rule play_sky
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-play \$in --headless --size $(esc "$SIZE") --frames $(esc "$PLAY_SKY_FRAMES") -o \${target} --depfile \${target}.d \$q
+  depfile = \${target}.d
+  deps = gcc
+  description = play_sky \${target}
 rule turntable
   command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$TURNTABLE_SIZE") --samples $(esc "$SKY_SAMPLES") --turntable $(esc "$TURNTABLE_FRAMES") --axis 0,0,1 -o \${target} \$q
   description = turntable \${target}
@@ -174,10 +180,13 @@ EOF
     echo "build $o/$m-sky.png: sky $o/$m-sky.json | $o/$m.ktx2 $o/snake.glb $(path "$EVAL")"
     echo "  target = $(esc "$OUT/$m-sky.png")"
     echo "  tidy = $(esc "$OUT/.$m-sky.png").tmp.*"
+    echo "build $o/$m-play-sky.png: play_sky $o/$m-sky.json | $o/$m.ktx2 $o/snake.glb $(path "$BIN/sunbeam-play")"
+    echo "  target = $(esc "$OUT/$m-play-sky.png")"
+    echo "  tidy = $(esc "$OUT/.$m-play-sky.png").tmp.*"
     echo "build $o/snake-$m.glb: bake_pack $o/$m.ktx2 | $o/$m.response.ktx2 $(path "$BIN/sunbeam-bake")"
     echo "  target = $(esc "$OUT/snake-$m.glb")"
     echo "  tidy = $(esc "$OUT/.snake-$m.glb").tmp.*"
-    sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png $o/$m-sky.png"
+    sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png $o/$m-play-sky.png $o/$m-sky.png"
   done
   tm=$TURNTABLE_MATERIAL
   echo "build $o/$tm-turntable.png: turntable $o/$tm-sky.json | $o/$tm.ktx2 $o/snake.glb $(path "$EVAL")"
@@ -198,7 +207,7 @@ EOF
   echo "build fields: phony$(list .exr)"
   echo "build packs: phony$(list .ktx2)"
   echo "build pictures: phony$(list -brdf.png -grating.png)"
-  echo "build frames: phony$(list -frame.png -sky.png)"
+  echo "build frames: phony$(list -frame.png -play-sky.png -sky.png)"
   echo "build sheet: phony $o/contact-sheet.png"
   web_in=""; for m in $MATERIALS; do web_in="$web_in $o/snake-$m.glb"; done
   echo "build web: phony $o/sunbeam-es.frag$web_in"

@@ -18,6 +18,7 @@ pub fn small_vars(bin: &Path, out: &Path) -> Vec<String> {
         "SYNTH_PIXEL=25nm".into(),
         "BRDF_SIZE=40".into(),
         "SIZE=96x54".into(),
+        "PLAY_SKY_FRAMES=2".into(),
         "Q=-q".into(),
     ]
 }

@@ -205,9 +205,10 @@ pub(crate) struct RenderArgs {
     #[arg(long, default_value = "sky", value_parser = clap::builder::PossibleValuesParser::new(["sky", "point"]))]
     pub(crate) lighting: String,
     /// Seed of the environment lighting's Monte Carlo sampling (scenes with an
-    /// `environment`; two seeds differ by the estimator's noise only).
-    #[arg(long, default_value_t = 1)]
-    pub(crate) seed: u64,
+    /// `environment`; two seeds differ by the estimator's noise only). Given
+    /// more than once, the frame is the mean of the seeds' frames in linear light.
+    #[arg(long, default_values_t = [1u64], action = clap::ArgAction::Append)]
+    pub(crate) seed: Vec<u64>,
     /// A turntable of N frames: the camera orbits the target about its `up`
     /// axis (lights and environment stay); -o FILE.png is an animated PNG.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=720))]

@@ -56,20 +56,46 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
         .unwrap_or(if scene.environment.is_some() { 16 } else { 1 });
     let opts = sunbeam_raster::Options {
         samples,
-        seed: a.seed,
+        seed: a.seed[0],
         ..Default::default()
     };
     sunbeam_raster::samples_side(samples)?;
     if let Some(n) = a.turntable {
+        if a.seed.len() > 1 {
+            return Err(Error::usage("--turntable takes one --seed"));
+        }
         return turntable(&scene, &opts, n, a);
     }
+    // The frame in linear light: one seed's, or the mean of several seeds'.
+    let linear = || -> Result<sunbeam_raster::LinearImage> {
+        let mut mean = sunbeam_raster::render_linear(&scene, &opts)?;
+        for &seed in &a.seed[1..] {
+            let o = sunbeam_raster::Options {
+                seed,
+                ..opts.clone()
+            };
+            let img = sunbeam_raster::render_linear(&scene, &o)?;
+            for (m, p) in mean.rgb.iter_mut().zip(&img.rgb) {
+                for c in 0..3 {
+                    m[c] += p[c];
+                }
+            }
+        }
+        let k = a.seed.len() as f32;
+        for m in &mut mean.rgb {
+            for v in m.iter_mut() {
+                *v /= k;
+            }
+        }
+        Ok(mean)
+    };
     let exr = a
         .output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     if let Some(refp) = &a.compare {
         let reference = sunbeam_raster::LinearImage::read_exr(refp)?;
-        let lin = sunbeam_raster::render_linear(&scene, &opts)?;
+        let lin = linear()?;
         let d = sunbeam_raster::compare_linear(&lin, &reference)
             .map_err(|e| e.context(refp.display()))?;
         if exr {
@@ -81,7 +107,9 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
         return Ok(());
     }
     if exr {
-        sunbeam_raster::render_linear(&scene, &opts)?.write_exr(&a.output)
+        linear()?.write_exr(&a.output)
+    } else if a.seed.len() > 1 {
+        linear()?.display(opts.curve).write_png(&a.output)
     } else {
         sunbeam_raster::render_with(&scene, &opts)?.write_png(&a.output)
     }

@@ -66,6 +66,30 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
         other.contains("CIEDE2000") && !other.contains("max 0.000"),
         "{other}"
     );
+    // --seed 7 --seed 8: the mean of the two frames (read back and averaged here).
+    let b8 = d.join("b8.exr");
+    let o = render(&s, &b8, &["--samples", "4", "--seed", "8"]);
+    assert!(o.status.success());
+    let both = d.join("both.exr");
+    let o = render(&s, &both, &["--samples", "4", "--seed", "7", "--seed", "8"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (p7, p8, pm) = (
+        sunbeam_raster::LinearImage::read_exr(&a).unwrap(),
+        sunbeam_raster::LinearImage::read_exr(&b8).unwrap(),
+        sunbeam_raster::LinearImage::read_exr(&both).unwrap(),
+    );
+    let mut differs = false;
+    for ((x, y), m) in p7.rgb.iter().zip(&p8.rgb).zip(&pm.rgb) {
+        for c in 0..3 {
+            let want = (x[c] + y[c]) / 2.0;
+            assert!(
+                (m[c] - want).abs() <= 1e-6 * want.abs().max(1e-3),
+                "{m:?} vs {x:?} {y:?}"
+            );
+            differs |= x[c] != y[c];
+        }
+    }
+    assert!(differs, "two seeds gave the same frame");
     // A white diffuse sphere under the sky is lit (no point light is added).
     let img = sunbeam_raster_probe(&a);
     assert!(img > 0.05, "mean value {img}");
