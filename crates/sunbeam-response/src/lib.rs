@@ -18,6 +18,7 @@ pub mod env;
 pub mod exr;
 pub mod grid;
 pub mod ktx2;
+pub mod nvr;
 pub mod proposal;
 
 pub use build::{build, Options};
