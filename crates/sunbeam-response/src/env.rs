@@ -225,28 +225,38 @@ impl EnvResponse {
     /// hemisphere (`cos(theta_i) = u[1]`, azimuth `2 pi u[2]`), else the
     /// proposal with `u[0]` rescaled.
     pub fn draw(&self, wr: [f64; 3], u: [f64; 3]) -> Option<([f64; 2], f64)> {
-        let uv = if u[0] < DEFENSIVE {
+        let (uv, p) = if u[0] < DEFENSIVE {
             let z = u[1];
             let (s, c) = (2.0 * std::f64::consts::PI * u[2]).sin_cos();
             let sr = (1.0 - z * z).max(0.0).sqrt();
-            [-sr * c - wr[0], -sr * s - wr[1]]
+            let uv = [-sr * c - wr[0], -sr * s - wr[1]];
+            (uv, self.density(wr, uv))
         } else {
+            // The proposal's density comes with its draw: no second descent.
             let u0 = ((u[0] - DEFENSIVE) / (1.0 - DEFENSIVE)).min(1.0 - f64::EPSILON);
-            self.proposal.sample(wr, [u0, u[1], u[2]])?.0
+            let (uv, p) = self.proposal.sample(wr, [u0, u[1], u[2]])?;
+            (
+                uv,
+                DEFENSIVE * hemisphere_density(wr, uv) + (1.0 - DEFENSIVE) * p,
+            )
         };
-        let p = self.density(wr, uv);
         (p > 0.0).then_some((uv, p))
     }
 
     /// Density per unit `(u, v)` with which [`EnvResponse::draw`] draws `uv`.
     pub fn density(&self, wr: [f64; 3], uv: [f64; 2]) -> f64 {
-        let (wx, wy) = (-uv[0] - wr[0], -uv[1] - wr[1]);
-        let r2 = wx * wx + wy * wy;
-        let hemi = if r2 < 1.0 {
-            1.0 / (2.0 * std::f64::consts::PI * (1.0 - r2).sqrt())
-        } else {
-            0.0
-        };
-        DEFENSIVE * hemi + (1.0 - DEFENSIVE) * self.proposal.pdf(wr, uv)
+        DEFENSIVE * hemisphere_density(wr, uv) + (1.0 - DEFENSIVE) * self.proposal.pdf(wr, uv)
+    }
+}
+
+/// Density per unit `(u, v)` of a direction uniform over the hemisphere:
+/// `1 / (2 pi cos(theta_i))` inside the view's disc, 0 outside.
+fn hemisphere_density(wr: [f64; 3], uv: [f64; 2]) -> f64 {
+    let (wx, wy) = (-uv[0] - wr[0], -uv[1] - wr[1]);
+    let r2 = wx * wx + wy * wy;
+    if r2 < 1.0 {
+        1.0 / (2.0 * std::f64::consts::PI * (1.0 - r2).sqrt())
+    } else {
+        0.0
     }
 }
