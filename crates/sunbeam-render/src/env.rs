@@ -201,7 +201,7 @@ impl EnvScene {
             values,
             table,
             sampler,
-            dummy_map: crate::renderer::texture_3d(gpu, [1, 1, 1], &[0; 4]),
+            dummy_map: crate::response::texture_3d(gpu, [1, 1, 1], &[0; 4]),
             dummy_buf,
             env,
         }
@@ -333,7 +333,7 @@ impl EnvMaps {
                 }),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-        let view = |m: &sunbeam_response::Response| crate::renderer::response_texture(gpu, m);
+        let view = |m: &sunbeam_response::Response| crate::response::response_texture(gpu, m);
         Ok(EnvMaps {
             uniform,
             pyramid,

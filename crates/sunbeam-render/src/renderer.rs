@@ -484,7 +484,7 @@ impl Renderer {
                     .find(|(k, _)| Arc::ptr_eq(k, r))
                     .map(|(_, v)| v.clone())
                     .unwrap_or_else(|| {
-                        let v = Arc::new(response_texture(gpu, r));
+                        let v = Arc::new(crate::response::response_texture(gpu, r));
                         resp_views.push((r.clone(), v.clone()));
                         v
                     }),
@@ -973,43 +973,9 @@ fn render_pipeline(
     Ok(pipeline)
 }
 
-/// A 3D RGBA16F texture holding a response map.
-pub(crate) fn response_texture(gpu: &Gpu, r: &sunbeam_response::Response) -> wgpu::TextureView {
-    let g = r.info.grid;
-    texture_3d(
-        gpu,
-        [g.n_theta as u32, g.n_rho as u32, g.n_s as u32],
-        &r.data,
-    )
-}
-
-pub(crate) fn texture_3d(gpu: &Gpu, size: [u32; 3], data: &[u16]) -> wgpu::TextureView {
-    gpu.device
-        .create_texture_with_data(
-            &gpu.queue,
-            &wgpu::TextureDescriptor {
-                label: Some("response map"),
-                size: wgpu::Extent3d {
-                    width: size[0],
-                    height: size[1],
-                    depth_or_array_layers: size[2],
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D3,
-                format: wgpu::TextureFormat::Rgba16Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
-            bytemuck::cast_slice(data),
-        )
-        .create_view(&Default::default())
-}
-
 /// A 1x1x1 stand-in for materials without a response map.
 fn dummy_texture(gpu: &Gpu) -> wgpu::TextureView {
-    texture_3d(gpu, [1, 1, 1], &[0; 4])
+    crate::response::texture_3d(gpu, [1, 1, 1], &[0; 4])
 }
 
 /// A depth texture view of the given size (single-sample).

@@ -4,12 +4,15 @@
 //! (for `NAME.ktx2` or `NAME.exr`). The player loads that file when it exists
 //! and was built from the same pack (the embedded manifests are equal); else it
 //! builds the map itself, which takes seconds for large packs, and says so.
+//! Also the GPU texture of a map (the point map and the extended-light maps).
 
 use std::path::Path;
 use std::sync::Arc;
 use sunbeam_common::Result;
 use sunbeam_pack::Pack;
+use crate::gpu::Gpu;
 use sunbeam_response::{ktx2, Response};
+use wgpu::util::DeviceExt;
 
 /// `dir/NAME.response.ktx2` for a pack `dir/NAME.ext`.
 pub use sunbeam_response::sidecar_path as sidecar;
@@ -83,4 +86,39 @@ pub fn load_or_build(
         )
     });
     Ok((Arc::new(r), note))
+}
+
+/// A 3D RGBA16F texture holding a response map.
+pub(crate) fn response_texture(gpu: &Gpu, r: &sunbeam_response::Response) -> wgpu::TextureView {
+    let g = r.info.grid;
+    texture_3d(
+        gpu,
+        [g.n_theta as u32, g.n_rho as u32, g.n_s as u32],
+        &r.data,
+    )
+}
+
+/// A 3D RGBA16F texture of `size` texels (layer-major f16 bits).
+pub(crate) fn texture_3d(gpu: &Gpu, size: [u32; 3], data: &[u16]) -> wgpu::TextureView {
+    gpu.device
+        .create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("response map"),
+                size: wgpu::Extent3d {
+                    width: size[0],
+                    height: size[1],
+                    depth_or_array_layers: size[2],
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(data),
+        )
+        .create_view(&Default::default())
 }
