@@ -275,6 +275,23 @@ impl Uniforms {
     }
 }
 
+/// The uniform numbers of a pixel's `n` samples under `seed`: the wavelengths
+/// stratified (sample `k` in stratum `k` of `n`, shifted per pixel), the rest
+/// independent, each sample from its own generator ([`EnvShader::rng`]).
+pub fn pixel_uniforms(seed: u64, pixel: u64, n: u64) -> Vec<Uniforms> {
+    let offset = EnvShader::rng(seed, pixel, u64::MAX).unit();
+    (0..n)
+        .map(|k| {
+            let mut rng = EnvShader::rng(seed, pixel, k);
+            let lambda = (offset + (k as f64 + rng.unit()) / n as f64).fract();
+            Uniforms {
+                lambda,
+                ..Uniforms::random(&mut rng)
+            }
+        })
+        .collect()
+}
+
 /// The environment and the lobe samplers of a prepared scene's packs.
 pub struct EnvShader {
     pub env: Arc<Environment>,
