@@ -23,6 +23,7 @@ pub mod environment;
 pub mod fixtures;
 pub mod image;
 pub mod linear;
+pub mod lobe_sampler;
 pub mod raster;
 pub mod shade;
 pub mod spectral;

@@ -97,3 +97,101 @@ fn noise_at_shading_points() {
         }
     }
 }
+
+/// The lobe technique alone at one wavelength: one sample's relative standard
+/// deviation of `f / p` (the proposal's mismatch with the integrand), and the
+/// share of the second moment held by the largest 1 % of the weights.
+#[test]
+#[ignore]
+fn lobe_technique_alone() {
+    let pack = match std::env::var("SUNBEAM_PACK") {
+        Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
+        Err(_) => ridge_pack(),
+    };
+    let ls = sunbeam_raster::lobe_sampler::LobeSampler::new(pack.clone());
+    for th in [0.0f64, 40.0, 65.0, 80.0] {
+        for nm in [450.0, 550.0, 650.0] {
+            let th = th.to_radians();
+            let wr = [th.sin(), 0.0, th.cos()];
+            let l = nm * 1e-9;
+            let m = 40_000u64;
+            let mut w = Vec::with_capacity(m as usize);
+            let mut worst = (0.0, [0.0; 3]);
+            for k in 0..m {
+                let mut rng = EnvShader::rng(5, 0, k);
+                let u = [rng.unit(), rng.unit(), rng.unit()];
+                w.push(match ls.sample(u, wr, l) {
+                    Some(wi) => {
+                        let v = ls.brdf_cos(wi, wr, l) / ls.pdf(wi, wr, l);
+                        if v > worst.0 {
+                            worst = (v, wi);
+                        }
+                        v
+                    }
+                    None => 0.0,
+                });
+            }
+            if std::env::var("WORST").is_ok() {
+                let wi = worst.1;
+                let r = pack.reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], l);
+                eprintln!(
+                    "  worst {:.2}: wi {wi:.3?} R {r:.3e} G {:.3} pdf {:.3e}",
+                    worst.0,
+                    sunbeam_optics::gain::g(wi, wr, 1.5),
+                    ls.pdf(wi, wr, l)
+                );
+            }
+            let mean = w.iter().sum::<f64>() / m as f64;
+            let m2 = w.iter().map(|x| x * x).sum::<f64>() / m as f64;
+            let sd = (m2 - mean * mean).max(0.0).sqrt() / mean;
+            w.sort_by(|a, b| b.partial_cmp(a).unwrap());
+            let top: f64 = w[..(m / 100) as usize].iter().map(|x| x * x).sum::<f64>() / m as f64;
+            let zeros = w.iter().filter(|&&x| x == 0.0).count() as f64 / m as f64;
+            eprintln!(
+                "th_r {:3.0} {nm:3.0} nm: mean {mean:.4}, rel sd {sd:.3}, top 1 % share of 2nd moment {:.2}, zero {zeros:.3}",
+                th.to_degrees(),
+                top / m2
+            );
+        }
+    }
+}
+
+/// How much R varies inside a bin: points uniform in bins drawn by their
+/// centre's R, the relative sd of R(point) / R(centre) (at fixed w = -2).
+#[test]
+#[ignore]
+fn r_inside_bins() {
+    let pack = match std::env::var("SUNBEAM_PACK") {
+        Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
+        Err(_) => ridge_pack(),
+    };
+    let m = pack.manifest.clone();
+    let l = 550e-9;
+    let r_at = |kx: f64, ky: f64| {
+        let u = -kx * l / m.bin_scale_m[0];
+        let v = -ky * l / m.bin_scale_m[1];
+        pack.reflectance(u, v, -2.0, l)
+    };
+    let (mut s1, mut s2, mut sw) = (0.0, 0.0, 0.0);
+    let mut rng = EnvShader::rng(1, 2, 3);
+    let k = 15i64;
+    for by in -k..=k {
+        for bx in -k..=k {
+            let rc = r_at(bx as f64, by as f64);
+            for _ in 0..16 {
+                let r = r_at(bx as f64 + rng.unit() - 0.5, by as f64 + rng.unit() - 0.5);
+                if rc > 0.0 {
+                    let q = r / rc;
+                    s1 += rc * q;
+                    s2 += rc * q * q;
+                    sw += rc;
+                }
+            }
+        }
+    }
+    let mean = s1 / sw;
+    eprintln!(
+        "R(point) / R(bin centre): mean {mean:.3}, rel sd {:.3}",
+        (s2 / sw - mean * mean).sqrt() / mean
+    );
+}
