@@ -317,15 +317,24 @@ impl LobeSampler {
             let a = s - j as f64;
             at(j, k) + a * (at(j + 1, k) - at(j, k))
         };
-        let e0 = interp(direction_of(c)[2], 0);
-        if e0 <= 0.0 {
-            return 0.0;
-        }
-        let cc = [
-            c[0] + interp(direction_of(c)[2], 1) / e0 * q.du[0],
-            c[1] + interp(direction_of(c)[2], 2) / e0 * q.du[1],
-        ];
-        let wi = direction_of(cc);
+        // Leaves have no moments; a node's centroid from the table nearest to
+        // its centre's depth (cheap; the energy is then interpolated).
+        let wi = if level + 1 < self.pyramids.len() {
+            let s = ((direction_of(c)[2] + q.wr[2]) * q.k_h / m.t_max * (self.depths - 1) as f64)
+                .clamp(0.0, (self.depths - 1) as f64);
+            let j = s.round() as usize;
+            let e0 = at(j, 0);
+            if e0 > 0.0 {
+                direction_of([
+                    c[0] + at(j, 1) / e0 * q.du[0],
+                    c[1] + at(j, 2) / e0 * q.du[1],
+                ])
+            } else {
+                direction_of(c)
+            }
+        } else {
+            direction_of(c)
+        };
         let e = interp(wi[2], 0);
         if e <= 0.0 {
             return 0.0;
@@ -342,8 +351,13 @@ impl LobeSampler {
             [1.0, 0.0]
         };
         let ext = (half[0] * nr[0].abs() + half[1] * nr[1].abs()).max(1e-9);
-        let (r0, r1) = ((r - ext).clamp(0.0, 1.0), (r + ext).min(1.0));
-        let mean_inv_cos = (r1.asin() - r0.asin()) / (2.0 * ext);
+        let mean_inv_cos = if r + ext < 0.8 {
+            // Far from the horizon 1 / cos varies slowly: its value at the centre.
+            1.0 / (1.0 - r * r).sqrt()
+        } else {
+            let (r0, r1) = ((r - ext).clamp(0.0, 1.0), (r + ext).min(1.0));
+            (r1.asin() - r0.asin()) / (2.0 * ext)
+        };
         e * mean_inv_cos * gain_over_cos(wi, q.wr, 1.0)
     }
 
@@ -456,10 +470,13 @@ impl LobeSampler {
     /// `u[0]` drives the descent, `u[1]` and `u[2]` the point in the bin.
     pub fn sample(&self, u: [f64; 3], wr: [f64; 3], lambda_m: f64) -> Option<[f64; 3]> {
         self.sample_in(&self.query(wr, lambda_m), u)
+            .map(|(wi, _)| wi)
     }
 
-    /// [`LobeSampler::sample`] for a prepared view and wavelength.
-    pub fn sample_in(&self, q: &LobeQuery, u: [f64; 3]) -> Option<[f64; 3]> {
+    /// [`LobeSampler::sample`] for a prepared view and wavelength, with the
+    /// direction's density ([`LobeSampler::pdf_in`]; for the window model the
+    /// product of the descent's choices, no second descent).
+    pub fn sample_in(&self, q: &LobeQuery, u: [f64; 3]) -> Option<([f64; 3], f64)> {
         let total = q.total();
         if !(total > 0.0) {
             return None;
@@ -470,6 +487,7 @@ impl LobeSampler {
         let i = q.cdf.partition_point(|&c| c <= target).min(q.cdf.len() - 1);
         let below = if i > 0 { q.cdf[i - 1] } else { 0.0 };
         let mut r = ((target - below) / (q.cdf[i] - below)).clamp(0.0, 1.0 - f64::EPSILON);
+        let mut p = (q.cdf[i] - below) / total;
         let (mut x, mut y) = (q.nodes[i].0 as usize, q.nodes[i].1 as usize);
         for l in q.top + 1..levels {
             let (px, py) = (2 * x, 2 * y);
@@ -493,6 +511,7 @@ impl LobeSampler {
                 pick -= 1;
             }
             r = (target / ws[pick]).clamp(0.0, 1.0 - f64::EPSILON);
+            p *= ws[pick] / total;
             x = px + kids[pick].0;
             y = py + kids[pick].1;
         }
@@ -500,6 +519,7 @@ impl LobeSampler {
         let (ox, oy) = match self.tiled_sigma() {
             None => {
                 let s = leaf_point(q, kc, [u[1], u[2]]);
+                p *= leaf_density(q, kc, s);
                 (s[0] - 0.5, s[1] - 0.5)
             }
             Some([sx, sy]) => {
@@ -515,7 +535,12 @@ impl LobeSampler {
         if r2 >= 1.0 {
             return None;
         }
-        Some([wx, wy, (1.0 - r2).sqrt()])
+        let wi = [wx, wy, (1.0 - r2).sqrt()];
+        let pdf = match self.tiled_sigma() {
+            None => p / (q.du[0] * q.du[1]) * wi[2],
+            Some(_) => self.pdf_in(q, wi),
+        };
+        Some((wi, pdf))
     }
 
     /// `f_r cos(theta_i) = G R A / lambda^2` (1/sr) for local directions.

@@ -75,7 +75,11 @@ fn noise_at_shading_points() {
             for (p, acc) in v.iter_mut().enumerate() {
                 let uniforms = sunbeam_raster::environment::pixel_uniforms(3, p as u64 + 100, ns);
                 for u in &uniforms {
-                    let xyz = y_of(u);
+                    let mut u = *u;
+                    if let Ok(v) = std::env::var("FIXED_LAMBDA") {
+                        u.lambda = v.parse().unwrap();
+                    }
+                    let xyz = y_of(&u);
                     for c in 0..3 {
                         acc[c] += xyz[c] / ns as f64;
                     }
