@@ -163,33 +163,24 @@ impl EnvShader {
             .filter(|_| dw < 1.0);
         let mut rgb = [0.0; 3];
         let mut xyz = [0.0; 3];
-        // Each wavelength's lobe proposal, prepared once for its draw and the
-        // densities. The lobes move with the wavelength, so each wavelength has
-        // its own lobe direction (evaluated at that wavelength only), while the
-        // environment's and the sun's directions serve all of them: per
-        // wavelength `j` the balance heuristic over p_env, p_sun and p_lobe_j.
+        // Each wavelength's lobe proposal, prepared once for the draw and the
+        // densities. The lobe technique draws at the hero wavelength, which is
+        // any of the HERO with equal probability, so its density is the mean
+        // over them (one direction serves all wavelengths: measured on frames,
+        // a direction per wavelength, each evaluated at its own, was noisier).
         let queries: Vec<LobeQuery> = match lobe {
             Some(l) if wr_l[2] > 0.0 => lambdas.iter().map(|&x| l.query(wr_l, x)).collect(),
             _ => Vec::new(),
         };
-        // `only`: a lobe direction of wavelength j only, with its density.
-        let mut add = |lobe: &LobeSampler,
-                       d: [f64; 3],
-                       wi: [f64; 3],
-                       only: Option<(usize, f64)>,
-                       p_other: f64| {
+        let lobe = lobe.filter(|_| !queries.is_empty());
+        let lobe_pdf = |lobe: &LobeSampler, wi: [f64; 3]| {
+            queries.iter().map(|q| lobe.pdf_in(q, wi)).sum::<f64>() / HERO as f64
+        };
+        let mut add = |lobe: &LobeSampler, d: [f64; 3], wi: [f64; 3], p_sum: f64| {
             let radiance = self.env.spectrum(d);
-            for (j, &l) in lambdas.iter().enumerate() {
-                if only.is_some_and(|(o, _)| o != j) {
-                    continue;
-                }
+            for &l in &lambdas {
                 let fc = lobe.brdf_cos(wi, wr_l, l);
                 if fc > 0.0 {
-                    let p_lobe = match only {
-                        Some((_, p)) => p,
-                        None => lobe.pdf_in(&queries[j], wi),
-                    };
-                    let p_sum = p_other + p_lobe;
                     let s = radiance.at(l) * fc * span_nm / (self.norm * p_sum);
                     if s.is_finite() {
                         let cmf = cie::cmf_at(l);
@@ -211,7 +202,6 @@ impl EnvShader {
             Some(s) if s.in_sun(d) => 1.0 / s.sun_solid_angle(),
             _ => 0.0,
         };
-        let lobe = lobe.filter(|_| !queries.is_empty());
         if let Some((d, p_env)) = self.env.sample(u.env[0], u.env[1], u.env[2]) {
             let wi = local(d);
             if wi[2] > 0.0 && wr_l[2] > 0.0 {
@@ -222,7 +212,7 @@ impl EnvShader {
                     }
                 }
                 if let Some(lobe) = lobe {
-                    add(lobe, d, wi, None, p_env + sun_pdf(d));
+                    add(lobe, d, wi, p_env + sun_pdf(d) + lobe_pdf(lobe, wi));
                 }
             }
         }
@@ -230,20 +220,19 @@ impl EnvShader {
             if let Some((d, p_sun)) = sky.sample_sun(u.sun[0], u.sun[1]) {
                 let wi = local(d);
                 if wi[2] > 0.0 {
-                    add(lobe, d, wi, None, self.env.pdf(d) + p_sun);
+                    add(lobe, d, wi, self.env.pdf(d) + p_sun + lobe_pdf(lobe, wi));
                 }
             }
         }
         if let Some(lobe) = lobe {
-            for (j, q) in queries.iter().enumerate() {
-                // Wavelength j's uniforms: the sample's, rotated by j / HERO
-                // (each uniform; the descents of the wavelengths spread apart).
-                let r = j as f64 / HERO as f64;
-                let uj = u.lobe.map(|x| (x + r).fract());
-                if let Some((wi, p)) = lobe.sample_in(q, uj) {
-                    let d = world(wi);
-                    add(lobe, d, wi, Some((j, p)), self.env.pdf(d) + sun_pdf(d));
-                }
+            if let Some((wi, _)) = lobe.sample_in(&queries[0], u.lobe) {
+                let d = world(wi);
+                add(
+                    lobe,
+                    d,
+                    wi,
+                    self.env.pdf(d) + sun_pdf(d) + lobe_pdf(lobe, wi),
+                );
             }
         }
         let spec = colour::xyz_to_linear_srgb(xyz);

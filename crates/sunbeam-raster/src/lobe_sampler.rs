@@ -39,7 +39,7 @@ use sunbeam_pack::{manifest::Model, series, Pack};
 const TILED_REACH: f64 = 5.0;
 /// Leaves per bin along each axis for the window model: R varies inside a bin
 /// (one sample's relative spread 0.3 with one leaf per bin).
-const SUB_BINS: usize = 2;
+const SUB_BINS: usize = 1;
 /// Most depth tables (more follow the orders' strengths more closely in `t`).
 const MAX_DEPTHS: usize = 16;
 /// Memory budget of the pyramids, in f32 values.
@@ -47,7 +47,7 @@ const BUDGET_VALUES: usize = 24_000_000;
 /// Leaves within this many leaf widths of the horizon sample towards it.
 const HORIZON_LEAVES: f64 = 6.0;
 /// Width of the descent's top-level nodes in direction cosines (at most).
-const TOP_NODE_COS: f64 = 0.5;
+const TOP_NODE_COS: f64 = 1.0;
 
 /// One view and wavelength, prepared for drawing and for densities: the
 /// constants of the weights and the flat top level of the descent (the

@@ -51,7 +51,7 @@ fn noise_at_shading_points() {
     ];
     for (name, env) in envs {
         let es = EnvShader::new(Arc::new(env), &[Some(pack.clone())]);
-        for (th, ph) in [(0.0f64, 0.0f64), (40.0, 30.0), (65.0, 100.0), (80.0, 200.0)] {
+        for (th, ph) in th_list() {
             let (th, ph) = (th.to_radians(), ph.to_radians());
             let wr = world([th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()]);
             let y_of = |u: &Uniforms| {
@@ -198,4 +198,45 @@ fn r_inside_bins() {
         "R(point) / R(bin centre): mean {mean:.3}, rel sd {:.3}",
         (s2 / sw - mean * mean).sqrt() / mean
     );
+}
+
+/// The views of [`noise_at_shading_points`]: `THETAS="0,85"` or the default.
+fn th_list() -> Vec<(f64, f64)> {
+    match std::env::var("THETAS") {
+        Ok(s) => s.split(',').map(|t| (t.parse().unwrap(), 30.0)).collect(),
+        Err(_) => vec![(0.0, 0.0), (40.0, 30.0), (65.0, 100.0), (80.0, 200.0)],
+    }
+}
+
+/// The largest CIEDE2000 differences between two frames `A` and `B` (EXR),
+/// with their pixels and luminances.
+#[test]
+#[ignore]
+fn worst_pixels() {
+    use sunbeam_raster::LinearImage;
+    let a = LinearImage::read_exr(std::path::Path::new(&std::env::var("A").unwrap())).unwrap();
+    let b = LinearImage::read_exr(std::path::Path::new(&std::env::var("B").unwrap())).unwrap();
+    let mut d: Vec<(f64, usize)> = a
+        .rgb
+        .iter()
+        .zip(&b.rgb)
+        .enumerate()
+        .filter(|(_, (_, q))| {
+            sunbeam_raster::linear::luminance(**q) >= sunbeam_raster::linear::LIT_Y
+        })
+        .map(|(i, (p, q))| {
+            let xyz = |v: &[f32; 3]| colour::linear_srgb_to_xyz(v.map(|x| f64::from(x).max(0.0)));
+            (colour::ciede2000_xyz(xyz(p), xyz(q)), i)
+        })
+        .collect();
+    d.sort_by(|x, y| y.0.total_cmp(&x.0));
+    for &(e, i) in d.iter().take(25) {
+        eprintln!(
+            "dE {e:.1} at ({}, {}): Y {:.3} vs {:.3}",
+            i as u32 % a.width,
+            i as u32 / a.width,
+            sunbeam_raster::linear::luminance(a.rgb[i]),
+            sunbeam_raster::linear::luminance(b.rgb[i])
+        );
+    }
 }
