@@ -193,15 +193,16 @@ impl EnvShader {
         };
         // A third technique for the sky's sun: its disc sampled at every sample
         // (so the wavelengths stay stratified over the pixel where the sun's
-        // diffraction is); its density joins the balance heuristic.
+        // diffraction is). The disc is its alone: the other two techniques
+        // skip directions in it (a partition of the sphere, so none of their
+        // densities is needed there; the disc's density, 1 / its solid angle,
+        // would take nearly all of the balance heuristic's weight anyway).
         let sun = match &*self.env {
             Environment::Sky(s) => Some(s),
             Environment::Map(_) => None,
         };
-        let sun_pdf = |d: [f64; 3]| match sun {
-            Some(s) if s.in_sun(d) => 1.0 / s.sun_solid_angle(),
-            _ => 0.0,
-        };
+        let sun_drawn = sun.is_some_and(|s| s.sample_sun(0.5, 0.5).is_some());
+        let in_sun = |d: [f64; 3]| sun_drawn && sun.is_some_and(|s| s.in_sun(d));
         if let Some((d, p_env)) = self.env.sample(u.env[0], u.env[1], u.env[2]) {
             let wi = local(d);
             if wi[2] > 0.0 && wr_l[2] > 0.0 {
@@ -211,8 +212,8 @@ impl EnvShader {
                         rgb[c] += dw * base[c] * e[c] * wi[2] / (PI * p_env);
                     }
                 }
-                if let Some(lobe) = lobe {
-                    add(lobe, d, wi, p_env + sun_pdf(d) + lobe_pdf(lobe, wi));
+                if let (Some(lobe), false) = (lobe, in_sun(d)) {
+                    add(lobe, d, wi, p_env + lobe_pdf(lobe, wi));
                 }
             }
         }
@@ -220,19 +221,16 @@ impl EnvShader {
             if let Some((d, p_sun)) = sky.sample_sun(u.sun[0], u.sun[1]) {
                 let wi = local(d);
                 if wi[2] > 0.0 {
-                    add(lobe, d, wi, self.env.pdf(d) + p_sun + lobe_pdf(lobe, wi));
+                    add(lobe, d, wi, p_sun);
                 }
             }
         }
         if let Some(lobe) = lobe {
             if let Some((wi, _)) = lobe.sample_in(&queries[0], u.lobe) {
                 let d = world(wi);
-                add(
-                    lobe,
-                    d,
-                    wi,
-                    self.env.pdf(d) + sun_pdf(d) + lobe_pdf(lobe, wi),
-                );
+                if !in_sun(d) {
+                    add(lobe, d, wi, self.env.pdf(d) + lobe_pdf(lobe, wi));
+                }
             }
         }
         let spec = colour::xyz_to_linear_srgb(xyz);
