@@ -243,7 +243,7 @@ impl LobeSampler {
             nodes: Vec::new(),
             cdf: Vec::new(),
         };
-        if !(wr[2] > 0.0) {
+        if !positive(wr[2]) {
             return q;
         }
         let [(x0, x1), (y0, y1)] = self.top_range(&q);
@@ -372,7 +372,7 @@ impl LobeSampler {
         let (ix, iy) = (ix as usize, iy as usize);
         let levels = self.pyramids.len();
         let total = q.total();
-        if !(total > 0.0) {
+        if !positive(total) {
             return 0.0;
         }
         let shift = levels - 1 - q.top;
@@ -382,7 +382,7 @@ impl LobeSampler {
             return 0.0;
         }
         let mut p = self.weight(q, q.top, tx, ty) / total;
-        if !(p > 0.0) {
+        if !positive(p) {
             return 0.0;
         }
         for l in q.top + 1..levels {
@@ -393,7 +393,7 @@ impl LobeSampler {
                 .map(|(dx, dy)| self.weight(q, l, px + dx, py + dy));
             let total: f64 = ws.iter().sum();
             let own = ws[(y - py) * 2 + (x - px)];
-            if !(total > 0.0) || own <= 0.0 {
+            if !positive(total) || own <= 0.0 {
                 return 0.0;
             }
             p *= own / total;
@@ -478,7 +478,7 @@ impl LobeSampler {
     /// product of the descent's choices, no second descent).
     pub fn sample_in(&self, q: &LobeQuery, u: [f64; 3]) -> Option<([f64; 3], f64)> {
         let total = q.total();
-        if !(total > 0.0) {
+        if !positive(total) {
             return None;
         }
         let levels = self.pyramids.len();
@@ -494,7 +494,7 @@ impl LobeSampler {
             let kids = [(0, 0), (1, 0), (0, 1), (1, 1)];
             let ws = kids.map(|(dx, dy)| self.weight(q, l, px + dx, py + dy));
             let total: f64 = ws.iter().sum();
-            if !(total > 0.0) {
+            if !positive(total) {
                 return None;
             }
             let mut target = r * total;
@@ -622,6 +622,11 @@ fn leaf_point(q: &LobeQuery, kc: [f64; 2], u: [f64; 2]) -> [f64; 2] {
             p
         }
     }
+}
+
+/// `x > 0`, false for NaN (a weight or density that can be drawn from).
+fn positive(x: f64) -> bool {
+    x > 0.0
 }
 
 /// The direction whose tangential part is `c` (on the horizon when `|c| >= 1`).
