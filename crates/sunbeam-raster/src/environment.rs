@@ -11,7 +11,8 @@
 //!   diffraction lobes ([`LobeSampler`]), combined by multiple importance
 //!   sampling with the balance heuristic: each adds
 //!   `f L / (p_env + p_sun + p_lobe)`, the lobe density being the mean over
-//!   the hero wavelengths;
+//!   the hero wavelengths; the sun's disc belongs to the sun technique alone
+//!   (the other two skip directions in it);
 //! - the diffraction term is `XYZ += L(wi, lambda) G R(u, v, w, lambda)
 //!   (A / lambda^2) cmf(lambda) / (p_lambda sum D65 ybar)`, `A` the pack's
 //!   coherent area (window: `(sum g)^2 / sum g^2 dx dy`, tiled:
@@ -22,9 +23,9 @@
 //!
 //! Random numbers come from SplitMix64 seeded by (seed, pixel, sample), so a
 //! frame depends on `--seed` and `--samples` only, not on the thread count.
-//! Stratifying the directions too (per-pixel permuted grids) was measured and
-//! gained nothing under the sky (docs/LIGHTING.md "Noise"), so they are
-//! independent.
+//! Besides the wavelengths, the lobe sampler's descent and the environment
+//! sampler's first coordinate are stratified over a pixel's samples
+//! ([`pixel_uniforms`]); the rest are independent.
 
 pub use crate::lobe_sampler::{LobeQuery, LobeSampler};
 use crate::shade::dot;
