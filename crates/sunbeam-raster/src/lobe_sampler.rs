@@ -11,24 +11,33 @@
 //! which then have heavy tails.
 //!
 //! So the proposal is a quadtree over the pack's bins (a pyramid of sums of
-//! `|sum_n c_n(t_j) T_n|^2` per depth table `t_j`), descended from the root: at
-//! each node one of its four children is chosen with probability proportional
-//! to
+//! `|sum_n c_n(t_j) T_n|^2` per depth table `t_j`, with each node's first
+//! moments). For a view and wavelength a [`LobeQuery`] holds the weights of a
+//! flat top level (nodes about `TOP_NODE_COS` wide in direction cosines, so
+//! that one point per node represents it well enough); the descent starts
+//! there and at each node chooses one of its four children with probability
+//! proportional to
 //!
 //! - the child's stored energy interpolated linearly in `|t|` between the depth
-//!   tables at the child centre's actual `t` (for this view and wavelength), times
-//! - `G / cos(theta_i)` at the child centre's direction, `cos(theta_i)` clamped
-//!   below by the square root of half the child's width in direction cosines
-//!   (about the mean of `1 / cos` over a cell at the horizon), times
+//!   tables at the actual `t` of the direction of its energy centroid (for this
+//!   view and wavelength), times
+//! - `(F / F0)^2 (1 + wi.wr)^2 / (cos(theta_i) + cos(theta_r))^2` at the
+//!   centroid, times the mean of `1 / cos(theta_i)` over the child's radial
+//!   extent (near the horizon `(asin rho_1 - asin rho_0) / (2 ext)`, the part
+//!   beyond the horizon counting 0), i.e. `G / cos(theta_i)` up to the view's
+//!   constant, times
 //! - zero when the child lies wholly outside the disc of propagating
 //!   directions (`|wi_xy| < 1`), so no sample is spent on evanescent frequencies.
 //!
-//! At the leaf (one bin) the point is uniform in the bin (window model) or the
-//! tiled model's Gaussian around it. The density of any frequency is the product
-//! of the choices along its leaf's path (per unit bin area), computed by the same
-//! code as the draw, so the estimator's multiple importance sampling stays exact.
-//! A draw consumes one uniform for the whole descent (rescaled at each choice),
-//! so stratifying that uniform over a pixel's samples stratifies the leaves.
+//! At the leaf (one bin) the point is uniform in the bin, or near the horizon
+//! half the time drawn towards it (`horizon_mode`) (window model), or the
+//! tiled model's Gaussian around the bin. The density of any frequency is the
+//! product of the choices along its leaf's path times the leaf's density,
+//! computed by the same code as the draw, so the estimator's multiple importance
+//! sampling stays exact. A draw consumes one uniform for the whole descent
+//! (rescaled at each choice), so stratifying that uniform over a pixel's
+//! samples stratifies the leaves. Measured choices and the variants not kept:
+//! docs/LIGHTING.md "Noise".
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -37,8 +46,10 @@ use sunbeam_pack::{manifest::Model, series, Pack};
 
 /// Bins summed on each side for the tiled model's density, in sigmas.
 const TILED_REACH: f64 = 5.0;
-/// Leaves per bin along each axis for the window model: R varies inside a bin
-/// (one sample's relative spread 0.3 with one leaf per bin).
+/// Leaves per bin along each axis for the window model (R at the leaves'
+/// centres by `Pack::reflectance` when above 1). R varies inside a bin (one
+/// sample's relative spread 0.3 with one leaf per bin), but 2 leaves per bin
+/// measured no better on frames at 4 times the preparation, so 1.
 const SUB_BINS: usize = 1;
 /// Most depth tables (more follow the orders' strengths more closely in `t`).
 const MAX_DEPTHS: usize = 16;
@@ -219,7 +230,7 @@ impl LobeSampler {
     }
 
     /// Prepare view `wr` (local, unit) at `lambda_m` ([`LobeQuery`]). The top
-    /// level's nodes are about [`TOP_NODE_COS`] wide in direction cosines, so
+    /// level's nodes are about `TOP_NODE_COS` wide in direction cosines, so
     /// that the weights, taken at one point per node, are accurate where the
     /// descent starts (a few hundred nodes over the disc of directions).
     pub fn query(&self, wr: [f64; 3], lambda_m: f64) -> LobeQuery {
@@ -582,7 +593,7 @@ fn horizon_mode(q: &LobeQuery, kc: [f64; 2]) -> Option<(usize, bool, f64)> {
 }
 
 /// Density (per unit leaf area) of the point `s` (in `[0, 1]^2`, leaf units,
-/// increasing with kappa) in the leaf centred at bin `kc` ([`horizon_mode`]).
+/// increasing with kappa) in the leaf centred at bin `kc` (`horizon_mode`).
 fn leaf_density(q: &LobeQuery, kc: [f64; 2], s: [f64; 2]) -> f64 {
     match horizon_mode(q, kc) {
         None => 1.0,

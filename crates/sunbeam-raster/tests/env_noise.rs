@@ -6,6 +6,9 @@
 //! of a 256-sample pixel (wavelengths stratified as in the renderer) over 48
 //! pixels.
 //!   cargo test --release -p sunbeam-raster --test env_noise -- --ignored --nocapture
+//! `THETAS=85,89` picks the views; `FIXED_LAMBDA=0.37` holds the wavelengths
+//! constant (the spectral share of the noise); `lobe_technique_alone`,
+//! `r_inside_bins` and `worst_pixels` (`A=a.exr B=b.exr`) dissect the rest.
 
 use std::f64::consts::PI;
 use std::sync::Arc;
