@@ -11,7 +11,8 @@
 //!   diffraction lobes ([`LobeSampler`]), combined by multiple importance
 //!   sampling with the balance heuristic: each adds
 //!   `f L / (p_env + p_sun + p_lobe)`, the lobe density being the mean over
-//!   the hero wavelengths;
+//!   the hero wavelengths; the sun's disc belongs to the sun technique alone
+//!   (the other two skip directions in it);
 //! - the diffraction term is `XYZ += L(wi, lambda) G R(u, v, w, lambda)
 //!   (A / lambda^2) cmf(lambda) / (p_lambda sum D65 ybar)`, `A` the pack's
 //!   coherent area (window: `(sum g)^2 / sum g^2 dx dy`, tiled:
@@ -22,236 +23,23 @@
 //!
 //! Random numbers come from SplitMix64 seeded by (seed, pixel, sample), so a
 //! frame depends on `--seed` and `--samples` only, not on the thread count.
-//! Stratifying the directions too (per-pixel permuted grids) was measured and
-//! gained nothing under the sky (docs/LIGHTING.md "Noise"), so they are
-//! independent.
+//! Besides the wavelengths, the lobe sampler's descent and the environment
+//! sampler's first coordinate are stratified over a pixel's samples
+//! ([`pixel_uniforms`]); the rest are independent.
 
+pub use crate::lobe_sampler::{LobeQuery, LobeSampler};
 use crate::shade::dot;
 use std::f64::consts::PI;
 use std::sync::Arc;
 use sunbeam_common::rng::SplitMix64;
 use sunbeam_light::Environment;
-use sunbeam_optics::{cie, colour, gain};
-use sunbeam_pack::{manifest::Model, series, Pack};
+use sunbeam_optics::{cie, colour};
+use sunbeam_pack::Pack;
 
 /// Wavelength range of the integral (nm).
 const RANGE_NM: (u32, u32) = cie::DEFAULT_RANGE_NM;
 /// Wavelengths evaluated per direction (hero wavelength sampling, Wilkie et al. 2014).
 pub const HERO: usize = 8;
-/// Bins summed on each side for the tiled model's density, in sigmas.
-const TILED_REACH: f64 = 5.0;
-
-/// Draws incoming directions near the diffraction lobes of a pack: a bin of the
-/// pack's stored spectrum with probability proportional to `|sum c_n(t) T_n|^2`
-/// at one of up to eight phase depths `t` spanning the pack's range (a table
-/// per depth), then a point in the bin. Bins are fixed in spatial frequency, so
-/// the tables serve every wavelength and view; for a view `wr` and wavelength
-/// the directions can only reach `|t|` in `2 pi H / lambda [cos(theta_r),
-/// 1 + cos(theta_r)]`, so the draw mixes, with equal weights, only the tables
-/// of the depths in that range (the orders' strengths change with `t`).
-pub struct LobeSampler {
-    pack: Arc<Pack>,
-    /// One CDF over the bins per phase depth `t_j = -t_max (j + 1/2) / depths`.
-    cdfs: Vec<Vec<f64>>,
-    width: usize,
-    height: usize,
-    /// Coherent area (m^2).
-    pub area_m2: f64,
-}
-
-impl LobeSampler {
-    pub fn new(pack: Arc<Pack>) -> LobeSampler {
-        use rayon::prelude::*;
-        let m = &pack.manifest;
-        let (w, h) = (m.crop.width, m.crop.height);
-        let layer = m.layer_texels();
-        // Up to 8 depths, fewer for very large crops (memory: 8 bytes per bin per depth).
-        let depths = (16_000_000 / (w * h).max(1)).clamp(1, 8);
-        let cdfs: Vec<Vec<f64>> = (0..depths)
-            .map(|j| {
-                let t = -m.t_max * (j as f64 + 0.5) / depths as f64;
-                let c = series::coefficients_f64(m.basis, t, m.terms);
-                let p: Vec<f64> = (0..w * h)
-                    .into_par_iter()
-                    .map(|b| {
-                        let mut a = [0.0f64; 2];
-                        for (n, cn) in c.iter().enumerate() {
-                            let i = 2 * (n * layer + b);
-                            let (re, im) = (pack.terms[i] as f64, pack.terms[i + 1] as f64);
-                            a[0] += cn[0] * re - cn[1] * im;
-                            a[1] += cn[0] * im + cn[1] * re;
-                        }
-                        a[0] * a[0] + a[1] * a[1]
-                    })
-                    .collect();
-                let s: f64 = p.iter().sum();
-                let mut cdf = Vec::with_capacity(w * h + 1);
-                let mut acc = 0.0;
-                cdf.push(0.0);
-                for v in &p {
-                    acc += if s > 0.0 { v / s } else { 1.0 / (w * h) as f64 };
-                    cdf.push(acc);
-                }
-                cdf
-            })
-            .collect();
-        let area_m2 = match m.model {
-            Model::Window => sunbeam_optics::truth::window_coherent_area_m2(
-                m.patch.width,
-                m.patch.height,
-                m.patch.dx_m,
-                m.patch.dy_m,
-                m.window_sigma_m,
-            ),
-            Model::Tiled => sunbeam_optics::truth::tiled_coherent_area_m2(m.sigma_f_per_m),
-        };
-        LobeSampler {
-            pack,
-            cdfs,
-            width: w,
-            height: h,
-            area_m2,
-        }
-    }
-
-    /// The depth tables a view and wavelength mix: `[lo, hi]` (inclusive).
-    fn levels(&self, wr_z: f64, lambda_m: f64) -> (usize, usize) {
-        let m = &self.pack.manifest;
-        let d = self.cdfs.len();
-        if m.t_max.is_nan() || m.t_max <= 0.0 {
-            return (0, d - 1);
-        }
-        let k = 2.0 * std::f64::consts::PI * m.height_half_range_m / lambda_m;
-        let level =
-            |t_abs: f64| ((t_abs / m.t_max * d as f64).floor().max(0.0) as usize).min(d - 1);
-        (level(k * wr_z.max(0.0)), level(k * (1.0 + wr_z.max(0.0))))
-    }
-
-    /// Probability of bin `(ix, iy)` (crop indices; 0 outside) in the mixture
-    /// of the depth tables `lv`.
-    fn bin_prob(&self, lv: (usize, usize), ix: i64, iy: i64) -> f64 {
-        if ix < 0 || iy < 0 || ix >= self.width as i64 || iy >= self.height as i64 {
-            return 0.0;
-        }
-        let b = iy as usize * self.width + ix as usize;
-        let sum: f64 = self.cdfs[lv.0..=lv.1].iter().map(|c| c[b + 1] - c[b]).sum();
-        sum / (lv.1 - lv.0 + 1) as f64
-    }
-
-    /// Density per unit bin area at bin coordinates `kappa`. Window model: the
-    /// bin's probability spread uniformly over it. Tiled model: each bin's
-    /// probability spread as the model's Gaussian of `sigma_bins` around it
-    /// (the tiled response is exactly such a sum), summed over the bins within
-    /// [`TILED_REACH`] sigma.
-    fn pdf_kappa(&self, lv: (usize, usize), kx: f64, ky: f64) -> f64 {
-        let m = &self.pack.manifest;
-        match self.tiled_sigma() {
-            None => self.bin_prob(
-                lv,
-                kx.round() as i64 + m.crop.kx,
-                ky.round() as i64 + m.crop.ky,
-            ),
-            Some([sx, sy]) => {
-                let (rx, ry) = (
-                    (TILED_REACH * sx).ceil() as i64,
-                    (TILED_REACH * sy).ceil() as i64,
-                );
-                let (cx, cy) = (kx.round() as i64, ky.round() as i64);
-                let gauss =
-                    |d: f64, s: f64| (-0.5 * d * d / (s * s)).exp() / (s * (2.0 * PI).sqrt());
-                let mut p = 0.0;
-                for by in cy - ry..=cy + ry {
-                    let gy = gauss(ky - by as f64, sy);
-                    for bx in cx - rx..=cx + rx {
-                        let q = self.bin_prob(lv, bx + m.crop.kx, by + m.crop.ky);
-                        if q > 0.0 {
-                            p += q * gy * gauss(kx - bx as f64, sx);
-                        }
-                    }
-                }
-                p
-            }
-        }
-    }
-
-    /// The tiled model's Gaussian width in bins (None for the window model).
-    fn tiled_sigma(&self) -> Option<[f64; 2]> {
-        let m = &self.pack.manifest;
-        (m.model == Model::Tiled).then(|| m.kernel.sigma_bins.map(|s| s.clamp(1e-3, 8.0)))
-    }
-
-    /// Bin coordinates of local directions at `lambda_m` (as `Pack::reflectance`).
-    fn kappa(&self, wi: [f64; 3], wr: [f64; 3], lambda_m: f64) -> (f64, f64) {
-        let m = &self.pack.manifest;
-        let (u, v) = (-wi[0] - wr[0], -wi[1] - wr[1]);
-        (
-            -u / lambda_m * m.bin_scale_m[0],
-            -v / lambda_m * m.bin_scale_m[1],
-        )
-    }
-
-    /// Solid-angle density (1/sr) of drawing local `wi` for view `wr` at `lambda_m`.
-    pub fn pdf(&self, wi: [f64; 3], wr: [f64; 3], lambda_m: f64) -> f64 {
-        if wi[2] <= 0.0 {
-            return 0.0;
-        }
-        let m = &self.pack.manifest;
-        let (kx, ky) = self.kappa(wi, wr, lambda_m);
-        let lv = self.levels(wr[2], lambda_m);
-        // d(kappa_x, kappa_y) = bin_scale^2 / lambda^2 d(u, v), d(u, v) = cos(theta_i) dw.
-        self.pdf_kappa(lv, kx, ky) * m.bin_scale_m[0] * m.bin_scale_m[1] / (lambda_m * lambda_m)
-            * wi[2]
-    }
-
-    /// A local incoming direction for view `wr` at `lambda_m` (its density is
-    /// [`LobeSampler::pdf`]); None when the drawn frequency is evanescent.
-    pub fn sample(&self, u: [f64; 3], wr: [f64; 3], lambda_m: f64) -> Option<[f64; 3]> {
-        let m = &self.pack.manifest;
-        // The depth table, then the bin (u[0] split between the two choices).
-        let lv = self.levels(wr[2], lambda_m);
-        let k = lv.1 - lv.0 + 1;
-        let uk = u[0] * k as f64;
-        let li = (lv.0 + uk.floor() as usize).min(lv.1);
-        let cdf = &self.cdfs[li];
-        let x = (uk - uk.floor()) * cdf[cdf.len() - 1];
-        let b = cdf
-            .partition_point(|&c| c <= x)
-            .saturating_sub(1)
-            .min(cdf.len() - 2);
-        let (ix, iy) = ((b % self.width) as i64, (b / self.width) as i64);
-        let (ox, oy) = match self.tiled_sigma() {
-            None => (u[1] - 0.5, u[2] - 0.5),
-            Some([sx, sy]) => {
-                // Box-Muller: a Gaussian offset of the model's width.
-                let r = (-2.0 * (1.0 - u[1]).ln()).sqrt();
-                let (s, c) = (2.0 * PI * u[2]).sin_cos();
-                (r * c * sx, r * s * sy)
-            }
-        };
-        let kx = (ix - m.crop.kx) as f64 + ox;
-        let ky = (iy - m.crop.ky) as f64 + oy;
-        let uu = -kx * lambda_m / m.bin_scale_m[0];
-        let vv = -ky * lambda_m / m.bin_scale_m[1];
-        let (wx, wy) = (-uu - wr[0], -vv - wr[1]);
-        let r2 = wx * wx + wy * wy;
-        if r2 >= 1.0 {
-            return None;
-        }
-        Some([wx, wy, (1.0 - r2).sqrt()])
-    }
-
-    /// `f_r cos(theta_i) = G R A / lambda^2` (1/sr) for local directions.
-    pub fn brdf_cos(&self, wi: [f64; 3], wr: [f64; 3], lambda_m: f64) -> f64 {
-        if !(wi[2] > 0.0 && wr[2] > 0.0) {
-            return 0.0;
-        }
-        let r = self
-            .pack
-            .reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], lambda_m);
-        gain::g(wi, wr, gain::DEFAULT_IOR) * r * self.area_m2 / (lambda_m * lambda_m)
-    }
-}
-
 /// The uniform numbers of one sample: the hero wavelength's position, the
 /// environment's three, the sun disc's two, the lobe sampler's three (bin, then
 /// the offset inside it).
@@ -273,6 +61,41 @@ impl Uniforms {
             lobe: [rng.unit(), rng.unit(), rng.unit()],
         }
     }
+}
+
+/// The uniform numbers of a pixel's `n` samples under `seed`: the wavelengths
+/// stratified (sample `k` in stratum `k` of `n`, shifted per pixel), the
+/// lobe sampler's descent (`lobe[0]`) and the environment sampler's first
+/// coordinate (`env[1]`) stratified too, each in its own random permutation of the
+/// strata (Latin hypercube: each dimension's strata are all hit once,
+/// independently of the others); the rest independent, each sample from its own
+/// generator ([`EnvShader::rng`]). One uniform drives the whole descent of the
+/// lobe sampler, so its strata are strata of the proposal's leaves.
+pub fn pixel_uniforms(seed: u64, pixel: u64, n: u64) -> Vec<Uniforms> {
+    let mut g = EnvShader::rng(seed, pixel, u64::MAX);
+    let offset = g.unit();
+    let mut perm = || {
+        let mut p: Vec<u64> = (0..n).collect();
+        for i in (1..p.len()).rev() {
+            let j = ((g.unit() * (i + 1) as f64) as usize).min(i);
+            p.swap(i, j);
+        }
+        p
+    };
+    let (pl, pe) = (perm(), perm());
+    (0..n)
+        .map(|k| {
+            let mut rng = EnvShader::rng(seed, pixel, k);
+            let lambda = (offset + (k as f64 + rng.unit()) / n as f64).fract();
+            let mut u = Uniforms {
+                lambda,
+                ..Uniforms::random(&mut rng)
+            };
+            u.lobe[0] = (pl[k as usize] as f64 + u.lobe[0]) / n as f64;
+            u.env[1] = (pe[k as usize] as f64 + u.env[1]) / n as f64;
+            u
+        })
+        .collect()
 }
 
 /// The environment and the lobe samplers of a prepared scene's packs.
@@ -341,10 +164,18 @@ impl EnvShader {
             .filter(|_| dw < 1.0);
         let mut rgb = [0.0; 3];
         let mut xyz = [0.0; 3];
-        // The lobe technique's density: the hero is any of the HERO wavelengths
-        // with equal probability, so its density is the mean over them.
+        // Each wavelength's lobe proposal, prepared once for the draw and the
+        // densities. The lobe technique draws at the hero wavelength, which is
+        // any of the HERO with equal probability, so its density is the mean
+        // over them (one direction serves all wavelengths: measured on frames,
+        // a direction per wavelength, each evaluated at its own, was noisier).
+        let queries: Vec<LobeQuery> = match lobe {
+            Some(l) if wr_l[2] > 0.0 => lambdas.iter().map(|&x| l.query(wr_l, x)).collect(),
+            _ => Vec::new(),
+        };
+        let lobe = lobe.filter(|_| !queries.is_empty());
         let lobe_pdf = |lobe: &LobeSampler, wi: [f64; 3]| {
-            lambdas.iter().map(|&l| lobe.pdf(wi, wr_l, l)).sum::<f64>() / HERO as f64
+            queries.iter().map(|q| lobe.pdf_in(q, wi)).sum::<f64>() / HERO as f64
         };
         let mut add = |lobe: &LobeSampler, d: [f64; 3], wi: [f64; 3], p_sum: f64| {
             let radiance = self.env.spectrum(d);
@@ -363,15 +194,16 @@ impl EnvShader {
         };
         // A third technique for the sky's sun: its disc sampled at every sample
         // (so the wavelengths stay stratified over the pixel where the sun's
-        // diffraction is); its density joins the balance heuristic.
+        // diffraction is). The disc is its alone: the other two techniques
+        // skip directions in it (a partition of the sphere, so none of their
+        // densities is needed there; the disc's density, 1 / its solid angle,
+        // would take nearly all of the balance heuristic's weight anyway).
         let sun = match &*self.env {
             Environment::Sky(s) => Some(s),
             Environment::Map(_) => None,
         };
-        let sun_pdf = |d: [f64; 3]| match sun {
-            Some(s) if s.in_sun(d) => 1.0 / s.sun_solid_angle(),
-            _ => 0.0,
-        };
+        let sun_drawn = sun.is_some_and(|s| s.sample_sun(0.5, 0.5).is_some());
+        let in_sun = |d: [f64; 3]| sun_drawn && sun.is_some_and(|s| s.in_sun(d));
         if let Some((d, p_env)) = self.env.sample(u.env[0], u.env[1], u.env[2]) {
             let wi = local(d);
             if wi[2] > 0.0 && wr_l[2] > 0.0 {
@@ -381,29 +213,24 @@ impl EnvShader {
                         rgb[c] += dw * base[c] * e[c] * wi[2] / (PI * p_env);
                     }
                 }
-                if let Some(lobe) = lobe {
-                    add(lobe, d, wi, p_env + sun_pdf(d) + lobe_pdf(lobe, wi));
+                if let (Some(lobe), false) = (lobe, in_sun(d)) {
+                    add(lobe, d, wi, p_env + lobe_pdf(lobe, wi));
                 }
             }
         }
         if let (Some(lobe), Some(sky)) = (lobe, sun) {
             if let Some((d, p_sun)) = sky.sample_sun(u.sun[0], u.sun[1]) {
                 let wi = local(d);
-                if wi[2] > 0.0 && wr_l[2] > 0.0 {
-                    add(lobe, d, wi, self.env.pdf(d) + p_sun + lobe_pdf(lobe, wi));
+                if wi[2] > 0.0 {
+                    add(lobe, d, wi, p_sun);
                 }
             }
         }
         if let Some(lobe) = lobe {
-            if let Some(wi) = lobe.sample(u.lobe, wr_l, lambdas[0]) {
-                if wr_l[2] > 0.0 {
-                    let d = world(wi);
-                    add(
-                        lobe,
-                        d,
-                        wi,
-                        self.env.pdf(d) + sun_pdf(d) + lobe_pdf(lobe, wi),
-                    );
+            if let Some((wi, _)) = lobe.sample_in(&queries[0], u.lobe) {
+                let d = world(wi);
+                if !in_sun(d) {
+                    add(lobe, d, wi, self.env.pdf(d) + lobe_pdf(lobe, wi));
                 }
             }
         }

@@ -23,6 +23,7 @@ pub mod environment;
 pub mod fixtures;
 pub mod image;
 pub mod linear;
+pub mod lobe_sampler;
 pub mod raster;
 pub mod shade;
 pub mod spectral;
@@ -32,7 +33,6 @@ pub use image::{compare, Image};
 pub use linear::{compare_linear, LinearImage};
 pub use sunbeam_scene::geometry::Mesh;
 
-use environment::EnvShader;
 use std::path::Path;
 use std::sync::Arc;
 use sunbeam_common::{Error, Result};
@@ -298,7 +298,7 @@ fn render_environment(
             let y = y0 as usize + jr;
             for (x, px) in row.iter_mut().enumerate() {
                 let pixel = (y * w as usize + x) as u64;
-                let offset = EnvShader::rng(opts.seed, pixel, u64::MAX).unit();
+                let uniforms = environment::pixel_uniforms(opts.seed, pixel, n);
                 let mut acc = [0.0; 3];
                 for k in 0..n {
                     let (sx, sy) = ((k % s as u64) as usize, (k / s as u64) as usize);
@@ -313,19 +313,13 @@ fn render_environment(
                             eye[2] - f.pos[2],
                         ]);
                         if let (Some(fr), Some(wr)) = (shade::frame(f.normal, f.tangent), view) {
-                            let mut rng = EnvShader::rng(opts.seed, pixel, k);
-                            // Stratified wavelengths: sample k in stratum k of n, shifted per pixel.
-                            let lambda = (offset + (k as f64 + rng.unit()) / n as f64).fract();
-                            let u = environment::Uniforms {
-                                lambda,
-                                ..environment::Uniforms::random(&mut rng)
-                            };
+                            let u = &uniforms[k as usize];
                             let dw = if mat.pack.is_some() {
                                 mat.diffuse_weight
                             } else {
                                 1.0
                             };
-                            let e = es.sample(mi, fr, wr, mat.base_color, dw, &u);
+                            let e = es.sample(mi, fr, wr, mat.base_color, dw, u);
                             for i in 0..3 {
                                 c[i] += e[i];
                             }

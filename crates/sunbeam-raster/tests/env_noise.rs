@@ -1,0 +1,245 @@
+//! Measurement, not a check (ignored): the environment estimator's noise at
+//! single shading points (docs/LIGHTING.md "Noise"). For a pack (the ridge
+//! field below, or `SUNBEAM_PACK=path.ktx2`), a few views under a constant
+//! white map and under the sky, it prints the mean Y, one sample's relative
+//! standard deviation of Y, and the relative standard deviation of X, Y, Z
+//! of a 256-sample pixel (wavelengths stratified as in the renderer) over 48
+//! pixels.
+//!   cargo test --release -p sunbeam-raster --test env_noise -- --ignored --nocapture
+//! `THETAS=85,89` picks the views; `FIXED_LAMBDA=0.37` holds the wavelengths
+//! constant (the spectral share of the noise); `lobe_technique_alone`,
+//! `r_inside_bins` and `worst_pixels` (`A=a.exr B=b.exr`) dissect the rest.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+use sunbeam_light::{sky::Sky, EnvMap, Environment};
+use sunbeam_optics::colour;
+use sunbeam_pack::{build::BuildOptions, FieldRef, Pack};
+use sunbeam_raster::environment::{EnvShader, Uniforms};
+
+fn ridge_pack() -> Arc<Pack> {
+    let (n, dx, period, amp) = (64usize, 50e-9, 1.3e-6, 420e-9);
+    let data: Vec<f64> = (0..n * n)
+        .map(|k| {
+            let (i, j) = ((k % n) as f64, (k / n) as f64);
+            0.5 * amp * (1.0 + (2.0 * PI * (i * dx) / period + 0.3 * (0.7 * j).sin()).sin())
+        })
+        .collect();
+    let f = FieldRef {
+        width: n,
+        height: n,
+        dx,
+        dy: dx,
+        data: &data,
+    };
+    Arc::new(sunbeam_pack::build(f, &BuildOptions::default(), &mut |_, _| {}).unwrap())
+}
+
+#[test]
+#[ignore]
+fn noise_at_shading_points() {
+    let pack = match std::env::var("SUNBEAM_PACK") {
+        Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
+        Err(_) => ridge_pack(),
+    };
+    // World up is +y: the frame's normal.
+    let (t, b, n) = ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]);
+    let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
+    let envs = [
+        ("white", Environment::Map(EnvMap::constant([1.0; 3]))),
+        (
+            "sky",
+            Environment::Sky(Box::new(Sky::new(25.0, 120.0, 3.0, 1.0))),
+        ),
+    ];
+    for (name, env) in envs {
+        let es = EnvShader::new(Arc::new(env), &[Some(pack.clone())]);
+        for (th, ph) in th_list() {
+            let (th, ph) = (th.to_radians(), ph.to_radians());
+            let wr = world([th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()]);
+            let y_of = |u: &Uniforms| {
+                colour::linear_srgb_to_xyz(es.sample(0, (t, b, n), wr, [0.0; 3], 0.0, u))
+            };
+            // One sample's spread (independent samples).
+            let m = 20_000u64;
+            let (mut s1, mut s2) = (0.0, 0.0);
+            for k in 0..m {
+                let mut rng = EnvShader::rng(9, 1, k);
+                let y = y_of(&Uniforms::random(&mut rng))[1];
+                s1 += y;
+                s2 += y * y;
+            }
+            let mean = s1 / m as f64;
+            let sd1 = (s2 / m as f64 - mean * mean).max(0.0).sqrt() / mean;
+            // Pixels of 256 samples, as the renderer draws them.
+            let (px, ns) = (48u64, 256u64);
+            let mut v = vec![[0.0; 3]; px as usize];
+            let t0 = std::time::Instant::now();
+            for (p, acc) in v.iter_mut().enumerate() {
+                let uniforms = sunbeam_raster::environment::pixel_uniforms(3, p as u64 + 100, ns);
+                for u in &uniforms {
+                    let mut u = *u;
+                    if let Ok(v) = std::env::var("FIXED_LAMBDA") {
+                        u.lambda = v.parse().unwrap();
+                    }
+                    let xyz = y_of(&u);
+                    for c in 0..3 {
+                        acc[c] += xyz[c] / ns as f64;
+                    }
+                }
+            }
+            let us = t0.elapsed().as_secs_f64() * 1e6 / (px * ns) as f64;
+            let rel = [0, 1, 2].map(|c| {
+                let mu = v.iter().map(|x| x[c]).sum::<f64>() / px as f64;
+                let var = v.iter().map(|x| (x[c] - mu).powi(2)).sum::<f64>() / (px - 1) as f64;
+                var.sqrt() / mu
+            });
+            eprintln!(
+                "{name:5} th_r {:4.0} deg: Y {mean:.4}, one sample {sd1:.2}, 256-sample pixel X/Y/Z {:.3} / {:.3} / {:.3} ({us:.0} us/sample)",
+                th.to_degrees(),
+                rel[0],
+                rel[1],
+                rel[2]
+            );
+        }
+    }
+}
+
+/// The lobe technique alone at one wavelength: one sample's relative standard
+/// deviation of `f / p` (the proposal's mismatch with the integrand), and the
+/// share of the second moment held by the largest 1 % of the weights.
+#[test]
+#[ignore]
+fn lobe_technique_alone() {
+    let pack = match std::env::var("SUNBEAM_PACK") {
+        Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
+        Err(_) => ridge_pack(),
+    };
+    let ls = sunbeam_raster::lobe_sampler::LobeSampler::new(pack.clone());
+    for th in [0.0f64, 40.0, 65.0, 80.0] {
+        for nm in [450.0, 550.0, 650.0] {
+            let th = th.to_radians();
+            let wr = [th.sin(), 0.0, th.cos()];
+            let l = nm * 1e-9;
+            let m = 40_000u64;
+            let mut w = Vec::with_capacity(m as usize);
+            let mut worst = (0.0, [0.0; 3]);
+            for k in 0..m {
+                let mut rng = EnvShader::rng(5, 0, k);
+                let u = [rng.unit(), rng.unit(), rng.unit()];
+                w.push(match ls.sample(u, wr, l) {
+                    Some(wi) => {
+                        let v = ls.brdf_cos(wi, wr, l) / ls.pdf(wi, wr, l);
+                        if v > worst.0 {
+                            worst = (v, wi);
+                        }
+                        v
+                    }
+                    None => 0.0,
+                });
+            }
+            if std::env::var("WORST").is_ok() {
+                let wi = worst.1;
+                let r = pack.reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], l);
+                eprintln!(
+                    "  worst {:.2}: wi {wi:.3?} R {r:.3e} G {:.3} pdf {:.3e}",
+                    worst.0,
+                    sunbeam_optics::gain::g(wi, wr, 1.5),
+                    ls.pdf(wi, wr, l)
+                );
+            }
+            let mean = w.iter().sum::<f64>() / m as f64;
+            let m2 = w.iter().map(|x| x * x).sum::<f64>() / m as f64;
+            let sd = (m2 - mean * mean).max(0.0).sqrt() / mean;
+            w.sort_by(|a, b| b.partial_cmp(a).unwrap());
+            let top: f64 = w[..(m / 100) as usize].iter().map(|x| x * x).sum::<f64>() / m as f64;
+            let zeros = w.iter().filter(|&&x| x == 0.0).count() as f64 / m as f64;
+            eprintln!(
+                "th_r {:3.0} {nm:3.0} nm: mean {mean:.4}, rel sd {sd:.3}, top 1 % share of 2nd moment {:.2}, zero {zeros:.3}",
+                th.to_degrees(),
+                top / m2
+            );
+        }
+    }
+}
+
+/// How much R varies inside a bin: points uniform in bins drawn by their
+/// centre's R, the relative sd of R(point) / R(centre) (at fixed w = -2).
+#[test]
+#[ignore]
+fn r_inside_bins() {
+    let pack = match std::env::var("SUNBEAM_PACK") {
+        Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
+        Err(_) => ridge_pack(),
+    };
+    let m = pack.manifest.clone();
+    let l = 550e-9;
+    let r_at = |kx: f64, ky: f64| {
+        let u = -kx * l / m.bin_scale_m[0];
+        let v = -ky * l / m.bin_scale_m[1];
+        pack.reflectance(u, v, -2.0, l)
+    };
+    let (mut s1, mut s2, mut sw) = (0.0, 0.0, 0.0);
+    let mut rng = EnvShader::rng(1, 2, 3);
+    let k = 15i64;
+    for by in -k..=k {
+        for bx in -k..=k {
+            let rc = r_at(bx as f64, by as f64);
+            for _ in 0..16 {
+                let r = r_at(bx as f64 + rng.unit() - 0.5, by as f64 + rng.unit() - 0.5);
+                if rc > 0.0 {
+                    let q = r / rc;
+                    s1 += rc * q;
+                    s2 += rc * q * q;
+                    sw += rc;
+                }
+            }
+        }
+    }
+    let mean = s1 / sw;
+    eprintln!(
+        "R(point) / R(bin centre): mean {mean:.3}, rel sd {:.3}",
+        (s2 / sw - mean * mean).sqrt() / mean
+    );
+}
+
+/// The views of [`noise_at_shading_points`]: `THETAS="0,85"` or the default.
+fn th_list() -> Vec<(f64, f64)> {
+    match std::env::var("THETAS") {
+        Ok(s) => s.split(',').map(|t| (t.parse().unwrap(), 30.0)).collect(),
+        Err(_) => vec![(0.0, 0.0), (40.0, 30.0), (65.0, 100.0), (80.0, 200.0)],
+    }
+}
+
+/// The largest CIEDE2000 differences between two frames `A` and `B` (EXR),
+/// with their pixels and luminances.
+#[test]
+#[ignore]
+fn worst_pixels() {
+    use sunbeam_raster::LinearImage;
+    let a = LinearImage::read_exr(std::path::Path::new(&std::env::var("A").unwrap())).unwrap();
+    let b = LinearImage::read_exr(std::path::Path::new(&std::env::var("B").unwrap())).unwrap();
+    let mut d: Vec<(f64, usize)> = a
+        .rgb
+        .iter()
+        .zip(&b.rgb)
+        .enumerate()
+        .filter(|(_, (_, q))| {
+            sunbeam_raster::linear::luminance(**q) >= sunbeam_raster::linear::LIT_Y
+        })
+        .map(|(i, (p, q))| {
+            let xyz = |v: &[f32; 3]| colour::linear_srgb_to_xyz(v.map(|x| f64::from(x).max(0.0)));
+            (colour::ciede2000_xyz(xyz(p), xyz(q)), i)
+        })
+        .collect();
+    d.sort_by(|x, y| y.0.total_cmp(&x.0));
+    for &(e, i) in d.iter().take(25) {
+        eprintln!(
+            "dE {e:.1} at ({}, {}): Y {:.3} vs {:.3}",
+            i as u32 % a.width,
+            i as u32 / a.width,
+            sunbeam_raster::linear::luminance(a.rgb[i]),
+            sunbeam_raster::linear::luminance(b.rgb[i])
+        );
+    }
+}
