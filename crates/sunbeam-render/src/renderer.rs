@@ -400,7 +400,10 @@ impl Renderer {
                         }
                     };
                     let (table, dt) = pack_uniforms(&mut mu, pack, used, settings, lambda_min);
-                    if settings.mode == Mode::Default {
+                    // The point map serves point lights only: an environment scene
+                    // without any needs just the environment's maps (built below).
+                    let point_lit = environment.is_none() || !p.scene.lights.is_empty();
+                    if settings.mode == Mode::Default && point_lit {
                         let path = p.scene.meshes.get(mi).and_then(|m| m.pack.as_deref());
                         let t0 = std::time::Instant::now();
                         let (resp, note) =
