@@ -319,3 +319,57 @@ fn default_scene_is_sky_lit() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--lighting"));
 }
+
+/// The environment mode in a real window under Xvfb (`xvfb-run -a`): the
+/// sky-lit default scene accumulates in the window too, and the player's copy
+/// of its swapchain image after 4 frames is lit, not blank.
+#[test]
+fn window_shades_the_sky() {
+    if !sunbeam_common::testdata::have_command("xvfb-run", &["--help"]) {
+        return;
+    }
+    if !have_gpu() {
+        return;
+    }
+    let dir = tmp("window");
+    ridge_pack(&dir);
+    let shot = dir.join("window.png");
+    let o = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 640x480x24", BIN])
+        .args(["--mesh", "builtin:sphere", "--pack"])
+        .arg(dir.join("ridge.ktx2"))
+        .args([
+            "--size",
+            "96x96",
+            "--frames",
+            "4",
+            "--hold-secs",
+            "0.3",
+            "-o",
+        ])
+        .arg(&shot)
+        .output()
+        .unwrap();
+    let log = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "window run failed: {log}");
+    assert!(log.contains("window frames: n=4"), "{log}");
+    assert!(
+        log.contains("built the environment's response maps"),
+        "{log}"
+    );
+    let img = sunbeam_raster::Image::read_png(&shot)
+        .unwrap_or_else(|e| panic!("no screenshot ({e}): {log}"));
+    let (mean, sd) = img.mean_sd();
+    eprintln!(
+        "sky window {}x{} mean {mean:.3} sd {sd:.3}",
+        img.width, img.height
+    );
+    assert!(
+        mean > 0.02 && sd > 0.02,
+        "screenshot looks blank: mean {mean} sd {sd}"
+    );
+}
