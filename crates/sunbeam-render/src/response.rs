@@ -6,11 +6,11 @@
 //! builds the map itself, which takes seconds for large packs, and says so.
 //! Also the GPU texture of a map (the point map and the extended-light maps).
 
+use crate::gpu::Gpu;
 use std::path::Path;
 use std::sync::Arc;
 use sunbeam_common::Result;
 use sunbeam_pack::Pack;
-use crate::gpu::Gpu;
 use sunbeam_response::{ktx2, Response};
 use wgpu::util::DeviceExt;
 
