@@ -425,6 +425,14 @@ fn display(rgb: vec3<f32>) -> vec4<f32> {
     if (g.output == 2u) {
         var lin = rgb * g.exposure_scale;
         lin = select(lin, vec3<f32>(0.0), lin != lin);
+        // Under an environment the frame is one Monte Carlo estimate of a
+        // running mean (shaders/accumulate.wgsl): negative values (a sample's
+        // saturated colour outside the sRGB gamut, the maps' negative texels)
+        // stay, or clamping each frame biases the mean upwards (+2.5 % red on
+        // a ridge under a white map); the mean is clamped when displayed.
+        if (envg.on == 1u) {
+            return vec4<f32>(lin, 1.0);
+        }
         return vec4<f32>(max(lin, vec3<f32>(0.0)), 1.0);
     }
     var out = vec3<f32>(0.0);

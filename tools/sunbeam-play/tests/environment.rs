@@ -169,7 +169,7 @@ fn sky_lit_sphere_settles_to_the_reference() {
 }
 
 /// A white furnace: a constant white map (radiance 1) on the ridge quad seen
-/// head-on; the frame's centre equals the reference's.
+/// head-on; the frame's centre (512 frames) equals the reference's.
 #[test]
 fn white_furnace_on_the_quad_matches_the_reference_at_the_centre() {
     let dir = tmp("furnace");
@@ -196,7 +196,7 @@ fn white_furnace_on_the_quad_matches_the_reference_at_the_centre() {
     let refp = dir.join("ref.exr");
     let reference = reference(&scene, 64, &[1], &refp);
     let out = dir.join("f.exr");
-    let r = play(&scene, 64, &out, &refp);
+    let r = play(&scene, 512, &out, &refp);
     let frame = LinearImage::read_exr(&out).unwrap();
     let centre = |img: &LinearImage| {
         let mut s = [0.0f64; 3];
@@ -213,10 +213,13 @@ fn white_furnace_on_the_quad_matches_the_reference_at_the_centre() {
         s.map(|v| v / n)
     };
     let (a, b) = (centre(&frame), centre(&reference));
+    // Measured on lavapipe (512 frames): within 0.7 % per channel; the
+    // standard error of the ratio is ~0.8 % (the reference's 64 samples 0.4-0.7 %,
+    // the player's 0.3-0.5 %). Clamping each frame at 0 had made red +2.4 %.
     eprintln!("furnace centre: player {a:?} reference {b:?} ({r})");
     for c in 0..3 {
         assert!(
-            (a[c] / b[c] - 1.0).abs() < 0.05,
+            (a[c] / b[c] - 1.0).abs() < 0.025,
             "channel {c}: player {} vs reference {}",
             a[c],
             b[c]
