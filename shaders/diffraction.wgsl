@@ -116,6 +116,16 @@ struct VsOut {
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) tangent: vec3<f32>,
+    // The same at the centroid of the pixel's covered samples (MSAA): the
+    // environment's Monte Carlo estimate shades there, on the surface. At the
+    // pixel centre a silhouette pixel extrapolates its attributes past the
+    // triangle: the view can fall below the horizon (black pixels) or just
+    // above it, where the gain G grows as 1 / cos(theta_r) (fireflies that no
+    // number of frames averages away). The point lights keep the centre,
+    // whose screen derivatives the footprint filter needs.
+    @location(3) @interpolate(perspective, centroid) world_c: vec3<f32>,
+    @location(4) @interpolate(perspective, centroid) normal_c: vec3<f32>,
+    @location(5) @interpolate(perspective, centroid) tangent_c: vec3<f32>,
 };
 
 @vertex
@@ -125,6 +135,9 @@ fn vs_main(v: VsIn) -> VsOut {
     o.world = v.pos;
     o.normal = v.normal;
     o.tangent = v.tangent.xyz;
+    o.world_c = v.pos;
+    o.normal_c = v.normal;
+    o.tangent_c = v.tangent.xyz;
     return o;
 }
 
@@ -460,10 +473,11 @@ fn xyz_to_rgb(c: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(g.xyz_to_rgb[0].xyz, c), dot(g.xyz_to_rgb[1].xyz, c), dot(g.xyz_to_rgb[2].xyz, c));
 }
 
-@fragment
-fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
-    let n = normalize(in.normal);
-    var t = in.tangent - n * dot(n, in.tangent);
+// The local frame (columns t, b, n) of an interpolated normal and
+// orientation: t made orthogonal to n (any perpendicular when degenerate).
+fn shading_frame(normal: vec3<f32>, tangent: vec3<f32>) -> mat3x3<f32> {
+    let n = normalize(normal);
+    var t = tangent - n * dot(n, tangent);
     if (length(t) < 1e-12) {
         var a = vec3<f32>(1.0, 0.0, 0.0);
         if (abs(n.x) >= 0.9) {
@@ -472,7 +486,15 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         t = a - n * dot(n, a);
     }
     t = normalize(t);
-    let b = cross(n, t);
+    return mat3x3<f32>(t, cross(n, t), n);
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    let fr = shading_frame(in.normal, in.tangent);
+    let t = fr[0];
+    let b = fr[1];
+    let n = fr[2];
     let wr = normalize(g.eye.xyz - in.world);
     let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
     let base = mat.base.xyz;
@@ -515,7 +537,10 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     // The scene's environment (shaders/environment.wgsl): one Monte Carlo
     // estimate per frame, accumulated by the caller.
     if (envg.on == 1u) {
-        rgb = rgb + env_shade(t, b, n, wr_l, base, dw, diffract, vec2<u32>(in.clip.xy));
+        let fc = shading_frame(in.normal_c, in.tangent_c);
+        let wr_c = normalize(g.eye.xyz - in.world_c);
+        let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
+        rgb = rgb + env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, vec2<u32>(in.clip.xy));
     }
     return display(rgb);
 }

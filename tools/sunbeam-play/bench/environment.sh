@@ -11,8 +11,11 @@
 # reference's own noise), then the player's settled frame (`--headless --frames
 # N`) for each N against the mean, and the player's frame time while moving
 # (`--bench`, the sum reset every frame, against `--lambert` in the same run) at
-# 512 x 512. Prints a markdown table. Environment: RES (frame size, default 64),
-# REF_SAMPLES (default 256), SUNBEAM_BIN (the folder of the binaries).
+# 512 x 512. Prints a markdown table. Environment: RES (the sphere's frame
+# size, default 64), SNAKE_W and SNAKE_H (the snake's, default 384 x 216),
+# REF_SAMPLES (default 256), SCENES (default "sphere snake"), SUPERSAMPLE (the
+# player's --supersample, default 1), SUNBEAM_BIN (the
+# folder of the binaries).
 set -euo pipefail
 out=${1:?usage: environment.sh OUT_DIR PACK.ktx2 SNAKE.glb [FRAMES ...]}
 pack=$(realpath "${2:?pack}")
@@ -23,6 +26,10 @@ frames=("$@")
 root=$(cd "$(dirname "$0")/../../.." && pwd)
 bin=${SUNBEAM_BIN:-$(cd "$root" && cargo metadata --format-version 1 --no-deps | python3 -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')/release}
 res=${RES:-64}
+# The snake is a few percent of its frame: at 64 px high it is 3-5 px thick
+# and nearly every pixel is a silhouette; 384 x 216 gives it ~15 px.
+snake_w=${SNAKE_W:-384}
+snake_h=${SNAKE_H:-216}
 ref_samples=${REF_SAMPLES:-256}
 mkdir -p "$out"
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(d=${TMPDIR:-/tmp}/sunbeam-xdg-$(id -u); mkdir -p -m 700 "$d"; echo "$d")}
@@ -35,13 +42,13 @@ JSON
 cat > "$out/snake.json" <<JSON
 { "camera": { "eye": [0.0, -0.55, 1.05], "target": [0.0, -0.01, 0.0], "up": [0, 1, 0], "fov_y_deg": 28 },
   "meshes": [ { "mesh": "$snake", "pack": "$pack", "base_color": [0.03, 0.03, 0.035], "diffuse_weight": 0.15 } ],
-  $sky, "exposure": -1.5, "size": [$((res * 16 / 9 / 2 * 2)), $res] }
+  $sky, "exposure": -1.5, "size": [$snake_w, $snake_h] }
 JSON
 cie() { sed -E 's/.*mean ([0-9.]+) p99 ([0-9.]+) max ([0-9.]+).*/\1 \/ \2 \/ \3/'; }
 j() { python3 -c "import json,sys; d=json.load(sys.stdin); print($1)"; }
 echo "| scene | what | seconds | CIEDE2000 mean / p99 / max |"
 echo "|---|---|---|---|"
-for scene in sphere snake; do
+for scene in ${SCENES:-sphere snake}; do
   s="$out/$scene.json"
   # The references are kept in OUT_DIR: a second run with other FRAMES reuses them.
   if [ ! -f "$out/$scene-ref.exr" ]; then
@@ -55,7 +62,7 @@ for scene in sphere snake; do
   cat "$out/$scene-ref.row"
   for n in "${frames[@]}"; do
     t0=$(date +%s.%N)
-    r=$("$bin/sunbeam-play" "$s" --headless --supersample 1 --frames "$n" -o "$out/$scene-play-$n.exr" --compare "$out/$scene-ref.exr" --json 2>/dev/null)
+    r=$("$bin/sunbeam-play" "$s" --headless --supersample "${SUPERSAMPLE:-1}" --frames "$n" -o "$out/$scene-play-$n.exr" --compare "$out/$scene-ref.exr" --json 2>/dev/null)
     t1=$(date +%s.%N)
     echo "| $scene | player, $n frames, vs the mean of the two seeds | $(echo "$t1 - $t0" | bc) | $(echo "$r" | j "'%.2f / %.2f / %.2f' % (d['ciede2000']['mean'], d['ciede2000']['p99'], d['ciede2000']['max'])") |"
   done

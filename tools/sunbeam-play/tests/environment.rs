@@ -162,10 +162,13 @@ fn sky_lit_sphere_settles_to_the_reference() {
     eprintln!("player: {:.1} s, {r}", t.elapsed().as_secs_f64());
     assert_eq!(r["accumulated_frames"].as_u64(), Some(256));
     let d = p99(&r);
-    // Measured on lavapipe: p99 ~25 at 256 frames, while two seeds of the
-    // reference itself differ by p99 ~17 at 256 samples (its noise floor); the
-    // issue's p99 < 2 needs a far less noisy reference (docs/bench/play.md).
-    assert!(d < 35.0, "CIEDE2000 p99 {d} (report {r})");
+    // Measured on lavapipe: p99 12.6 at 256 frames (deterministic: both
+    // estimators are seeded), of which most is the reference's own noise at
+    // 256 samples; the p99 < 2 needs a far less noisy reference
+    // (docs/bench/play.md "Environment mode"). Before the per-frame clamp was
+    // removed (a bias of +2.4 % in red) and with the proposal weighed at cell
+    // centres, 15-25.
+    assert!(d < 16.0, "CIEDE2000 p99 {d} (report {r})");
 }
 
 /// A white furnace: a constant white map (radiance 1) on the ridge quad seen
