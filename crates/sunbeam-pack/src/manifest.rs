@@ -153,6 +153,23 @@ pub struct Manifest {
 }
 
 impl Manifest {
+    /// The pack's coherent area `A` (m^2), the factor of the BRDF for extended
+    /// light (docs/LIGHTING.md "The factor"): window `(sum g)^2 / sum g^2 dx dy`,
+    /// tiled `1 / (2 pi sigma_f^2)`. One definition for the reference and the
+    /// player's maps.
+    pub fn coherent_area_m2(&self) -> f64 {
+        match self.model {
+            Model::Window => sunbeam_optics::truth::window_coherent_area_m2(
+                self.patch.width,
+                self.patch.height,
+                self.patch.dx_m,
+                self.patch.dy_m,
+                self.window_sigma_m,
+            ),
+            Model::Tiled => sunbeam_optics::truth::tiled_coherent_area_m2(self.sigma_f_per_m),
+        }
+    }
+
     /// Serialise as compact JSON (deterministic field order).
     pub fn to_json(&self) -> String {
         serde_json::to_string(self).expect("manifest serialises")

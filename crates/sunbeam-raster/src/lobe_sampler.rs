@@ -204,16 +204,7 @@ impl LobeSampler {
             }
             pyramids[l] = coarse;
         }
-        let area_m2 = match m.model {
-            Model::Window => sunbeam_optics::truth::window_coherent_area_m2(
-                m.patch.width,
-                m.patch.height,
-                m.patch.dx_m,
-                m.patch.dy_m,
-                m.window_sigma_m,
-            ),
-            Model::Tiled => sunbeam_optics::truth::tiled_coherent_area_m2(m.sigma_f_per_m),
-        };
+        let area_m2 = m.coherent_area_m2();
         let origin = [
             sub as f64 * (m.crop.kx as f64 + 0.5) - 0.5,
             sub as f64 * (m.crop.ky as f64 + 0.5) - 0.5,

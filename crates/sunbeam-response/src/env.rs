@@ -22,7 +22,7 @@ use crate::grid::Grid;
 use crate::Response;
 use sunbeam_light::Environment;
 use sunbeam_optics::{cie, colour, gain};
-use sunbeam_pack::{Model, Pack};
+use sunbeam_pack::Pack;
 
 pub use crate::proposal::Proposal;
 
@@ -106,17 +106,7 @@ fn proposal_maps<'a>(env: &Environment, basis: &'a [Response]) -> Vec<&'a Respon
 /// `LobeSampler::area_m2`: window `(sum g)^2 / sum g^2 dx dy`, tiled
 /// `1 / (2 pi sigma_f^2)` (docs/LIGHTING.md "The factor").
 pub fn coherent_area_m2(pack: &Pack) -> f64 {
-    let m = &pack.manifest;
-    match m.model {
-        Model::Window => sunbeam_optics::truth::window_coherent_area_m2(
-            m.patch.width,
-            m.patch.height,
-            m.patch.dx_m,
-            m.patch.dy_m,
-            m.window_sigma_m,
-        ),
-        Model::Tiled => sunbeam_optics::truth::tiled_coherent_area_m2(m.sigma_f_per_m),
-    }
+    pack.manifest.coherent_area_m2()
 }
 
 /// The weight sets of the extended-light maps at `n` midpoint wavelengths:
