@@ -1,11 +1,11 @@
-//! Measurement, not a check (ignored): the environment estimator's noise at
+//! Measurement, not a check (`test = false` in Cargo.toml: `cargo test` does not run it): the environment estimator's noise at
 //! single shading points (docs/LIGHTING.md "Noise"). For a pack (the ridge
 //! field below, or `SUNBEAM_PACK=path.ktx2`), a few views under a constant
 //! white map and under the sky, it prints the mean Y, one sample's relative
 //! standard deviation of Y, and the relative standard deviation of X, Y, Z
 //! of a 256-sample pixel (wavelengths stratified as in the renderer) over 48
 //! pixels.
-//!   cargo test --release -p sunbeam-raster --test env_noise -- --ignored --nocapture
+//!   cargo test --release -p sunbeam-raster --test env_noise -- --nocapture
 //! `THETAS=85,89` picks the views; `FIXED_LAMBDA=0.37` holds the wavelengths
 //! constant (the spectral share of the noise); `lobe_technique_alone`,
 //! `r_inside_bins` and `worst_pixels` (`A=a.exr B=b.exr`) dissect the rest.
@@ -36,7 +36,6 @@ fn ridge_pack() -> Arc<Pack> {
 }
 
 #[test]
-#[ignore]
 fn noise_at_shading_points() {
     let pack = match std::env::var("SUNBEAM_PACK") {
         Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
@@ -109,7 +108,6 @@ fn noise_at_shading_points() {
 /// deviation of `f / p` (the proposal's mismatch with the integrand), and the
 /// share of the second moment held by the largest 1 % of the weights.
 #[test]
-#[ignore]
 fn lobe_technique_alone() {
     let pack = match std::env::var("SUNBEAM_PACK") {
         Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
@@ -166,7 +164,6 @@ fn lobe_technique_alone() {
 /// How much R varies inside a bin: points uniform in bins drawn by their
 /// centre's R, the relative sd of R(point) / R(centre) (at fixed w = -2).
 #[test]
-#[ignore]
 fn r_inside_bins() {
     let pack = match std::env::var("SUNBEAM_PACK") {
         Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
@@ -214,7 +211,6 @@ fn th_list() -> Vec<(f64, f64)> {
 /// The largest CIEDE2000 differences between two frames `A` and `B` (EXR),
 /// with their pixels and luminances.
 #[test]
-#[ignore]
 fn worst_pixels() {
     use sunbeam_raster::LinearImage;
     let a = LinearImage::read_exr(std::path::Path::new(&std::env::var("A").unwrap())).unwrap();
