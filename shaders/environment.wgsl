@@ -246,6 +246,43 @@ fn env_cell_weight(l: u32, x: u32, y: u32, wr: vec3<f32>) -> f32 {
     return fallback * 0.05;
 }
 
+// The children at level l - 1 of cell (x, y) of level l, in the order y
+// outer, x inner (slot 2 cy + cx; 0 where a side did not halve), and their
+// weights for view wr: what the draw (env_descend) and the density of a
+// given point (env_pdf) both weigh.
+struct EnvChildren {
+    x0: u32,
+    y0: u32,
+    e: array<f32, 4>,
+    total: f32,
+};
+
+fn env_children(l: u32, x: u32, y: u32, wr: vec3<f32>) -> EnvChildren {
+    let lc = l - 1u;
+    var nx = 1u;
+    if (env_w(lc) > env_w(l)) {
+        nx = 2u;
+    }
+    var ny = 1u;
+    if (env_h(lc) > env_h(l)) {
+        ny = 2u;
+    }
+    var out: EnvChildren;
+    out.x0 = x * nx;
+    out.y0 = y * ny;
+    out.e = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
+    out.total = 0.0;
+    for (var c = 0u; c < 4u; c = c + 1u) {
+        let cx = c & 1u;
+        let cy = c >> 1u;
+        if (cx < nx && cy < ny) {
+            out.e[c] = env_cell_weight(lc, out.x0 + cx, out.y0 + cy, wr);
+            out.total = out.total + out.e[c];
+        }
+    }
+    return out;
+}
+
 // Density per unit (u, v) with which env_descend draws uv for view wr
 // (Proposal::pdf): the descent repeated along the level-0 cell holding uv.
 fn env_pdf(wr: vec3<f32>, uv: vec2<f32>) -> f32 {
@@ -272,30 +309,10 @@ fn env_pdf(wr: vec3<f32>, uv: vec2<f32>) -> f32 {
     var y = 0u;
     for (var l = envp.top; l > 0u; l = l - 1u) {
         let lc = l - 1u;
-        var nx = 1u;
-        if (env_w(lc) > env_w(l)) {
-            nx = 2u;
-        }
-        var ny = 1u;
-        if (env_h(lc) > env_h(l)) {
-            ny = 2u;
-        }
-        let x0 = x * nx;
-        let y0 = y * ny;
+        var ch = env_children(l, x, y, wr);
         let want = vec2<u32>(i / (envp.pw / env_w(lc)), j / (envp.ph / env_h(lc)));
-        var total = 0.0;
-        var mine = 0.0;
-        for (var c = 0u; c < 4u; c = c + 1u) {
-            let cx = c & 1u;
-            let cy = c >> 1u;
-            if (cx < nx && cy < ny) {
-                let e = env_cell_weight(lc, x0 + cx, y0 + cy, wr);
-                total = total + e;
-                if (x0 + cx == want.x && y0 + cy == want.y) {
-                    mine = e;
-                }
-            }
-        }
+        let total = ch.total;
+        let mine = ch.e[(want.y - ch.y0) * 2u + (want.x - ch.x0)];
         if (!(total > 0.0 && mine > 0.0)) {
             return 0.0;
         }
@@ -349,26 +366,11 @@ fn env_descend(wr: vec3<f32>, u: vec3<f32>, q: u32) -> EnvDraw {
         if (l != envp.top) {
             u0 = env_rand(q + 3u + l);
         }
-        var nx = 1u;
-        if (env_w(lc) > env_w(l)) {
-            nx = 2u;
-        }
-        var ny = 1u;
-        if (env_h(lc) > env_h(l)) {
-            ny = 2u;
-        }
-        let x0 = x * nx;
-        let y0 = y * ny;
-        var e = array<f32, 4>(0.0, 0.0, 0.0, 0.0);
-        var total = 0.0;
-        for (var c = 0u; c < 4u; c = c + 1u) {
-            let cx = c & 1u;
-            let cy = c >> 1u;
-            if (cx < nx && cy < ny) {
-                e[c] = env_cell_weight(lc, x0 + cx, y0 + cy, wr);
-                total = total + e[c];
-            }
-        }
+        var ch = env_children(l, x, y, wr);
+        let x0 = ch.x0;
+        let y0 = ch.y0;
+        var e = ch.e;
+        let total = ch.total;
         if (!(total > 0.0)) {
             return out;
         }
