@@ -24,6 +24,7 @@
 pub mod daylight;
 pub mod environment;
 pub mod io;
+pub mod irradiance;
 pub mod rgb_spectrum;
 pub mod sky;
 

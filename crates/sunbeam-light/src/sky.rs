@@ -297,6 +297,15 @@ impl Sky {
         Some((d, 1.0 / self.sun_solid_angle()))
     }
 
+    /// XYZ of the sun disc's radiance (scene units; zero when the sun is down).
+    pub fn sun_xyz(&self) -> [f64; 3] {
+        if self.sun_is_up() {
+            self.sun_xyz
+        } else {
+            [0.0; 3]
+        }
+    }
+
     /// Solid angle of the sun's disc (sr).
     pub fn sun_solid_angle(&self) -> f64 {
         2.0 * PI * (1.0 - self.sun_cos_max)

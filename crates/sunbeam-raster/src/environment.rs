@@ -1,6 +1,17 @@
-//! Environment lighting in the reference: the integral over incoming directions
-//! by Monte Carlo (docs/LIGHTING.md "The reference's estimator"). Per sub-pixel
-//! sample, [`HERO`] wavelengths and up to three directions:
+//! Environment lighting in the reference: the integral over incoming
+//! directions (docs/LIGHTING.md "The reference's estimator"), by one of two
+//! estimators ([`EnvEstimator`]):
+//!
+//! - **quadrature** (the default): per sub-pixel sample, the sum over the
+//!   texels of the pack's extended-light maps
+//!   ([`sunbeam_response::quadrature`]), interleaved over the pixel's samples
+//!   ([`EnvShader::shade_pixel`]), the sun at a point of its disc, the diffuse
+//!   part from the environment's tabulated irradiance
+//!   ([`sunbeam_light::irradiance`]): no noise but the sub-pixel positions';
+//! - **Monte Carlo** ([`EnvShader::sample`]), which evaluates the pack's `R`
+//!   per wavelength and direction and shares no code with the maps: the check
+//!   of the quadrature. Per sub-pixel sample, [`HERO`] wavelengths and up to
+//!   three directions:
 //!
 //! - a hero wavelength uniform over 380..780 nm, stratified over the pixel's
 //!   samples by the caller, and its rotations by `1 / HERO` of the range (hero
@@ -33,8 +44,37 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 use sunbeam_common::rng::SplitMix64;
 use sunbeam_light::Environment;
+use sunbeam_light::irradiance::Irradiance;
 use sunbeam_optics::{cie, colour};
 use sunbeam_pack::Pack;
+use sunbeam_response::quadrature::{EnvQuadrature, Query};
+
+/// How the reference integrates an environment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EnvEstimator {
+    /// The sum over the extended-light maps' texels (no direction noise).
+    #[default]
+    Quadrature,
+    /// Monte Carlo with the pack's `R` per wavelength (the independent check).
+    MonteCarlo,
+}
+
+/// Largest number of interleaved classes a pixel's samples share ([`EnvShader::shade_pixel`]).
+pub const MAX_PARTS: usize = 64;
+
+/// One covered sub-pixel sample of a pixel for [`EnvShader::shade_pixel`].
+#[derive(Debug, Clone, Copy)]
+pub struct Fragment {
+    pub mesh: usize,
+    pub frame: Frame,
+    /// View direction (world, unit).
+    pub wr: [f64; 3],
+    pub base: [f64; 3],
+    /// Diffuse weight.
+    pub dw: f64,
+    /// Two uniforms for the point of the sun's disc.
+    pub sun_u: [f64; 2],
+}
 
 /// Wavelength range of the integral (nm).
 const RANGE_NM: (u32, u32) = cie::DEFAULT_RANGE_NM;
@@ -103,6 +143,9 @@ pub struct EnvShader {
     pub env: Arc<Environment>,
     /// Per mesh of the scene: its pack's sampler (None without a pack).
     lobes: Vec<Option<LobeSampler>>,
+    /// Per mesh: its pack's extended-light maps (quadrature only).
+    quads: Vec<Option<Arc<EnvQuadrature>>>,
+    irradiance: Option<Irradiance>,
     norm: f64,
 }
 
@@ -111,7 +154,41 @@ pub type Frame = ([f64; 3], [f64; 3], [f64; 3]);
 
 impl EnvShader {
     pub fn new(env: Arc<Environment>, packs: &[Option<Arc<Pack>>]) -> EnvShader {
+        Self::with_estimator(env, packs, EnvEstimator::MonteCarlo)
+    }
+
+    /// The shader for `estimator`: under [`EnvEstimator::Quadrature`] each
+    /// distinct pack's maps are built once (1-3 s for the demo's packs).
+    pub fn with_estimator(
+        env: Arc<Environment>,
+        packs: &[Option<Arc<Pack>>],
+        estimator: EnvEstimator,
+    ) -> EnvShader {
+        let mut quads: Vec<Option<Arc<EnvQuadrature>>> = Vec::with_capacity(packs.len());
+        let mut irradiance = None;
+        if estimator == EnvEstimator::Quadrature {
+            for (i, p) in packs.iter().enumerate() {
+                let q = p.as_ref().filter(|p| p.has_terms()).map(|p| {
+                    // Meshes that share a pack share its maps.
+                    let same = packs[..i]
+                        .iter()
+                        .position(|o| o.as_ref().is_some_and(|o| Arc::ptr_eq(o, p)));
+                    match same.and_then(|k| quads[k].clone()) {
+                        Some(q) => q,
+                        None => Arc::new(EnvQuadrature::build(
+                            p,
+                            &env,
+                            &EnvQuadrature::reference_options(),
+                        )),
+                    }
+                });
+                quads.push(q);
+            }
+            irradiance = Some(Irradiance::new(&env));
+        }
         EnvShader {
+            quads,
+            irradiance,
             env,
             lobes: packs
                 .iter()
@@ -123,6 +200,94 @@ impl EnvShader {
                 .collect(),
             norm: cie::d65_y_norm(RANGE_NM),
         }
+    }
+
+    /// True when the shader runs the quadrature ([`EnvShader::shade_pixel`]).
+    pub fn is_quadrature(&self) -> bool {
+        self.irradiance.is_some()
+    }
+
+    /// The quadrature estimator's radiance (linear sRGB) of the covered
+    /// samples `frags` of one pixel, in their order.
+    ///
+    /// Interleaved sampling (Keller and Heidrich 2001): the samples of each
+    /// mesh share the texels of its maps. With `m` samples of a mesh, the
+    /// texels are split into `K` classes (`K` the largest of 64, 16, 4, 1 not
+    /// above `m`), the samples are dealt the classes in turn after a random
+    /// permutation from `rng` (so every class has `m / K` samples, give or
+    /// take one), and a sample of class `c` with `m_c` members sums its class
+    /// with weight `m / m_c` (times `K` inside the sum over one class): the
+    /// pixel gets every texel once per mesh, each class's share from the mean
+    /// over its samples. Unbiased over the permutation; where the integrand
+    /// does not change over the pixel, exact.
+    pub fn shade_pixel(&self, frags: &[Fragment], rng: &mut SplitMix64) -> Vec<[f64; 3]> {
+        let mut out = vec![[0.0; 3]; frags.len()];
+        let Some(irr) = &self.irradiance else {
+            return out;
+        };
+        let local = |f: &Fragment| {
+            let (t, b, n) = f.frame;
+            [dot(f.wr, t), dot(f.wr, b), dot(f.wr, n)]
+        };
+        // Diffuse: base / pi times the irradiance at the normal.
+        for (f, o) in frags.iter().zip(out.iter_mut()) {
+            if f.dw > 0.0 && local(f)[2] > 0.0 {
+                let e = irr.at(f.frame.2);
+                for c in 0..3 {
+                    o[c] += f.dw * f.base[c] * e[c] / PI;
+                }
+            }
+        }
+        let mut meshes: Vec<usize> = frags.iter().map(|f| f.mesh).collect();
+        meshes.sort_unstable();
+        meshes.dedup();
+        for mi in meshes {
+            let Some(quad) = self.quads.get(mi).and_then(|q| q.as_ref()) else {
+                continue;
+            };
+            let members: Vec<usize> = (0..frags.len())
+                .filter(|&k| frags[k].mesh == mi && frags[k].dw < 1.0)
+                .collect();
+            let m = members.len();
+            if m == 0 {
+                continue;
+            }
+            let parts = [MAX_PARTS, 16, 4, 1]
+                .into_iter()
+                .find(|&k| k <= m)
+                .unwrap_or(1);
+            let mut perm: Vec<usize> = (0..parts).collect();
+            for i in (1..parts).rev() {
+                let j = ((rng.unit() * (i + 1) as f64) as usize).min(i);
+                perm.swap(i, j);
+            }
+            let mut classes: Vec<Vec<usize>> = vec![Vec::new(); parts];
+            for (r, &k) in members.iter().enumerate() {
+                classes[perm[r % parts]].push(k);
+            }
+            for (c, ks) in classes.iter().enumerate() {
+                if ks.is_empty() {
+                    continue;
+                }
+                let queries: Vec<Query> = ks
+                    .iter()
+                    .map(|&k| Query {
+                        frame: frags[k].frame,
+                        wr: local(&frags[k]),
+                        sun_u: frags[k].sun_u,
+                    })
+                    .collect();
+                let weight = m as f64 / (parts * ks.len()) as f64;
+                for (&k, xyz) in ks.iter().zip(quad.integrate_many(&self.env, &queries, (c, parts))) {
+                    let rgb = colour::xyz_to_linear_srgb(xyz);
+                    let f = &frags[k];
+                    for a in 0..3 {
+                        out[k][a] += (1.0 - f.dw) * weight * rgb[a];
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// The generator of sample `k` of pixel `pixel` under `seed`.

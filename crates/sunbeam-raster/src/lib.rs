@@ -62,6 +62,8 @@ pub struct Options {
     /// Seed of the environment's Monte Carlo sampling (frames with different
     /// seeds differ by the estimator's noise only).
     pub seed: u64,
+    /// How an environment is integrated ([`environment::EnvEstimator`]).
+    pub estimator: environment::EnvEstimator,
 }
 
 /// The grid side `s` of `samples = s * s` per pixel, or a usage error.
@@ -282,7 +284,7 @@ fn render_environment(
     let [w, h] = opts.size.unwrap_or(p.scene.size);
     let (sw, sh) = (w * s, h * s);
     let packs: Vec<_> = p.meshes.iter().map(|(_, m)| m.pack.clone()).collect();
-    let es = environment::EnvShader::new(env, &packs);
+    let es = environment::EnvShader::with_estimator(env, &packs, opts.estimator);
     let shader = shade::Shader::new(p, opts);
     let scale = p.scene.exposure.exp2();
     let eye = p.scene.camera.eye;
@@ -300,6 +302,9 @@ fn render_environment(
                 let pixel = (y * w as usize + x) as u64;
                 let uniforms = environment::pixel_uniforms(opts.seed, pixel, n);
                 let mut acc = [0.0; 3];
+                // Under the quadrature, the covered samples are shaded
+                // together (they share the maps' texels).
+                let mut frags: Vec<environment::Fragment> = Vec::new();
                 for k in 0..n {
                     let (sx, sy) = ((k % s as u64) as usize, (k / s as u64) as usize);
                     let f = &gbuf[(jr * s as usize + sy) * sw as usize + x * s as usize + sx];
@@ -319,14 +324,33 @@ fn render_environment(
                             } else {
                                 1.0
                             };
-                            let e = es.sample(mi, fr, wr, mat.base_color, dw, u);
-                            for i in 0..3 {
-                                c[i] += e[i];
+                            if es.is_quadrature() {
+                                frags.push(environment::Fragment {
+                                    mesh: mi,
+                                    frame: fr,
+                                    wr,
+                                    base: mat.base_color,
+                                    dw,
+                                    sun_u: [u.lobe[0], u.env[1]],
+                                });
+                            } else {
+                                let e = es.sample(mi, fr, wr, mat.base_color, dw, u);
+                                for i in 0..3 {
+                                    c[i] += e[i];
+                                }
                             }
                         }
                     }
                     for i in 0..3 {
                         acc[i] += c[i];
+                    }
+                }
+                if !frags.is_empty() {
+                    let mut rng = environment::EnvShader::rng(opts.seed, pixel, u64::MAX - 1);
+                    for e in es.shade_pixel(&frags, &mut rng) {
+                        for i in 0..3 {
+                            acc[i] += e[i];
+                        }
                     }
                 }
                 *px = acc.map(|v| (v / n as f64 * scale) as f32);

@@ -20,6 +20,7 @@ pub mod grid;
 pub mod ktx2;
 pub mod nvr;
 pub mod proposal;
+pub mod quadrature;
 
 pub use build::{build, Options};
 pub use env::{build_env, EnvResponse};

@@ -209,6 +209,12 @@ pub(crate) struct RenderArgs {
     /// more than once, the frame is the mean of the seeds' frames in linear light.
     #[arg(long, default_values_t = [1u64], action = clap::ArgAction::Append)]
     pub(crate) seed: Vec<u64>,
+    /// How an `environment` is integrated: `quadrature` (default: the sum over
+    /// the pack's extended-light maps, no direction noise) or `monte-carlo`
+    /// (the pack's R per wavelength and direction, the independent check);
+    /// docs/LIGHTING.md "The reference's estimator".
+    #[arg(long, default_value = "quadrature", value_parser = clap::builder::PossibleValuesParser::new(["quadrature", "monte-carlo"]))]
+    pub(crate) env_estimator: String,
     /// A turntable of N frames: the camera orbits the target about its `up`
     /// axis (lights and environment stay); -o FILE.png is an animated PNG.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=720))]

@@ -57,6 +57,10 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
     let opts = sunbeam_raster::Options {
         samples,
         seed: a.seed[0],
+        estimator: match a.env_estimator.as_str() {
+            "monte-carlo" => sunbeam_raster::environment::EnvEstimator::MonteCarlo,
+            _ => sunbeam_raster::environment::EnvEstimator::Quadrature,
+        },
         ..Default::default()
     };
     sunbeam_raster::samples_side(samples)?;
