@@ -228,6 +228,58 @@ fn worst_pixels() {
             (colour::ciede2000_xyz(xyz(p), xyz(q)), i)
         })
         .collect();
+    // Interior pixels (all 8 neighbours lit) against silhouette pixels, and
+    // the interior's luminance ratio: a bias shows in the ratio and in the
+    // 2 x 2 block average, noise falls with the blocks.
+    let (w, h) = (a.width as usize, a.height as usize);
+    let lit = |x: usize, y: usize| {
+        sunbeam_raster::linear::luminance(b.rgb[y * w + x]) >= sunbeam_raster::linear::LIT_Y
+    };
+    let interior = |i: usize| {
+        let (x, y) = (i % w, i / w);
+        x > 0 && y > 0 && x + 1 < w && y + 1 < h && (0..9).all(|k| lit(x + k % 3 - 1, y + k / 3 - 1))
+    };
+    let pct = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let n = v.len().max(1);
+        let m = v.iter().sum::<f64>() / n as f64;
+        format!("{} px: mean {m:.2} p99 {:.2} max {:.2}", v.len(), v.get((n - 1) * 99 / 100).copied().unwrap_or(0.0), v.last().copied().unwrap_or(0.0))
+    };
+    let (inner, edge): (Vec<&(f64, usize)>, Vec<&(f64, usize)>) = d.iter().partition(|(_, i)| interior(*i));
+    eprintln!("interior {}", pct(inner.iter().map(|x| x.0).collect()));
+    eprintln!("silhouette {}", pct(edge.iter().map(|x| x.0).collect()));
+    let (mut ya, mut yb) = (0.0, 0.0);
+    for &&(_, i) in &inner {
+        ya += sunbeam_raster::linear::luminance(a.rgb[i]);
+        yb += sunbeam_raster::linear::luminance(b.rgb[i]);
+    }
+    eprintln!("interior Y ratio {:.4}", ya / yb);
+    for k in [2, 4] {
+        let d2 = sunbeam_raster::compare_linear(&a.downsample(k), &b.downsample(k)).unwrap();
+        eprintln!("{k} x {k} blocks: {d2}");
+    }
+    {
+        let (a4, b4) = (a.downsample(4), b.downsample(4));
+        let xyz = |v: &[f32; 3]| colour::linear_srgb_to_xyz(v.map(|x| f64::from(x).max(0.0)));
+        let mut e4: Vec<(f64, usize)> = (0..a4.rgb.len())
+            .filter(|&i| sunbeam_raster::linear::luminance(b4.rgb[i]) >= sunbeam_raster::linear::LIT_Y)
+            .map(|i| (colour::ciede2000_xyz(xyz(&a4.rgb[i]), xyz(&b4.rgb[i])), i))
+            .collect();
+        e4.sort_by(|x, y| y.0.total_cmp(&x.0));
+        for &(e, i) in e4.iter().take(10) {
+            let (p, q) = (xyz(&a4.rgb[i]), xyz(&b4.rgb[i]));
+            let s = |v: [f64; 3]| [v[0] / (v[0] + v[1] + v[2]), v[1] / (v[0] + v[1] + v[2])];
+            eprintln!(
+                "block dE {e:.2} at ({}, {}): Y {:.3} vs {:.3}, xy {:.4?} vs {:.4?}",
+                i as u32 % a4.width,
+                i as u32 / a4.width,
+                p[1],
+                q[1],
+                s(p),
+                s(q)
+            );
+        }
+    }
     d.sort_by(|x, y| y.0.total_cmp(&x.0));
     for &(e, i) in d.iter().take(25) {
         eprintln!(

@@ -1,8 +1,9 @@
 //! Environment lighting in the reference renderer (docs/LIGHTING.md): the
-//! furnace through the whole renderer, the Monte Carlo estimator against a
-//! deterministic quadrature with the float64 truth (no pack code, no sampling),
-//! seed-to-seed noise, and rotation of the environment against rotation of
-//! the scene.
+//! furnace through the whole renderer (both estimators), the Monte Carlo
+//! estimator against a deterministic quadrature with the float64 truth (no
+//! pack code, no sampling), the maps' quadrature against Monte Carlo over a
+//! whole frame, seed-to-seed noise, and rotation of the environment against
+//! rotation of the scene.
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -10,7 +11,7 @@ use sunbeam_light::{sky::Sky, EnvMap, Environment};
 use sunbeam_optics::truth::{Params, Truth};
 use sunbeam_optics::{cie, colour, gain};
 use sunbeam_pack::{build::BuildOptions, FieldRef, Model, Pack};
-use sunbeam_raster::environment::{EnvShader, Frame, Uniforms};
+use sunbeam_raster::environment::{EnvEstimator, EnvShader, Frame, Uniforms};
 use sunbeam_raster::{compare_linear, fixtures, render_prepared_linear, LinearImage, Options};
 
 /// A ridge field like snake skin, scaled down: sinusoidal ridges of `period`
@@ -73,9 +74,10 @@ fn mean_y(img: &LinearImage, x0: u32, x1: u32) -> f64 {
 
 /// Furnace: a flat patch seen head-on under a constant white environment of
 /// radiance 1 shows radiance 1 (the specular gain at normal incidence, PHYSICS.md 2),
-/// within 1 %, for a small and a large patch and both models: the estimator
-/// at the patch's centre (200 000 samples), then a whole frame (within 3 %:
-/// fewer samples per pixel).
+/// within 1 %, for a small and a large patch and both models: the Monte Carlo
+/// estimator at the patch's centre (200 000 samples), then a whole frame by
+/// the quadrature (within 1 %) and by Monte Carlo (within 3 %: fewer samples
+/// per pixel).
 #[test]
 fn furnace_through_the_renderer() {
     for (n, dx, model) in [
@@ -96,27 +98,30 @@ fn furnace_through_the_renderer() {
         scene.camera.eye = [0.0, 0.0, 3.0];
         let mut p = fixtures::prepared(scene, mesh, Some(pack));
         p.environment = Some(env);
-        let img = render_prepared_linear(
-            &p,
-            &Options {
-                samples: 256,
-                seed: 3,
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        // Every pixel that sees the patch (within 10 degrees of head-on, where
-        // the gain's Fresnel factor stays within 1e-4 of its normal value).
-        let ys: Vec<f64> = img
-            .rgb
-            .iter()
-            .map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64)
-            .filter(|&y| y > 0.3)
-            .collect();
-        assert!(ys.len() > 30, "{} lit pixels", ys.len());
-        let y = ys.iter().sum::<f64>() / ys.len() as f64;
-        eprintln!("furnace {n} x {dx:e} {model:?}: Y = {y:.5} over the frame");
-        assert!((y - 1.0).abs() < 0.03, "{n} px {model:?}: Y = {y}");
+        for (estimator, tol) in [(EnvEstimator::MonteCarlo, 0.03), (EnvEstimator::Quadrature, 0.01)] {
+            let img = render_prepared_linear(
+                &p,
+                &Options {
+                    samples: 256,
+                    seed: 3,
+                    estimator,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            // Every pixel that sees the patch (within 10 degrees of head-on, where
+            // the gain's Fresnel factor stays within 1e-4 of its normal value).
+            let ys: Vec<f64> = img
+                .rgb
+                .iter()
+                .map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64)
+                .filter(|&y| y > 0.3)
+                .collect();
+            assert!(ys.len() > 30, "{} lit pixels", ys.len());
+            let y = ys.iter().sum::<f64>() / ys.len() as f64;
+            eprintln!("furnace {n} x {dx:e} {model:?}: Y = {y:.5} over the frame ({estimator:?})");
+            assert!((y - 1.0).abs() < tol, "{n} px {model:?} {estimator:?}: Y = {y}");
+        }
     }
 }
 
@@ -216,6 +221,7 @@ fn sphere_under(
     eye: [f64; 3],
     samples: u32,
     seed: u64,
+    estimator: EnvEstimator,
 ) -> LinearImage {
     let (n, dx) = (64usize, 50e-9);
     let pack = pack_of(n, dx, &ridges(n, dx, 1.3e-6, 420e-9), Model::Window);
@@ -230,19 +236,26 @@ fn sphere_under(
         &Options {
             samples,
             seed,
+            estimator,
             ..Default::default()
         },
     )
     .unwrap()
 }
 
-/// The estimator's determinism and noise on a sky-lit ridge patch seen from
+/// The estimators' determinism and noise on a sky-lit ridge patch seen from
 /// the front: the same seed gives the same frame whatever the thread count;
-/// two seeds give frames whose mean luminance agrees to 3 % (each pixel is
-/// still noisy at 256 samples: CIEDE2000 p99 ~ 8 between seeds, against the
-/// goal of 0.5; docs/LIGHTING.md "Noise").
+/// two seeds give frames whose mean luminance agrees to 3 % (under Monte
+/// Carlo each pixel is still noisy at 256 samples: CIEDE2000 p99 ~ 8 between
+/// seeds; docs/LIGHTING.md "Cost and noise").
 #[test]
 fn seeds_are_deterministic_and_agree_on_average() {
+    for estimator in [EnvEstimator::MonteCarlo, EnvEstimator::Quadrature] {
+        seeds_agree(estimator);
+    }
+}
+
+fn seeds_agree(estimator: EnvEstimator) {
     let run = |seed, threads| {
         let (n, dx) = (64usize, 50e-9);
         let pack = pack_of(n, dx, &ridges(n, dx, 1.3e-6, 420e-9), Model::Window);
@@ -259,6 +272,7 @@ fn seeds_are_deterministic_and_agree_on_average() {
                 samples: 256,
                 seed,
                 threads,
+                estimator,
                 ..Default::default()
             },
         )
@@ -268,7 +282,7 @@ fn seeds_are_deterministic_and_agree_on_average() {
     assert_eq!(a, run(1, 1), "same seed, other thread count: another frame");
     let d = compare_linear(&a, &b).unwrap();
     let (ya, yb) = (mean_y(&a, 0, 12), mean_y(&b, 0, 12));
-    eprintln!("seed 1 vs 2: {d}; mean Y {ya:.4} vs {yb:.4}");
+    eprintln!("{estimator:?}: seed 1 vs 2: {d}; mean Y {ya:.4} vs {yb:.4}");
     assert!(d.pixels > 50, "{d}");
     assert!(
         ya > 0.05 && (ya / yb - 1.0).abs() < 0.03,
@@ -296,9 +310,9 @@ fn rotating_the_environment_equals_rotating_the_scene_back() {
     let r = 90.0;
     let map = |rot: f64| Environment::Map(EnvMap::new(w, h, px.clone(), rot, 1.0).unwrap());
     let eye = [0.3, 0.8, 2.5];
-    let rotated = sphere_under(map(r), 20, eye, 16, 5);
+    let rotated = sphere_under(map(r), 20, eye, 16, 5, EnvEstimator::MonteCarlo);
     let back = sunbeam_light::rot_y(eye, -r);
-    let scene_rotated = sphere_under(map(0.0), 20, back, 16, 5);
+    let scene_rotated = sphere_under(map(0.0), 20, back, 16, 5, EnvEstimator::MonteCarlo);
     let d = compare_linear(&rotated, &scene_rotated).unwrap();
     eprintln!("rotated environment vs rotated scene: {d}");
     assert!(d.pixels > 100, "{d}");
@@ -386,8 +400,9 @@ fn lobe_sampler_pdf_is_the_density_of_its_samples() {
     }
 }
 
-/// Seed-to-seed noise of a small sky-lit sphere (silhouettes included: grazing
-/// views, the estimator's hardest case): two seeds at 64 samples per pixel
+/// Seed-to-seed noise of the Monte Carlo estimator on a small sky-lit sphere
+/// (silhouettes included: grazing views, the estimator's hardest case): two
+/// seeds at 64 samples per pixel
 /// differ by less than the bound measured when the estimator was last changed
 /// (docs/LIGHTING.md "Cost and noise"), with a margin, so that a change that
 /// makes the estimator noisier fails here.
@@ -396,8 +411,8 @@ fn seed_to_seed_noise_of_a_sky_lit_sphere() {
     let sky = || Environment::Sky(Box::new(Sky::new(25.0, 120.0, 3.0, 1.0)));
     let eye = [0.0, 0.6, 2.6];
     let t0 = std::time::Instant::now();
-    let a = sphere_under(sky(), 24, eye, 64, 1);
-    let b = sphere_under(sky(), 24, eye, 64, 2);
+    let a = sphere_under(sky(), 24, eye, 64, 1, EnvEstimator::MonteCarlo);
+    let b = sphere_under(sky(), 24, eye, 64, 2, EnvEstimator::MonteCarlo);
     let d = compare_linear(&a, &b).unwrap();
     eprintln!(
         "sky-lit sphere, 24 x 24, 64 samples, seed 1 vs 2: {d} ({:.1} s)",
@@ -411,3 +426,59 @@ fn seed_to_seed_noise_of_a_sky_lit_sphere() {
 /// (2026-11-25), with a margin of 25 %.
 const MEAN_BOUND: f64 = 13.0;
 const P99_BOUND: f64 = 68.0;
+
+/// The quadrature on the sphere of [`seed_to_seed_noise_of_a_sky_lit_sphere`]:
+/// two seeds at 64 samples per pixel (their only difference: the sub-pixel
+/// positions, the sun's disc points and the texels' classes) within the
+/// issue's bound for the reference's noise, CIEDE2000 p99 < 0.5; and the
+/// quadrature's frame against the Monte Carlo frame (the mean of four seeds
+/// at 256 samples: no code of the maps): mean luminance over the lit pixels
+/// within 2 %, mean chromaticity within 0.003, and 4 x 4 blocks (where the
+/// Monte Carlo noise has averaged down) at CIEDE2000 mean < 2.
+#[test]
+fn quadrature_is_quiet_and_agrees_with_monte_carlo() {
+    let sky = || Environment::Sky(Box::new(Sky::new(25.0, 120.0, 3.0, 1.0)));
+    let eye = [0.0, 0.6, 2.6];
+    let q = EnvEstimator::Quadrature;
+    let a = sphere_under(sky(), 24, eye, 64, 1, q);
+    let b = sphere_under(sky(), 24, eye, 64, 2, q);
+    let d = compare_linear(&a, &b).unwrap();
+    eprintln!("quadrature, 24 x 24, 64 samples, seed 1 vs 2: {d}");
+    assert!(d.pixels > 150, "{d}");
+    assert!(d.p99 < 0.5, "{d}");
+    let mc: Vec<LinearImage> = (11..15)
+        .map(|seed| sphere_under(sky(), 24, eye, 256, seed, EnvEstimator::MonteCarlo))
+        .collect();
+    let mut m = LinearImage::new(24, 24);
+    for img in &mc {
+        for (o, p) in m.rgb.iter_mut().zip(&img.rgb) {
+            for c in 0..3 {
+                o[c] += p[c] / mc.len() as f32;
+            }
+        }
+    }
+    let sums = |img: &LinearImage| {
+        let mut s = [0.0; 3];
+        for (p, r) in img.rgb.iter().zip(&m.rgb) {
+            if sunbeam_raster::linear::luminance(*r) >= sunbeam_raster::linear::LIT_Y {
+                let xyz = colour::linear_srgb_to_xyz(p.map(f64::from));
+                for c in 0..3 {
+                    s[c] += xyz[c];
+                }
+            }
+        }
+        s
+    };
+    let (sq, sm) = (sums(&a), sums(&m));
+    let xy = |v: [f64; 3]| [v[0] / (v[0] + v[1] + v[2]), v[1] / (v[0] + v[1] + v[2])];
+    let (cq, cm) = (xy(sq), xy(sm));
+    let blocks = compare_linear(&a.downsample(4), &m.downsample(4)).unwrap();
+    eprintln!(
+        "quadrature vs Monte Carlo: Y ratio {:.4}, xy {cq:.4?} vs {cm:.4?}; pixels {}; 4 x 4 blocks {blocks}",
+        sq[1] / sm[1],
+        compare_linear(&a, &m).unwrap()
+    );
+    assert!((sq[1] / sm[1] - 1.0).abs() < 0.02, "Y {} vs {}", sq[1], sm[1]);
+    assert!((cq[0] - cm[0]).abs() < 0.003 && (cq[1] - cm[1]).abs() < 0.003);
+    assert!(blocks.mean < 2.0, "{blocks}");
+}

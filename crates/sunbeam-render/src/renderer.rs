@@ -600,7 +600,24 @@ impl Renderer {
 
     /// Upload the per-frame uniforms for a `w x h` target.
     pub fn update(&self, gpu: &Gpu, state: &FrameState, w: u32, h: u32) {
-        let vp = camera::to_f32(&state.camera.view_proj(w, h));
+        self.update_jittered(gpu, state, w, h, [0.0; 2]);
+    }
+
+    /// [`Renderer::update`] with the image shifted by `jitter` pixels (x
+    /// right, y down): the progressive sum's frames each take another
+    /// sub-pixel position ([`subpixel_jitter`]), so the settled frame is the
+    /// average over each pixel's area, as a camera sees it (and as the
+    /// reference's stratified sub-pixel samples are), not the shading at its
+    /// centre.
+    pub fn update_jittered(&self, gpu: &Gpu, state: &FrameState, w: u32, h: u32, jitter: [f64; 2]) {
+        let mut vpm = state.camera.view_proj(w, h);
+        // clip.x += (2 jx / w) clip.w, clip.y -= (2 jy / h) clip.w (NDC y is up).
+        let (jx, jy) = (2.0 * jitter[0] / w.max(1) as f64, -2.0 * jitter[1] / h.max(1) as f64);
+        for c in &mut vpm {
+            c[0] += jx * c[3];
+            c[1] += jy * c[3];
+        }
+        let vp = camera::to_f32(&vpm);
         let mut lights = [[0.0f32; 4]; MAX_LIGHTS];
         let mut n = 0;
         for l in state.lights.iter().take(MAX_LIGHTS) {
@@ -1140,9 +1157,13 @@ impl Offscreen {
         r: &Renderer,
         state: &FrameState,
     ) {
-        r.update(gpu, state, self.width, self.height);
-        if let Some(a) = &self.acc {
-            r.set_frame(gpu, a.count());
+        match &self.acc {
+            Some(a) => {
+                let jitter = subpixel_jitter(a.count());
+                r.update_jittered(gpu, state, self.width, self.height, jitter);
+                r.set_frame(gpu, a.count());
+            }
+            None => r.update(gpu, state, self.width, self.height),
         }
         self.record(enc, r, state);
         if let Some(a) = &self.acc {
@@ -1230,6 +1251,25 @@ impl Offscreen {
 }
 
 use bytemuck::Zeroable;
+
+/// The sub-pixel offset (pixels, each in [-0.5, 0.5)) of frame `k` of a
+/// progressive sum: the Halton (2, 3) sequence from index 1, so any run of
+/// frames covers the pixel evenly (stratified, unlike independent random
+/// offsets) and the first frame (the one shown while the view moves) sits
+/// near the centre, (0, -1/6).
+pub fn subpixel_jitter(k: u32) -> [f64; 2] {
+    fn radical_inverse(mut i: u32, base: u32) -> f64 {
+        let (mut f, mut r) = (1.0, 0.0);
+        while i > 0 {
+            f /= base as f64;
+            r += f * (i % base) as f64;
+            i /= base;
+        }
+        r
+    }
+    let i = k.wrapping_add(1);
+    [radical_inverse(i, 2) - 0.5, radical_inverse(i, 3) - 0.5]
+}
 
 #[cfg(test)]
 mod layout_tests {
@@ -1390,5 +1430,28 @@ mod layout_tests {
             size_of::<ResolveU>(),
             &f!(ResolveU; width, inv_n, curve, output),
         );
+    }
+}
+
+
+#[cfg(test)]
+mod jitter_tests {
+    use super::subpixel_jitter;
+
+    /// The offsets stay inside the pixel and cover it evenly: over 64 frames,
+    /// each of the 4 x 4 sub-cells gets exactly 4, and the mean is the centre.
+    #[test]
+    fn jitter_covers_the_pixel_evenly() {
+        let mut cells = [0u32; 16];
+        let mut mean = [0.0; 2];
+        for k in 0..64 {
+            let j = subpixel_jitter(k);
+            assert!(j.iter().all(|v| (-0.5..0.5).contains(v)), "{j:?}");
+            let c = |v: f64| ((v + 0.5) * 4.0) as usize;
+            cells[c(j[0]) + 4 * c(j[1])] += 1;
+            mean = [mean[0] + j[0] / 64.0, mean[1] + j[1] / 64.0];
+        }
+        assert!(cells.iter().all(|&n| n >= 3 && n <= 5), "{cells:?}");
+        assert!(mean[0].abs() < 0.02 && mean[1].abs() < 0.02, "{mean:?}");
     }
 }

@@ -303,77 +303,44 @@ fn twin_agrees_with_the_reference() {
 
 /// The reference's quadrature ([`EnvQuadrature`]) against the per-wavelength
 /// Monte Carlo estimator (the pack's own `R`, no map) at views from head-on
-/// to grazing, under the sky with its sun and a white map.
+/// to grazing, under the sky with its sun and a white map: Y within 2 %
+/// (6 % at 1 degree above the horizon, where the Monte Carlo estimate itself
+/// scatters by a few per cent) and chromaticity within 0.005.
 #[test]
 fn quadrature_agrees_with_monte_carlo() {
     use sunbeam_response::quadrature::EnvQuadrature;
+    let xy = |v: [f64; 3]| {
+        let s = v[0] + v[1] + v[2];
+        [v[0] / s, v[1] / s]
+    };
     for (name, env) in [("sky", sky()), ("white", white())] {
-        let t0 = std::time::Instant::now();
         let q = EnvQuadrature::build(&ridge_pack(), &env, &EnvQuadrature::reference_options());
-        eprintln!("{name}: build {:.2?}, grid {:?}, kept {}", t0.elapsed(), q.grid(), q.kept_texels());
-        for wr in [
-            unit([0.0, 0.0, 1.0]),
-            unit([-0.2, 0.3, 0.8]),
-            unit([0.7, 0.1, 0.3]),
-            unit([0.2, -0.9, 0.1]),
-            unit([0.6, 0.8, 0.02]),
+        for (wr, tol) in [
+            (unit([0.0, 0.0, 1.0]), 0.02),
+            (unit([-0.2, 0.3, 0.8]), 0.02),
+            (unit([0.7, 0.1, 0.3]), 0.02),
+            (unit([0.2, -0.9, 0.1]), 0.02),
+            (unit([0.6, 0.8, 0.02]), 0.06),
         ] {
-            let t0 = std::time::Instant::now();
-            let n = 64;
+            // Every interleave class once (the quadrature is then complete),
+            // the sun's disc point stratified.
+            let parts = 16;
             let mut s = [0.0; 3];
-            for k in 0..n {
-                let x = q.integrate(&env, FRAME, wr, [(k as f64 + 0.5) / n as f64, 0.618 * k as f64 % 1.0], (k % 16, 16));
+            for k in 0..parts {
+                let u = [(k as f64 + 0.5) / parts as f64, (0.618 * k as f64) % 1.0];
+                let x = q.integrate(&env, FRAME, wr, u, (k, parts));
                 for c in 0..3 {
-                    s[c] += x[c] / n as f64;
+                    s[c] += x[c] / parts as f64;
                 }
             }
-            let dt = t0.elapsed() / n as u32;
             let r = reference(&env, wr, 100_000);
-            eprintln!(
-                "{name} wr {wr:.3?}: quadrature {s:.5?} ({dt:.2?} per point), reference {r:.5?}, ratio Y {:.4} X {:.4} Z {:.4}",
-                s[1] / r[1], s[0] / r[0], s[2] / r[2]
+            let (a, b) = (xy(s), xy(r));
+            eprintln!("{name} wr {wr:.3?}: quadrature {s:.5?}, Monte Carlo {r:.5?}, ratio Y {:.4}", s[1] / r[1]);
+            assert!((s[1] / r[1] - 1.0).abs() < tol, "{name} {wr:?}: {s:?} vs {r:?}");
+            assert!(
+                (a[0] - b[0]).abs() < 0.005 && (a[1] - b[1]).abs() < 0.005,
+                "{name} {wr:?}: chromaticity {a:?} vs {b:?}"
             );
         }
-    }
-}
-
-#[test]
-#[ignore]
-fn quadrature_profile() {
-    use sunbeam_response::quadrature::EnvQuadrature;
-    let env = sky();
-    let q = EnvQuadrature::build(&ridge_pack(), &env, &Options::default());
-    let t0 = std::time::Instant::now();
-    let mut s = 0.0;
-    for k in 0..4000 {
-        let wr = unit([0.3 * (k as f64 * 0.01).sin(), 0.2, 0.9]);
-        s += q.integrate(&env, FRAME, wr, [0.5, 0.5], (k % 16, 16))[1];
-    }
-    eprintln!("{s} {:?} per call", t0.elapsed() / 4000);
-}
-
-#[test]
-#[ignore]
-fn quadrature_profile_many() {
-    use sunbeam_response::quadrature::{EnvQuadrature, Query};
-    let env = sky();
-    let q = EnvQuadrature::build(&ridge_pack(), &env, &Options::default());
-    for (per, parts) in [(1, 16), (4, 64), (16, 16), (4, 16)] {
-        let t0 = std::time::Instant::now();
-        let mut s = 0.0;
-        let calls = 4000 / per;
-        for k in 0..calls {
-            let qs: Vec<Query> = (0..per)
-                .map(|m| Query {
-                    frame: FRAME,
-                    wr: unit([0.3 * (k as f64 * 0.01).sin() + 0.001 * m as f64, 0.2, 0.9]),
-                    sun_u: [0.5, 0.5],
-                })
-                .collect();
-            for x in q.integrate_many(&env, &qs, (k % parts, parts)) {
-                s += x[1];
-            }
-        }
-        eprintln!("{per} per call, {parts} parts: {s} {:?} per point", t0.elapsed() / 4000);
     }
 }
