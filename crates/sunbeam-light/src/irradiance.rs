@@ -123,7 +123,12 @@ mod tests {
     #[test]
     fn furnace_and_sky_units() {
         let white = Irradiance::new(&Environment::Map(EnvMap::constant([1.0; 3])));
-        for n in [[0.0, 1.0, 0.0], [0.6, 0.0, 0.8], [0.0, -1.0, 0.0], [0.3, -0.5, 0.81]] {
+        for n in [
+            [0.0f64, 1.0, 0.0],
+            [0.6, 0.0, 0.8],
+            [0.0, -1.0, 0.0],
+            [0.3, -0.5, 0.81],
+        ] {
             let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
             let e = white.at(n.map(|v| v / l));
             for v in e {
@@ -133,6 +138,9 @@ mod tests {
         let sky = Environment::Sky(Box::new(Sky::new(35.0, 70.0, 3.0, 1.0)));
         let e = Irradiance::new(&sky).at([0.0, 1.0, 0.0]);
         let y = colour::linear_srgb_to_xyz(e)[1];
-        assert!((y / PI - 1.0).abs() < 0.01, "horizontal irradiance {y} vs pi");
+        assert!(
+            (y / PI - 1.0).abs() < 0.01,
+            "horizontal irradiance {y} vs pi"
+        );
     }
 }

@@ -43,8 +43,8 @@ use crate::shade::dot;
 use std::f64::consts::PI;
 use std::sync::Arc;
 use sunbeam_common::rng::SplitMix64;
-use sunbeam_light::Environment;
 use sunbeam_light::irradiance::Irradiance;
+use sunbeam_light::Environment;
 use sunbeam_optics::{cie, colour};
 use sunbeam_pack::Pack;
 use sunbeam_response::quadrature::{EnvQuadrature, Query};
@@ -278,7 +278,10 @@ impl EnvShader {
                     })
                     .collect();
                 let weight = m as f64 / (parts * ks.len()) as f64;
-                for (&k, xyz) in ks.iter().zip(quad.integrate_many(&self.env, &queries, (c, parts))) {
+                for (&k, xyz) in ks
+                    .iter()
+                    .zip(quad.integrate_many(&self.env, &queries, (c, parts)))
+                {
                     let rgb = colour::xyz_to_linear_srgb(xyz);
                     let f = &frags[k];
                     for a in 0..3 {

@@ -237,15 +237,25 @@ fn worst_pixels() {
     };
     let interior = |i: usize| {
         let (x, y) = (i % w, i / w);
-        x > 0 && y > 0 && x + 1 < w && y + 1 < h && (0..9).all(|k| lit(x + k % 3 - 1, y + k / 3 - 1))
+        x > 0
+            && y > 0
+            && x + 1 < w
+            && y + 1 < h
+            && (0..9).all(|k| lit(x + k % 3 - 1, y + k / 3 - 1))
     };
     let pct = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         let n = v.len().max(1);
         let m = v.iter().sum::<f64>() / n as f64;
-        format!("{} px: mean {m:.2} p99 {:.2} max {:.2}", v.len(), v.get((n - 1) * 99 / 100).copied().unwrap_or(0.0), v.last().copied().unwrap_or(0.0))
+        format!(
+            "{} px: mean {m:.2} p99 {:.2} max {:.2}",
+            v.len(),
+            v.get((n - 1) * 99 / 100).copied().unwrap_or(0.0),
+            v.last().copied().unwrap_or(0.0)
+        )
     };
-    let (inner, edge): (Vec<&(f64, usize)>, Vec<&(f64, usize)>) = d.iter().partition(|(_, i)| interior(*i));
+    let (inner, edge): (Vec<&(f64, usize)>, Vec<&(f64, usize)>) =
+        d.iter().partition(|(_, i)| interior(*i));
     eprintln!("interior {}", pct(inner.iter().map(|x| x.0).collect()));
     eprintln!("silhouette {}", pct(edge.iter().map(|x| x.0).collect()));
     let (mut ya, mut yb) = (0.0, 0.0);
@@ -262,7 +272,9 @@ fn worst_pixels() {
         let (a4, b4) = (a.downsample(4), b.downsample(4));
         let xyz = |v: &[f32; 3]| colour::linear_srgb_to_xyz(v.map(|x| f64::from(x).max(0.0)));
         let mut e4: Vec<(f64, usize)> = (0..a4.rgb.len())
-            .filter(|&i| sunbeam_raster::linear::luminance(b4.rgb[i]) >= sunbeam_raster::linear::LIT_Y)
+            .filter(|&i| {
+                sunbeam_raster::linear::luminance(b4.rgb[i]) >= sunbeam_raster::linear::LIT_Y
+            })
             .map(|i| (colour::ciede2000_xyz(xyz(&a4.rgb[i]), xyz(&b4.rgb[i])), i))
             .collect();
         e4.sort_by(|x, y| y.0.total_cmp(&x.0));

@@ -98,7 +98,10 @@ fn furnace_through_the_renderer() {
         scene.camera.eye = [0.0, 0.0, 3.0];
         let mut p = fixtures::prepared(scene, mesh, Some(pack));
         p.environment = Some(env);
-        for (estimator, tol) in [(EnvEstimator::MonteCarlo, 0.03), (EnvEstimator::Quadrature, 0.01)] {
+        for (estimator, tol) in [
+            (EnvEstimator::MonteCarlo, 0.03),
+            (EnvEstimator::Quadrature, 0.01),
+        ] {
             let img = render_prepared_linear(
                 &p,
                 &Options {
@@ -120,7 +123,10 @@ fn furnace_through_the_renderer() {
             assert!(ys.len() > 30, "{} lit pixels", ys.len());
             let y = ys.iter().sum::<f64>() / ys.len() as f64;
             eprintln!("furnace {n} x {dx:e} {model:?}: Y = {y:.5} over the frame ({estimator:?})");
-            assert!((y - 1.0).abs() < tol, "{n} px {model:?} {estimator:?}: Y = {y}");
+            assert!(
+                (y - 1.0).abs() < tol,
+                "{n} px {model:?} {estimator:?}: Y = {y}"
+            );
         }
     }
 }
@@ -462,11 +468,14 @@ fn quadrature_is_quiet_and_agrees_with_monte_carlo() {
     }
     // Interior pixels (all eight neighbours lit): at the silhouette the Monte
     // Carlo estimate still has fireflies at 1024 samples (grazing views).
-    let lit = |i: usize| sunbeam_raster::linear::luminance(m.rgb[i]) >= sunbeam_raster::linear::LIT_Y;
+    let lit =
+        |i: usize| sunbeam_raster::linear::luminance(m.rgb[i]) >= sunbeam_raster::linear::LIT_Y;
     let interior: Vec<usize> = (0..24 * 24)
         .filter(|&i| {
             let (x, y) = (i % 24, i / 24);
-            (1..23).contains(&x) && (1..23).contains(&y) && (0..9).all(|k| lit((y + k / 3 - 1) * 24 + x + k % 3 - 1))
+            (1..23).contains(&x)
+                && (1..23).contains(&y)
+                && (0..9).all(|k| lit((y + k / 3 - 1) * 24 + x + k % 3 - 1))
         })
         .collect();
     let xyz = |p: [f32; 3]| colour::linear_srgb_to_xyz(p.map(f64::from));
@@ -483,7 +492,10 @@ fn quadrature_is_quiet_and_agrees_with_monte_carlo() {
     let (sq, sm) = (sums(&a), sums(&m));
     let xy = |v: [f64; 3]| [v[0] / (v[0] + v[1] + v[2]), v[1] / (v[0] + v[1] + v[2])];
     let (cq, cm) = (xy(sq), xy(sm));
-    let de: Vec<f64> = interior.iter().map(|&i| colour::ciede2000_xyz(xyz(a.rgb[i]), xyz(m.rgb[i]))).collect();
+    let de: Vec<f64> = interior
+        .iter()
+        .map(|&i| colour::ciede2000_xyz(xyz(a.rgb[i]), xyz(m.rgb[i])))
+        .collect();
     let mean_de = de.iter().sum::<f64>() / de.len() as f64;
     eprintln!(
         "quadrature vs Monte Carlo over {} interior pixels: Y ratio {:.4}, xy {cq:.4?} vs {cm:.4?}, CIEDE2000 mean {mean_de:.2}",
@@ -491,7 +503,12 @@ fn quadrature_is_quiet_and_agrees_with_monte_carlo() {
         sq[1] / sm[1],
     );
     assert!(interior.len() > 100, "{} interior pixels", interior.len());
-    assert!((sq[1] / sm[1] - 1.0).abs() < 0.02, "Y {} vs {}", sq[1], sm[1]);
+    assert!(
+        (sq[1] / sm[1] - 1.0).abs() < 0.02,
+        "Y {} vs {}",
+        sq[1],
+        sm[1]
+    );
     assert!((cq[0] - cm[0]).abs() < 0.003 && (cq[1] - cm[1]).abs() < 0.003);
     // The Monte Carlo frame's own noise is ~1.5 here.
     assert!(mean_de < 2.5, "{mean_de}");

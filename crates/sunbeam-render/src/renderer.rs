@@ -612,7 +612,10 @@ impl Renderer {
     pub fn update_jittered(&self, gpu: &Gpu, state: &FrameState, w: u32, h: u32, jitter: [f64; 2]) {
         let mut vpm = state.camera.view_proj(w, h);
         // clip.x += (2 jx / w) clip.w, clip.y -= (2 jy / h) clip.w (NDC y is up).
-        let (jx, jy) = (2.0 * jitter[0] / w.max(1) as f64, -2.0 * jitter[1] / h.max(1) as f64);
+        let (jx, jy) = (
+            2.0 * jitter[0] / w.max(1) as f64,
+            -2.0 * jitter[1] / h.max(1) as f64,
+        );
         for c in &mut vpm {
             c[0] += jx * c[3];
             c[1] += jy * c[3];
@@ -1432,7 +1435,6 @@ mod layout_tests {
         );
     }
 }
-
 
 #[cfg(test)]
 mod jitter_tests {

@@ -17,14 +17,17 @@
 //! none, and its error is the maps' (measured against the per-wavelength
 //! Monte Carlo estimator, which evaluates `R` from the pack directly).
 //!
-//! Texels within two of their widths of the horizon (`|wi_xy| = 1`), where
-//! `1 / cos(theta_i)` and `G` change within a texel, are split into
-//! [`HORIZON_SPLIT`]^2 equal-area parts, each with its own factors and its own
-//! `s`; `E_k` stays the texel's. In those parts `1 / cos(theta_i)` is replaced
-//! by its mean over the part's extent across the horizon, in closed form
-//! (`(asin d_1 - asin d_0) / (d_1 - d_0)` with `d = |wi_xy|`, the part beyond
-//! `d = 1` counted as 0): a midpoint there loses the integrable
-//! `1 / sqrt(1 - d)` peak (1.8 % of a head-on ridge patch under a white map).
+//! Texels within [`BAND`] of their widths of the horizon (`|wi_xy| = 1`),
+//! where `1 / cos(theta_i)` and `G` change within a texel, are integrated
+//! across their extent: `d = |wi_xy|` over the texel is a trapezoid
+//! distribution (the centre's `d` plus the radial and angular half extents
+//! projected on `wi_xy`), and each linear piece of it, cut at `d = 1`, by
+//! 3-point Gauss-Legendre in `tau = -1 / (cos(theta_i) + cos(theta_r))`, in
+//! which the integrand is smooth (`G (ci + cr)^2` is): the peak at the
+//! horizon, `cos(theta_r)^2` wide in `d` at grazing views, is followed
+//! whatever the view. A midpoint rule there lost the integrable
+//! `1 / sqrt(1 - d)` peak (1.8 % of a head-on ridge patch under a white map,
+//! tens of per cent at grazing views).
 //! The sun (a disc of 0.5 degrees, outside the basis) is a point of its disc
 //! per call, with `Omega E_sun` interpolated trilinearly, as in the player.
 //!
@@ -411,10 +414,18 @@ impl OctTable {
         let n = self.side as f64;
         let fx = ((u + 1.0) * 0.5 * n - 0.5).clamp(0.0, n - 1.0);
         let fy = ((v + 1.0) * 0.5 * n - 0.5).clamp(0.0, n - 1.0);
-        let (i0, j0) = ((fx as usize).min(self.side - 2), (fy as usize).min(self.side - 2));
+        let (i0, j0) = (
+            (fx as usize).min(self.side - 2),
+            (fy as usize).min(self.side - 2),
+        );
         let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
         let at = |i: usize, j: usize| self.c[j * self.side + i];
-        let (a, b, c, e) = (at(i0, j0), at(i0 + 1, j0), at(i0, j0 + 1), at(i0 + 1, j0 + 1));
+        let (a, b, c, e) = (
+            at(i0, j0),
+            at(i0 + 1, j0),
+            at(i0, j0 + 1),
+            at(i0 + 1, j0 + 1),
+        );
         std::array::from_fn(|k| {
             let top = a[k] as f64 * (1.0 - tx) + b[k] as f64 * tx;
             let bot = c[k] as f64 * (1.0 - tx) + e[k] as f64 * tx;
@@ -468,8 +479,8 @@ impl<'a> View<'a> {
         if self.rho_v * row.r < 1e-12 {
             return (row.r.max(self.rho_v) <= reach).then_some((0, nt));
         }
-        let c = (reach * reach - row.r * row.r - self.rho_v * self.rho_v)
-            / (2.0 * row.r * self.rho_v);
+        let c =
+            (reach * reach - row.r * row.r - self.rho_v * self.rho_v) / (2.0 * row.r * self.rho_v);
         if c >= 1.0 {
             Some((0, nt))
         } else if c < -1.0 {
@@ -525,13 +536,32 @@ impl<'a> View<'a> {
         let dl = d.max(1e-12);
         let hr = ((x * cs + y * sn) / dl).abs() * (row.r_hi - row.r_lo) / 2.0;
         let ha = ((-x * sn + y * cs) / dl).abs() * row.r * dt / 2.0;
-        self.band(quad, -x, -y, row.r, hr.max(1e-9), ha.max(1e-9), area, e, xyz);
+        self.band(
+            quad,
+            -x,
+            -y,
+            row.r,
+            hr.max(1e-9),
+            ha.max(1e-9),
+            area,
+            e,
+            xyz,
+        );
     }
 
     /// Adds `weight * sum_k c_k E_k(s)` of texel layers `e` for an incoming
     /// direction with `cos(theta_i) = ci` at `(u, v)` radius `r`.
     #[allow(clippy::too_many_arguments)]
-    fn add(&self, quad: &EnvQuadrature, ci: f64, r: f64, weight: f64, c: [f64; 3], e: &[f32], xyz: &mut [f64; 3]) {
+    fn add(
+        &self,
+        quad: &EnvQuadrature,
+        ci: f64,
+        r: f64,
+        weight: f64,
+        c: [f64; 3],
+        e: &[f32],
+        xyz: &mut [f64; 3],
+    ) {
         let ns = quad.grid.n_s;
         let s = (ci + self.wr[2]) / (4.0 - r * r).max(1e-12).sqrt();
         let ks = s.clamp(0.0, 1.0) * (ns - 1) as f64;
@@ -551,7 +581,16 @@ impl<'a> View<'a> {
 
     /// A texel away from the horizon: its centre, `wi_xy = (x, y)`.
     #[allow(clippy::too_many_arguments)]
-    fn plain(&self, quad: &EnvQuadrature, x: f64, y: f64, r: f64, area: f64, e: &[f32], xyz: &mut [f64; 3]) {
+    fn plain(
+        &self,
+        quad: &EnvQuadrature,
+        x: f64,
+        y: f64,
+        r: f64,
+        area: f64,
+        e: &[f32],
+        xyz: &mut [f64; 3],
+    ) {
         let d2 = x * x + y * y;
         if d2 >= 1.0 {
             return;

@@ -335,8 +335,14 @@ fn quadrature_agrees_with_monte_carlo() {
             }
             let r = reference(&env, wr, 100_000);
             let (a, b) = (xy(s), xy(r));
-            eprintln!("{name} wr {wr:.3?}: quadrature {s:.5?}, Monte Carlo {r:.5?}, ratio Y {:.4}", s[1] / r[1]);
-            assert!((s[1] / r[1] - 1.0).abs() < tol, "{name} {wr:?}: {s:?} vs {r:?}");
+            eprintln!(
+                "{name} wr {wr:.3?}: quadrature {s:.5?}, Monte Carlo {r:.5?}, ratio Y {:.4}",
+                s[1] / r[1]
+            );
+            assert!(
+                (s[1] / r[1] - 1.0).abs() < tol,
+                "{name} {wr:?}: {s:?} vs {r:?}"
+            );
             assert!(
                 (a[0] - b[0]).abs() < 0.005 && (a[1] - b[1]).abs() < 0.005,
                 "{name} {wr:?}: chromaticity {a:?} vs {b:?}"

@@ -1,5 +1,6 @@
 //! `sunbeam-eval render` under a scene `environment` (docs/SCENE.md,
-//! docs/LIGHTING.md): a sky-lit scene renders (deterministic for a seed);
+//! docs/LIGHTING.md): a sky-lit scene renders (deterministic for a seed,
+//! the two estimators agree);
 //! bad environments exit 2 naming the file and field, with no output.
 
 use std::path::Path;
@@ -37,7 +38,18 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
     .unwrap();
     let (a, b) = (d.join("a.exr"), d.join("b.exr"));
     for out in [&a, &b] {
-        let o = render(&s, out, &["--samples", "4", "--seed", "7"]);
+        let o = render(
+            &s,
+            out,
+            &[
+                "--env-estimator",
+                "monte-carlo",
+                "--samples",
+                "4",
+                "--seed",
+                "7",
+            ],
+        );
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     assert_eq!(
@@ -48,6 +60,8 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
     // --compare: the same seed gives the same frame (CIEDE2000 0), another seed not.
     let compare = |seed: &str| {
         let args = [
+            "--env-estimator",
+            "monte-carlo",
             "--samples",
             "4",
             "--seed",
@@ -68,10 +82,34 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
     );
     // --seed 7 --seed 8: the mean of the two frames (read back and averaged here).
     let b8 = d.join("b8.exr");
-    let o = render(&s, &b8, &["--samples", "4", "--seed", "8"]);
+    let o = render(
+        &s,
+        &b8,
+        &[
+            "--env-estimator",
+            "monte-carlo",
+            "--samples",
+            "4",
+            "--seed",
+            "8",
+        ],
+    );
     assert!(o.status.success());
     let both = d.join("both.exr");
-    let o = render(&s, &both, &["--samples", "4", "--seed", "7", "--seed", "8"]);
+    let o = render(
+        &s,
+        &both,
+        &[
+            "--env-estimator",
+            "monte-carlo",
+            "--samples",
+            "4",
+            "--seed",
+            "7",
+            "--seed",
+            "8",
+        ],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let (p7, p8, pm) = (
         sunbeam_raster::LinearImage::read_exr(&a).unwrap(),
@@ -93,6 +131,23 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
     // A white diffuse sphere under the sky is lit (no point light is added).
     let img = sunbeam_raster_probe(&a);
     assert!(img > 0.05, "mean value {img}");
+    // The default estimator (the quadrature; here the diffuse part from the
+    // tabulated irradiance) agrees with Monte Carlo's mean of two seeds.
+    let q = d.join("q.exr");
+    let o = render(&s, &q, &["--samples", "16"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (vq, vm) = (sunbeam_raster_probe(&q), sunbeam_raster_probe(&both));
+    assert!(
+        (vq / vm - 1.0).abs() < 0.05,
+        "quadrature {vq} vs Monte Carlo {vm}"
+    );
+    let o = render(&s, &q, &["--env-estimator", "guess"]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 
     let bad_map = d.join("bad.hdr");
     std::fs::write(&bad_map, b"not an image").unwrap();
