@@ -1441,7 +1441,7 @@ mod jitter_tests {
     use super::subpixel_jitter;
 
     /// The offsets stay inside the pixel and cover it evenly: over 64 frames,
-    /// each of the 4 x 4 sub-cells gets exactly 4, and the mean is the centre.
+    /// each of the 4 x 4 sub-cells gets 3 to 5 (4 on average), and the mean is the centre.
     #[test]
     fn jitter_covers_the_pixel_evenly() {
         let mut cells = [0u32; 16];
@@ -1453,7 +1453,7 @@ mod jitter_tests {
             cells[c(j[0]) + 4 * c(j[1])] += 1;
             mean = [mean[0] + j[0] / 64.0, mean[1] + j[1] / 64.0];
         }
-        assert!(cells.iter().all(|&n| n >= 3 && n <= 5), "{cells:?}");
+        assert!(cells.iter().all(|n| (3..=5).contains(n)), "{cells:?}");
         assert!(mean[0].abs() < 0.02 && mean[1].abs() < 0.02, "{mean:?}");
     }
 }

@@ -339,8 +339,8 @@ impl EnvQuadrature {
             for (j, wj) in [(j0, 1.0 - tj), (j0 + 1, tj)] {
                 for (i, wi) in [(i0, 1.0 - ti), (i1, ti)] {
                     let o = 3 * ((k * g.n_rho + j) * g.n_theta + i);
-                    for a in 0..3 {
-                        out[a] += wk * wj * wi * self.sun[o + a] as f64;
+                    for (a, x) in out.iter_mut().enumerate() {
+                        *x += wk * wj * wi * self.sun[o + a] as f64;
                     }
                 }
             }
@@ -407,7 +407,7 @@ impl OctTable {
             return self.ground;
         }
         let s = d[0].abs() + d[1].abs() + d[2].abs();
-        if !(s > 0.0) {
+        if s.is_nan() || s <= 0.0 {
             return [0.0; 3];
         }
         let (u, v) = (d[0] / s, d[2] / s);
@@ -569,13 +569,14 @@ impl<'a> View<'a> {
         let k1 = (k0 + 1).min(ns - 1);
         let f = (ks - k0 as f64) as f32;
         let (e0, e1) = (&e[k0 * 9..k0 * 9 + 9], &e[k1 * 9..k1 * 9 + 9]);
-        for a in 0..3 {
-            let mut acc = 0.0;
-            for k in 0..3 {
-                let i = 3 * k + a;
-                acc += c[k] * (e0[i] + f * (e1[i] - e0[i])) as f64;
-            }
-            xyz[a] += weight * acc;
+        for (a, x) in xyz.iter_mut().enumerate() {
+            let acc: f64 = (0..3)
+                .map(|k| {
+                    let i = 3 * k + a;
+                    c[k] * (e0[i] + f * (e1[i] - e0[i])) as f64
+                })
+                .sum();
+            *x += weight * acc;
         }
     }
 

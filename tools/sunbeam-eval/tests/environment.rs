@@ -141,10 +141,11 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
         (vq / vm - 1.0).abs() < 0.05,
         "quadrature {vq} vs Monte Carlo {vm}"
     );
+    // An unknown estimator is a usage error (exit 1, DESIGN.md).
     let o = render(&s, &q, &["--env-estimator", "guess"]);
     assert_eq!(
         o.status.code(),
-        Some(2),
+        Some(1),
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
