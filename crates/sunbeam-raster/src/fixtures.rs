@@ -133,6 +133,7 @@ pub fn prepared(scene: Scene, mesh: Mesh, pack: Option<Arc<Pack>>) -> Prepared {
         meshes: vec![(Arc::new(mesh), mat)],
         scene,
         environment: None,
+        env_cache: Default::default(),
     }
 }
 

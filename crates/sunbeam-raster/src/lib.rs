@@ -96,6 +96,51 @@ pub struct Prepared {
     pub meshes: Vec<(Arc<Mesh>, Material)>,
     /// The scene's environment, loaded (None: point lights only).
     pub environment: Option<Arc<sunbeam_light::Environment>>,
+    /// The environment's shaders already built for this scene (shared by
+    /// clones: a turntable's frames build the quadrature's maps once).
+    pub env_cache: EnvCache,
+}
+
+/// Built [`environment::EnvShader`]s, keyed by estimator, environment and
+/// packs (their addresses: a changed environment or pack builds anew).
+#[derive(Clone, Default)]
+pub struct EnvCache(Arc<std::sync::Mutex<Vec<(EnvKey, Arc<environment::EnvShader>)>>>);
+
+type EnvKey = (environment::EnvEstimator, usize, Vec<usize>);
+
+impl std::fmt::Debug for EnvCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let n = self.0.lock().map(|v| v.len()).unwrap_or(0);
+        write!(f, "EnvCache({n} shaders)")
+    }
+}
+
+impl EnvCache {
+    /// The shader for `env`, `packs` and `estimator`, built on first use.
+    fn get(
+        &self,
+        env: Arc<sunbeam_light::Environment>,
+        packs: &[Option<Arc<Pack>>],
+        estimator: environment::EnvEstimator,
+    ) -> Arc<environment::EnvShader> {
+        let key: EnvKey = (
+            estimator,
+            Arc::as_ptr(&env) as usize,
+            packs
+                .iter()
+                .map(|p| p.as_ref().map_or(0, |p| Arc::as_ptr(p) as usize))
+                .collect(),
+        );
+        let mut v = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, es)) = v.iter().find(|(k, _)| *k == key) {
+            return es.clone();
+        }
+        let es = Arc::new(environment::EnvShader::with_estimator(
+            env, packs, estimator,
+        ));
+        v.push((key, es.clone()));
+        es
+    }
 }
 
 /// Load a mesh named by a scene: `builtin:quad`, `builtin:sphere`, or a glTF/GLB/OBJ
@@ -198,6 +243,7 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
         scene: scene.clone(),
         meshes,
         environment,
+        env_cache: EnvCache::default(),
     })
 }
 
@@ -284,7 +330,7 @@ fn render_environment(
     let [w, h] = opts.size.unwrap_or(p.scene.size);
     let (sw, sh) = (w * s, h * s);
     let packs: Vec<_> = p.meshes.iter().map(|(_, m)| m.pack.clone()).collect();
-    let es = environment::EnvShader::with_estimator(env, &packs, opts.estimator);
+    let es = p.env_cache.get(env, &packs, opts.estimator);
     let shader = shade::Shader::new(p, opts);
     let scale = p.scene.exposure.exp2();
     let eye = p.scene.camera.eye;
