@@ -104,9 +104,10 @@ pub struct Prepared {
 /// Built [`environment::EnvShader`]s, keyed by estimator, environment and
 /// packs (their addresses: a changed environment or pack builds anew).
 #[derive(Clone, Default)]
-pub struct EnvCache(Arc<std::sync::Mutex<Vec<(EnvKey, Arc<environment::EnvShader>)>>>);
+pub struct EnvCache(Arc<std::sync::Mutex<Vec<EnvEntry>>>);
 
 type EnvKey = (environment::EnvEstimator, usize, Vec<usize>);
+type EnvEntry = (EnvKey, Arc<environment::EnvShader>);
 
 impl std::fmt::Debug for EnvCache {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
