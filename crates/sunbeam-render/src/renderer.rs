@@ -152,7 +152,8 @@ struct Globals {
     exposure_scale: f32,
     n_lambda: u32,
     f0: f32,
-    _pad: f32,
+    /// Samples per pixel of the colour target (the shader tells covered pixels from silhouettes).
+    msaa: u32,
 }
 
 #[repr(C)]
@@ -674,7 +675,7 @@ impl Renderer {
             exposure_scale: state.exposure.exp2() as f32,
             n_lambda: self.n_lambda,
             f0: gain::f0(gain::DEFAULT_IOR) as f32,
-            _pad: 0.0,
+            msaa: self.msaa(),
         };
         gpu.queue
             .write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
