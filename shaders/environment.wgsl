@@ -95,11 +95,36 @@ var<private> env_seed: u32;
 
 fn env_seed_at(px: vec2<u32>, frame: u32) {
     env_seed = pcg(px.x ^ pcg(px.y ^ pcg(frame)));
+    env_pixel = pcg(px.x ^ pcg(px.y ^ 0x9e3779b9u));
 }
 
 // Uniform in [0, 1) for dimension k of this pixel and frame.
 fn env_rand(k: u32) -> f32 {
     return f32(pcg(env_seed ^ pcg(k)) >> 8u) * (1.0 / 16777216.0);
+}
+
+// The pixel's own hash, the same in every frame (the shifts of env_qmc).
+var<private> env_pixel: u32;
+
+// Point `i` (from 1) of the Halton sequence in prime `base`, shifted by a
+// uniform of this pixel (Cranley-Patterson rotation): over the frames a
+// pixel's points fill [0, 1) evenly (the error of the running mean falls
+// nearly as 1 / frames where the integrand allows, not 1 / sqrt(frames));
+// each frame alone is still uniform, and neighbouring pixels are
+// independent. The bases 2 and 3 are the sub-pixel jitter's
+// (renderer::subpixel_jitter), so the sampling takes 5 and up.
+fn env_qmc(i: u32, base: u32) -> f32 {
+    var f = 1.0;
+    var r = 0.0;
+    var n = i;
+    let b = f32(base);
+    while (n > 0u) {
+        f = f / b;
+        r = r + f * f32(n % base);
+        n = n / base;
+    }
+    let shift = f32(pcg(env_pixel ^ pcg(base)) >> 8u) * (1.0 / 16777216.0);
+    return fract(r + shift);
 }
 
 // ---------------------------------------------------------------- lookups
@@ -351,8 +376,11 @@ struct EnvDraw {
 };
 
 // One (u, v) from the pyramid for view wr and uniforms u (contract: "Descent").
-// The child at each level is picked with a fresh uniform env_rand(q + 3 + l)
-// (the contract rescales one u0; f32 would run out of bits over ~10 levels).
+// u.x is rescaled from level to level (the contract's one u0: a stratified
+// u.x over the frames keeps the children stratified) while float32 keeps
+// enough of its bits: once a uniform has been stretched by more than 2^18
+// (the product of total / picked), the next level takes a fresh uniform
+// env_rand(q + 3 + l).
 fn env_descend(wr: vec3<f32>, u: vec3<f32>, q: u32) -> EnvDraw {
     var out: EnvDraw;
     out.pdf = 0.0;
@@ -360,11 +388,13 @@ fn env_descend(wr: vec3<f32>, u: vec3<f32>, q: u32) -> EnvDraw {
     var x = 0u;
     var y = 0u;
     var p = 1.0;
+    var u0 = u.x;
+    var stretch = 1.0;
     for (var l = envp.top; l > 0u; l = l - 1u) {
         let lc = l - 1u;
-        var u0 = u.x;
-        if (l != envp.top) {
+        if (stretch > 262144.0) {
             u0 = env_rand(q + 3u + l);
+            stretch = 1.0;
         }
         var ch = env_children(l, x, y, wr);
         let x0 = ch.x0;
@@ -399,6 +429,8 @@ fn env_descend(wr: vec3<f32>, u: vec3<f32>, q: u32) -> EnvDraw {
         p = p * pe / total;
         x = x0 + (pick & 1u);
         y = y0 + (pick >> 1u);
+        u0 = clamp((target_ - acc) / pe, 0.0, 0.99999994);
+        stretch = stretch * total / pe;
     }
     let rj = env_r_at(f32(y) / (envp.n_rho - 1.0));
     let rj1 = env_r_at(f32(y + 1u) / (envp.n_rho - 1.0));
@@ -425,8 +457,8 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     var rgb = vec3<f32>(0.0);
     // Diffuse: one cosine-weighted direction (pdf cos / pi) plus the sun's disc.
     if (dw > 0.0) {
-        let r = sqrt(env_rand(0u));
-        let phi = SB_TAU * env_rand(1u);
+        let r = sqrt(env_qmc(envg.frame + 1u, 23u));
+        let phi = SB_TAU * env_qmc(envg.frame + 1u, 29u);
         let wl = vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(1.0 - r * r, 0.0)));
         let d = wl.x * t + wl.y * b + wl.z * n;
         var irr_over_pi = env_basis_rgb(env_coefficients(d));
@@ -452,23 +484,33 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     }
     for (var k = 0u; k < ns; k = k + 1u) {
         let q = 8u + 32u * k;
+        // Three stratified uniforms per draw (env_qmc, point `i` of the
+        // pixel's sequence): the first picks the technique (below
+        // ENV_DEFENSIVE: the hemisphere) and, stretched, the descent's top
+        // levels; the other two the point in the leaf cell or the hemisphere
+        // direction.
+        let i = envg.frame * ns + k + 1u;
+        let u5 = env_qmc(i, 5u);
+        let u7 = env_qmc(i, 7u);
+        let u11 = env_qmc(i, 11u);
         // One-sample MIS over the mixture (EnvResponse::draw / density).
         var uvd = vec2<f32>(0.0);
         var pdf = 0.0;
         if (preview) {
-            let z = env_rand(q + 1u);
-            let ph = SB_TAU * env_rand(q + 2u);
+            let z = u7;
+            let ph = SB_TAU * u11;
             let sr = sqrt(max(1.0 - z * z, 0.0));
             uvd = -sr * vec2<f32>(cos(ph), sin(ph)) - wr.xy;
             pdf = env_hemi_pdf(wr, uvd);
-        } else if (env_rand(q + 30u) < ENV_DEFENSIVE) {
-            let z = env_rand(q + 1u);
-            let ph = SB_TAU * env_rand(q + 2u);
+        } else if (u5 < ENV_DEFENSIVE) {
+            let z = u7;
+            let ph = SB_TAU * u11;
             let sr = sqrt(max(1.0 - z * z, 0.0));
             uvd = -sr * vec2<f32>(cos(ph), sin(ph)) - wr.xy;
             pdf = ENV_DEFENSIVE * env_hemi_pdf(wr, uvd) + (1.0 - ENV_DEFENSIVE) * env_pdf(wr, uvd);
         } else {
-            let dr = env_descend(wr, vec3<f32>(env_rand(q), env_rand(q + 1u), env_rand(q + 2u)), q);
+            let ux = min((u5 - ENV_DEFENSIVE) / (1.0 - ENV_DEFENSIVE), 0.99999994);
+            let dr = env_descend(wr, vec3<f32>(ux, u7, u11), q);
             if (!(dr.pdf > 0.0)) {
                 continue;
             }
@@ -495,9 +537,9 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     xyz = xyz / f32(ns);
     if (envg.has_sun == 1u && envp.has_sun == 1u) {
         // Uniform on the disc (Sky::sample_sun).
-        let ct = 1.0 - env_rand(2u) * (1.0 - envg.sun_dir.w);
+        let ct = 1.0 - env_qmc(envg.frame + 1u, 17u) * (1.0 - envg.sun_dir.w);
         let st = sqrt(max(1.0 - ct * ct, 0.0));
-        let ph = SB_TAU * env_rand(3u);
+        let ph = SB_TAU * env_qmc(envg.frame + 1u, 19u);
         let d = st * (cos(ph) * envg.sun_t.xyz + sin(ph) * envg.sun_b.xyz) + ct * envg.sun_dir.xyz;
         let wi = vec3<f32>(dot(d, t), dot(d, b), dot(d, n));
         if (wi.z > 0.0) {
