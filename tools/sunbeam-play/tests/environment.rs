@@ -133,10 +133,9 @@ fn p99(report: &serde_json::Value) -> f64 {
     report["ciede2000"]["p99"].as_f64().unwrap()
 }
 
-/// A sky-lit sphere with the ridge pack, filling the frame (silhouettes,
-/// where MSAA and the reference's sub-pixel grid differ most, are left out):
-/// the settled frame (256 frames) against the reference at 256 samples per
-/// pixel, CIEDE2000 p99 over the lit pixels in linear light.
+/// A sky-lit sphere with the ridge pack, filling the frame: the settled frame
+/// (256 frames) against the reference at 256 samples per pixel, CIEDE2000
+/// p99 over the lit pixels in linear light, and over 4 x 4 blocks (a bias).
 #[test]
 fn sky_lit_sphere_settles_to_the_reference() {
     let dir = tmp("sky");
@@ -162,14 +161,28 @@ fn sky_lit_sphere_settles_to_the_reference() {
     eprintln!("player: {:.1} s, {r}", t.elapsed().as_secs_f64());
     assert_eq!(r["accumulated_frames"].as_u64(), Some(256));
     let d = p99(&r);
-    // Measured on lavapipe: p99 12.6 at 256 frames (deterministic: both
-    // estimators are seeded), of which most is the reference's own noise at
-    // 256 samples; the p99 < 2 needs a far less noisy reference
-    // (docs/bench/play.md "Environment mode"). Before the per-frame clamp was
-    // removed (a bias of +2.4 % in red) and with the proposal weighed at cell
-    // centres, 15-25.
-    assert!(d < 16.0, "CIEDE2000 p99 {d} (report {r})");
+    // Measured on lavapipe: p99 8.8 at 256 frames (deterministic: both
+    // renderers are seeded), the player's own noise (the reference, the
+    // quadrature, is at p99 ~0.2 between seeds); it falls with the frames to
+    // p99 1.6 at 4096 on the demo pack's sphere (docs/bench/play.md
+    // "Environment mode"). Bound: the measurement plus 25 %.
+    assert!(d < 11.0, "CIEDE2000 p99 {d} (report {r})");
+    // A bias survives averaging over 4 x 4 pixel blocks, the noise does not:
+    // shading at llvmpipe's centroid (a covered sample, 0.4 px off the centre
+    // of every pixel a triangle edge crosses) shifted sharp features and gave
+    // blocks p99 2.6 on the demo pack's sphere at any number of frames.
+    let frame = LinearImage::read_exr(&dir.join("f.exr")).unwrap();
+    let reference = LinearImage::read_exr(&refp).unwrap();
+    let blocks =
+        sunbeam_raster::compare_linear(&frame.downsample(4), &reference.downsample(4)).unwrap();
+    eprintln!("4 x 4 blocks: {blocks}");
+    assert!(blocks.p99 < BLOCKS_P99, "{blocks}");
 }
+
+/// Bound of [`sky_lit_sphere_settles_to_the_reference`]'s 4 x 4 blocks:
+/// measured 2.26 at 256 frames (2026-11-25; mostly the noise, 8.8 per pixel,
+/// over 4), plus 25 %.
+const BLOCKS_P99: f64 = 2.8;
 
 /// A white furnace: a constant white map (radiance 1) on the ridge quad seen
 /// head-on; the frame's centre (512 frames) equals the reference's.
@@ -216,13 +229,13 @@ fn white_furnace_on_the_quad_matches_the_reference_at_the_centre() {
         s.map(|v| v / n)
     };
     let (a, b) = (centre(&frame), centre(&reference));
-    // Measured on lavapipe (512 frames): within 0.7 % per channel; the
-    // standard error of the ratio is ~0.8 % (the reference's 64 samples 0.4-0.7 %,
-    // the player's 0.3-0.5 %). Clamping each frame at 0 had made red +2.4 %.
+    // Measured on lavapipe (512 frames) against the quadrature reference:
+    // within 0.02-0.12 % per channel (the player's standard error 0.3-0.5 %).
+    // Clamping each frame at 0 had made red +2.4 %.
     eprintln!("furnace centre: player {a:?} reference {b:?} ({r})");
     for c in 0..3 {
         assert!(
-            (a[c] / b[c] - 1.0).abs() < 0.025,
+            (a[c] / b[c] - 1.0).abs() < 0.015,
             "channel {c}: player {} vs reference {}",
             a[c],
             b[c]
