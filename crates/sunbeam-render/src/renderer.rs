@@ -1346,7 +1346,8 @@ mod layout_tests {
                 output,
                 exposure_scale,
                 n_lambda,
-                f0
+                f0,
+                msaa
             ),
         );
     }
