@@ -501,32 +501,6 @@ fn covered_centroid(covered: u32) -> vec2<f32> {
 
 @fragment
 fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f32> {
-    // Where the environment's Monte Carlo estimate shades: the pixel centre,
-    // except in a partly covered pixel whose centre sees the surface at a
-    // grazing angle or from below (a silhouette): there the centre
-    // extrapolates the attributes past the triangle, where the view falls
-    // below the horizon (black pixels) or just above it, where the gain G
-    // grows as 1 / cos(theta_r) (fireflies that no number of frames averages
-    // away), so it shades at the mean of the covered samples, reached along
-    // the attributes' screen derivatives (the triangle's plane: the point
-    // stays on the surface). Not `@interpolate(centroid)`: that may be any
-    // covered sample, and Mesa's llvmpipe takes one, 0.4 px off the centre of
-    // every pixel that an edge between triangles crosses, which shifted every
-    // sharp feature of the environment frame (the sun's glint: CIEDE2000 p99
-    // 4.6 against the reference, 0.3 now). The point lights shade at the
-    // centre, whose derivatives the footprint filter needs.
-    let off = covered_centroid(covered);
-    var world_c = in.world + dpdx(in.world) * off.x + dpdy(in.world) * off.y;
-    var normal_c = in.normal + dpdx(in.normal) * off.x + dpdy(in.normal) * off.y;
-    var tangent_c = in.tangent + dpdx(in.tangent) * off.x + dpdy(in.tangent) * off.y;
-    // Elsewhere (edges between triangles) the centre: closer to the pixel's
-    // mean, which the reference takes (the sun's glint on the benchmark
-    // sphere: p99 0.3 against 0.9 with the covered samples' mean everywhere).
-    if (dot(normalize(g.eye.xyz - in.world), normalize(in.normal)) > ENV_CENTRE_COS) {
-        world_c = in.world;
-        normal_c = in.normal;
-        tangent_c = in.tangent;
-    }
     let fr = shading_frame(in.normal, in.tangent);
     let t = fr[0];
     let b = fr[1];
@@ -573,6 +547,30 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
     // The scene's environment (shaders/environment.wgsl): one Monte Carlo
     // estimate per frame, accumulated by the caller.
     if (envg.on == 1u) {
+        // Where the environment's Monte Carlo estimate shades: the pixel centre,
+        // except in a partly covered pixel whose centre sees the surface at a
+        // grazing angle or from below (a silhouette): there the centre
+        // extrapolates the attributes past the triangle, where the view falls
+        // below the horizon (black pixels) or just above it, where the gain G
+        // grows as 1 / cos(theta_r) (fireflies that no number of frames averages
+        // away), so it shades at the mean of the covered samples, reached along
+        // the attributes' screen derivatives (the triangle's plane: the point
+        // stays on the surface). Not `@interpolate(centroid)`: that may be any
+        // covered sample, and Mesa's llvmpipe takes one, 0.4 px off the centre of
+        // every pixel that an edge between triangles crosses, which shifted every
+        // sharp feature of the environment frame (the sun's glint: CIEDE2000 p99
+        // 4.6 against the reference at the centroid, 0.3 at the centre). The
+        // point lights shade at the centre, whose derivatives the footprint
+        // filter needs. Elsewhere (edges between triangles) the centre too: it
+        // is closer to the pixel's mean, which the reference takes (the sun's
+        // glint on the benchmark sphere: p99 0.3 against 0.9 with the covered
+        // samples' mean everywhere).
+        // (Derivatives here: envg is uniform, so this is uniform control flow.)
+        let grazing = dot(wr, n) <= ENV_CENTRE_COS;
+        let off = select(vec2<f32>(0.0), covered_centroid(covered), grazing);
+        let world_c = in.world + dpdx(in.world) * off.x + dpdy(in.world) * off.y;
+        let normal_c = in.normal + dpdx(in.normal) * off.x + dpdy(in.normal) * off.y;
+        let tangent_c = in.tangent + dpdx(in.tangent) * off.x + dpdy(in.tangent) * off.y;
         let fc = shading_frame(normal_c, tangent_c);
         let wr_c = normalize(g.eye.xyz - world_c);
         let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));

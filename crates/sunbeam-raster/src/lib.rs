@@ -102,12 +102,17 @@ pub struct Prepared {
 }
 
 /// Built [`environment::EnvShader`]s, keyed by estimator, environment and
-/// packs (their addresses: a changed environment or pack builds anew).
+/// packs (the same `Arc`s: a changed environment or pack builds anew; the key
+/// holds them, so their addresses cannot be reused by others while cached).
 #[derive(Clone, Default)]
 pub struct EnvCache(Arc<std::sync::Mutex<Vec<EnvEntry>>>);
 
-type EnvKey = (environment::EnvEstimator, usize, Vec<usize>);
-type EnvEntry = (EnvKey, Arc<environment::EnvShader>);
+struct EnvEntry {
+    estimator: environment::EnvEstimator,
+    env: Arc<sunbeam_light::Environment>,
+    packs: Vec<Option<Arc<Pack>>>,
+    shader: Arc<environment::EnvShader>,
+}
 
 impl std::fmt::Debug for EnvCache {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -124,23 +129,33 @@ impl EnvCache {
         packs: &[Option<Arc<Pack>>],
         estimator: environment::EnvEstimator,
     ) -> Arc<environment::EnvShader> {
-        let key: EnvKey = (
-            estimator,
-            Arc::as_ptr(&env) as usize,
-            packs
-                .iter()
-                .map(|p| p.as_ref().map_or(0, |p| Arc::as_ptr(p) as usize))
-                .collect(),
-        );
+        let same_packs = |a: &[Option<Arc<Pack>>]| {
+            a.len() == packs.len()
+                && a.iter().zip(packs).all(|(x, y)| match (x, y) {
+                    (Some(x), Some(y)) => Arc::ptr_eq(x, y),
+                    (None, None) => true,
+                    _ => false,
+                })
+        };
         let mut v = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, es)) = v.iter().find(|(k, _)| *k == key) {
-            return es.clone();
+        if let Some(e) = v
+            .iter()
+            .find(|e| e.estimator == estimator && Arc::ptr_eq(&e.env, &env) && same_packs(&e.packs))
+        {
+            return e.shader.clone();
         }
-        let es = Arc::new(environment::EnvShader::with_estimator(
-            env, packs, estimator,
+        let shader = Arc::new(environment::EnvShader::with_estimator(
+            env.clone(),
+            packs,
+            estimator,
         ));
-        v.push((key, es.clone()));
-        es
+        v.push(EnvEntry {
+            estimator,
+            env,
+            packs: packs.to_vec(),
+            shader: shader.clone(),
+        });
+        shader
     }
 }
 

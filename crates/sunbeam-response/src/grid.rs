@@ -69,6 +69,45 @@ impl Grid {
         ])
     }
 
+    /// Trilinear interpolation at continuous texel coordinates `c` (see
+    /// [`Grid::coords`]): the angle wraps, radius and `s` are clamped; `texel`
+    /// reads texel `(i, j, k)`. What a shader's single texture sample returns.
+    pub fn trilinear(
+        &self,
+        c: [f64; 3],
+        texel: impl Fn(usize, usize, usize) -> [f64; 3],
+    ) -> [f64; 3] {
+        let fi = c[0].floor();
+        let (ti, i0) = (
+            c[0] - fi,
+            (fi as i64).rem_euclid(self.n_theta as i64) as usize,
+        );
+        let i1 = (i0 + 1) % self.n_theta;
+        let split = |x: f64, n: usize| {
+            let x = x.clamp(0.0, (n - 1) as f64);
+            let j = (x.floor() as usize).min(n - 2);
+            (j, x - j as f64)
+        };
+        let (j0, tj) = split(c[1], self.n_rho);
+        let (k0, tk) = split(c[2], self.n_s);
+        let mut out = [0.0; 3];
+        for (k, wk) in [(k0, 1.0 - tk), (k0 + 1, tk)] {
+            for (j, wj) in [(j0, 1.0 - tj), (j0 + 1, tj)] {
+                for (i, wi) in [(i0, 1.0 - ti), (i1, ti)] {
+                    let wgt = wk * wj * wi;
+                    if wgt == 0.0 {
+                        continue;
+                    }
+                    let t = texel(i, j, k);
+                    for (o, v) in out.iter_mut().zip(t) {
+                        *o += wgt * v;
+                    }
+                }
+            }
+        }
+        out
+    }
+
     pub fn texels(&self) -> usize {
         self.n_theta * self.n_rho * self.n_s
     }

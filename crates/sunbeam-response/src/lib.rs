@@ -125,33 +125,7 @@ impl Response {
 
     /// Trilinear interpolation at continuous texel coordinates (see [`Grid::coords`]).
     pub fn lookup_texel(&self, c: [f64; 3]) -> [f64; 3] {
-        let g = &self.info.grid;
-        let fi = c[0].floor();
-        let (ti, i0) = (c[0] - fi, (fi as i64).rem_euclid(g.n_theta as i64) as usize);
-        let i1 = (i0 + 1) % g.n_theta;
-        let split = |x: f64, n: usize| {
-            let x = x.clamp(0.0, (n - 1) as f64);
-            let j = (x.floor() as usize).min(n - 2);
-            (j, x - j as f64)
-        };
-        let (j0, tj) = split(c[1], g.n_rho);
-        let (k0, tk) = split(c[2], g.n_s);
-        let mut out = [0.0; 3];
-        for (k, wk) in [(k0, 1.0 - tk), (k0 + 1, tk)] {
-            for (j, wj) in [(j0, 1.0 - tj), (j0 + 1, tj)] {
-                for (i, wi) in [(i0, 1.0 - ti), (i1, ti)] {
-                    let wgt = wk * wj * wi;
-                    if wgt == 0.0 {
-                        continue;
-                    }
-                    let t = self.texel(i, j, k);
-                    for a in 0..3 {
-                        out[a] += wgt * t[a];
-                    }
-                }
-            }
-        }
-        out
+        self.info.grid.trilinear(c, |i, j, k| self.texel(i, j, k))
     }
 
     /// Size in bytes of the texel data.

@@ -324,28 +324,10 @@ impl EnvQuadrature {
         let Some(c) = g.coords(u, v, w) else {
             return [0.0; 3];
         };
-        let fi = c[0].floor();
-        let (ti, i0) = (c[0] - fi, (fi as i64).rem_euclid(g.n_theta as i64) as usize);
-        let i1 = (i0 + 1) % g.n_theta;
-        let split = |x: f64, n: usize| {
-            let x = x.clamp(0.0, (n - 1) as f64);
-            let j = (x.floor() as usize).min(n - 2);
-            (j, x - j as f64)
-        };
-        let (j0, tj) = split(c[1], g.n_rho);
-        let (k0, tk) = split(c[2], g.n_s);
-        let mut out = [0.0; 3];
-        for (k, wk) in [(k0, 1.0 - tk), (k0 + 1, tk)] {
-            for (j, wj) in [(j0, 1.0 - tj), (j0 + 1, tj)] {
-                for (i, wi) in [(i0, 1.0 - ti), (i1, ti)] {
-                    let o = 3 * ((k * g.n_rho + j) * g.n_theta + i);
-                    for (a, x) in out.iter_mut().enumerate() {
-                        *x += wk * wj * wi * self.sun[o + a] as f64;
-                    }
-                }
-            }
-        }
-        out
+        g.trilinear(c, |i, j, k| {
+            let o = 3 * ((k * g.n_rho + j) * g.n_theta + i);
+            [0, 1, 2].map(|a| f64::from(self.sun[o + a]))
+        })
     }
 }
 
