@@ -76,8 +76,9 @@ struct Material {
     tab_dv: f32,
     tab_w0: f32,
     tab_dw: f32,
-    _q0: f32,
-    _q1: f32,
+    // Smith masking (sunbeam_optics::masking): rms slopes along t and b; 0 = off
+    mask_sx: f32,
+    mask_sy: f32,
     _q2: f32,
     // response map (sunbeam-response): 1 when bound; texels (angle, radius, s);
     // radial warp rho = asinh(r / r0) / rho_scale; 1 = average over the footprint
@@ -402,7 +403,36 @@ fn response_map_xyz(wi: vec3<f32>, uvw: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>,
 // ---------------------------------------------------------------- colour
 // sunbeam_optics::gain::g (shaders/response_map.wgsl)
 fn gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    return sb_gain(wi, wr, g.f0);
+    return sb_gain(wi, wr, g.f0) * masking(wi, wr);
+}
+
+// sunbeam_optics::masking: Smith's height-correlated shadowing-masking for
+// Beckmann slopes with the material's rms slopes; 1 when off.
+fn smith_lambda(w: vec3<f32>) -> f32 {
+    let at2 = 2.0 * (w.x * w.x * mat.mask_sx * mat.mask_sx + w.y * w.y * mat.mask_sy * mat.mask_sy);
+    if (at2 <= 0.0) {
+        return 0.0;
+    }
+    let a = w.z / sqrt(at2);
+    if (a > 8.0) {
+        return 0.0;
+    }
+    // erf by Abramowitz & Stegun 7.1.26 (a >= 0), as the reference
+    let t = 1.0 / (1.0 + 0.3275911 * a);
+    let p = ((((1.061405429 * t - 1.453152027) * t + 1.421413741) * t - 0.284496736) * t + 0.254829592) * t;
+    let e = exp(-a * a);
+    // (erf(a) - 1) / 2 = -p e / 2
+    return -0.5 * p * e + e / (2.0 * a * 1.7724538509);
+}
+
+fn masking(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    if (mat.mask_sx <= 0.0 && mat.mask_sy <= 0.0) {
+        return 1.0;
+    }
+    if (wi.z <= 0.0 || wr.z <= 0.0) {
+        return 0.0;
+    }
+    return 1.0 / (1.0 + smith_lambda(wi) + smith_lambda(wr));
 }
 
 fn srgb_oetf(y: f32) -> f32 {
@@ -533,8 +563,10 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
         if (diffract && dw < 1.0 && wi_l.z > 0.0 && wr_l.z > 0.0) {
             var xyz: vec3<f32>;
             if (g.mode == 0u && mat.resp_on == 1u) {
-                // G is inside the footprint average
-                xyz = response_map_xyz(wi_l, uvw, vec3<f32>(duv_x, dw_x), vec3<f32>(duv_y, dw_y), jx, jy);
+                // G is inside the footprint average; the masking, smooth over
+                // the footprint, at its centre
+                xyz = response_map_xyz(wi_l, uvw, vec3<f32>(duv_x, dw_x), vec3<f32>(duv_y, dw_y), jx, jy)
+                    * masking(wi_l, wr_l);
             } else if (g.mode == 0u && mat.tab_on == 1u) {
                 xyz = response_xyz(wi_l, wr_l) * gain(wi_l, wr_l);
             } else {

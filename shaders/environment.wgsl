@@ -531,7 +531,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
         let c = env_coefficients(d);
         let rc = sb_resp_coords(uvw, gr);
         let e = c.x * env_map(env_e0, rc, gr) + c.y * env_map(env_e1, rc, gr) + c.z * env_map(env_e2, rc, gr);
-        let wgt = sb_gain(wi, wr, g.f0) / (wi.z * pdf);
+        let wgt = sb_gain(wi, wr, g.f0) * masking(wi, wr) / (wi.z * pdf);
         xyz = xyz + e * wgt;
     }
     xyz = xyz / f32(ns);
@@ -546,7 +546,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
             let uvw = -wi - wr;
             let rc = sb_resp_coords(uvw, gr);
             // the map holds Omega_sun E_sun (EnvResponse::sun)
-            xyz = xyz + sb_gain(wi, wr, g.f0) * env_map(env_esun, rc, gr);
+            xyz = xyz + sb_gain(wi, wr, g.f0) * masking(wi, wr) * env_map(env_esun, rc, gr);
         }
     }
     return rgb + (1.0 - dw) * xyz_to_rgb(xyz);

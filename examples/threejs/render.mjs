@@ -71,6 +71,9 @@ try {
 const sceneDir = dirname(resolve(opt.scene));
 if (!scene.camera || !Array.isArray(scene.camera.eye) || !Array.isArray(scene.camera.target)) fail(2, `${opt.scene}: camera.eye and camera.target are required`);
 if (!Array.isArray(scene.meshes) || scene.meshes.length === 0) fail(2, `${opt.scene}: meshes: at least one mesh is required`);
+scene.meshes.forEach((m, i) => {
+  if ((m.masking ?? 'off') !== 'off') fail(2, `${opt.scene}: meshes[${i}].masking: only "off" is rendered here (docs/SCENE.md); the player and sunbeam-eval render "smith"`);
+});
 if (scene.environment) fail(2, `${opt.scene}: environment: sky and map lighting are not rendered yet; light the scene with lights[] (docs/SCENE.md)`);
 scene.lights = scene.lights ?? [{ direction: [0.3, 1.0, 0.6], intensity: 1 }];
 scene.exposure = scene.exposure ?? 0;

@@ -7,6 +7,7 @@
 //! - [`colour`]: XYZ -> linear sRGB, CIELAB, CIEDE2000, and THE tone mapping +
 //!   sRGB encoding shared by the player and the CPU reference renderer.
 //! - [`gain`]: `G(wi, wr)` with Schlick's Fresnel (n = 1.5 by default).
+//! - [`masking`]: optional Smith shadowing-masking on top of `G` (grazing views).
 //! - [`truth`]: the ground truth (window and tiled models), sharing no code
 //!   with `sunbeam-pack`.
 
@@ -14,6 +15,7 @@ pub mod cie;
 mod cie_data;
 pub mod colour;
 pub mod gain;
+pub mod masking;
 pub mod truth;
 
 pub use truth::Model;

@@ -361,11 +361,65 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
         },
         source: o.source.clone(),
         notes: o.notes.clone(),
+        rms_slope: Some(rms_slope(f, window_sigma)),
     };
     manifest
         .validate()
         .map_err(|e| Error::internal(e.message))?;
     Ok(Plan { manifest, wx, wy })
+}
+
+/// rms slopes `[rms dh/dx, rms dh/dy]` of the field (sunbeam_optics::masking),
+/// weighted like the terms: by the coherence window `sigma` (the window model;
+/// the part of the relief the response sees) or uniformly (`sigma` 0, the tiled
+/// model). Central differences, one-sided at the edges, periodic for the tiled
+/// model (its patch repeats).
+fn rms_slope(f: FieldRef, sigma: f64) -> [f64; 2] {
+    let (mx, my) = (f.width, f.height);
+    let tiled = sigma <= 0.0;
+    let weights = |n: usize, d: f64| -> Vec<f64> {
+        let c = (n as f64 - 1.0) / 2.0;
+        (0..n)
+            .map(|i| {
+                if tiled {
+                    1.0
+                } else {
+                    (-((i as f64 - c) * d).powi(2) / (2.0 * sigma * sigma)).exp()
+                }
+            })
+            .collect()
+    };
+    let (gx, gy) = (weights(mx, f.dx), weights(my, f.dy));
+    // (lower index, upper index, their distance in samples) of the difference at i
+    let stencil = |i: usize, n: usize| -> (usize, usize, f64) {
+        if tiled {
+            ((i + n - 1) % n, (i + 1) % n, 2.0)
+        } else if i == 0 {
+            (0, 1, 1.0)
+        } else if i == n - 1 {
+            (n - 2, n - 1, 1.0)
+        } else {
+            (i - 1, i + 1, 2.0)
+        }
+    };
+    if mx < 2 || my < 2 {
+        return [0.0, 0.0];
+    }
+    let h = |c: usize, r: usize| f.data[r * mx + c];
+    let (mut sx, mut sy, mut sw) = (0.0, 0.0, 0.0);
+    for (r, wy) in gy.iter().enumerate() {
+        let (r0, r1, nr) = stencil(r, my);
+        for (c, wx) in gx.iter().enumerate() {
+            let (c0, c1, nc) = stencil(c, mx);
+            let w = wx * wy;
+            let dx = (h(c1, r) - h(c0, r)) / (nc * f.dx);
+            let dy = (h(c, r1) - h(c, r0)) / (nr * f.dy);
+            sx += w * dx * dx;
+            sy += w * dy * dy;
+            sw += w;
+        }
+    }
+    [(sx / sw).sqrt(), (sy / sw).sqrt()]
 }
 
 /// Run `job` on `pool` (a fixed thread count), or on rayon's global pool.
@@ -550,4 +604,65 @@ pub fn run(
         progress(n + 1, m.terms);
     }
     Pack::new(m.clone(), terms).map_err(|e| Error::internal(e.message))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A tilted plane has the same slope everywhere: the rms is the slope,
+    /// whatever the window (central and one-sided differences are exact on it).
+    #[test]
+    fn rms_slope_of_a_plane_is_its_slope() {
+        let (mx, my, d) = (40, 30, 20e-9);
+        let data: Vec<f64> = (0..mx * my)
+            .map(|i| 0.3 * (i % mx) as f64 * d - 0.1 * (i / mx) as f64 * d)
+            .collect();
+        let f = FieldRef {
+            width: mx,
+            height: my,
+            dx: d,
+            dy: d,
+            data: &data,
+        };
+        for sigma in [0.2e-6, 1.0] {
+            let s = rms_slope(f, sigma);
+            assert!(
+                (s[0] - 0.3).abs() < 1e-12 && (s[1] - 0.1).abs() < 1e-12,
+                "{sigma}: {s:?}"
+            );
+        }
+    }
+
+    /// Tiled: a sinusoid of amplitude A along x, one period per patch: rms of
+    /// the derivative A k / sqrt(2) (k = 2 pi / L), times the central
+    /// difference's sinc(k dx) (sin(k dx) / (k dx)); none along y.
+    #[test]
+    fn rms_slope_of_a_tiled_sinusoid() {
+        let (mx, my, d, a) = (64, 8, 25e-9, 100e-9);
+        let k = 2.0 * std::f64::consts::PI / (mx as f64 * d);
+        let data: Vec<f64> = (0..mx * my)
+            .map(|i| a * (k * (i % mx) as f64 * d).sin())
+            .collect();
+        let f = FieldRef {
+            width: mx,
+            height: my,
+            dx: d,
+            dy: d,
+            data: &data,
+        };
+        let s = rms_slope(f, 0.0);
+        let want = a * k / 2f64.sqrt() * (k * d).sin() / (k * d);
+        assert!(
+            (s[0] - want).abs() < 1e-12 * want && s[1] < 1e-15,
+            "{s:?} vs {want}"
+        );
+        // and the plan writes it into the manifest
+        let o = BuildOptions {
+            model: Model::Tiled,
+            ..BuildOptions::default()
+        };
+        let p = plan(f, &o).unwrap();
+        assert_eq!(p.manifest.rms_slope, Some(s));
+    }
 }

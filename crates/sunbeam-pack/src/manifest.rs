@@ -150,6 +150,12 @@ pub struct Manifest {
     /// Notes from the build (e.g. what a --scene bound skipped).
     #[serde(default)]
     pub notes: Vec<String>,
+    /// rms of the height field's slopes `[rms dh/dx, rms dh/dy]` (dimensionless,
+    /// weighted like the terms: the coherence window, or uniform for the tiled
+    /// model): what a scene's `"masking": "smith"` uses (sunbeam_optics::masking).
+    /// Absent in packs written before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_slope: Option<[f64; 2]>,
 }
 
 impl Manifest {
@@ -207,6 +213,11 @@ impl Manifest {
         }
         if self.terms == 0 || self.terms > 4096 {
             return bad("terms must be 1..4096");
+        }
+        if let Some(s) = self.rms_slope {
+            if !s.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return bad("rms_slope must be two finite values >= 0");
+            }
         }
         let c = &self.crop;
         if c.kx < 0 || c.ky < 0 || c.kx > 1 << 20 || c.ky > 1 << 20 {

@@ -45,6 +45,7 @@ use std::sync::Arc;
 use sunbeam_common::rng::SplitMix64;
 use sunbeam_light::irradiance::Irradiance;
 use sunbeam_light::Environment;
+use sunbeam_optics::masking::Masking;
 use sunbeam_optics::{cie, colour};
 use sunbeam_pack::Pack;
 use sunbeam_response::quadrature::{EnvQuadrature, Query};
@@ -146,6 +147,8 @@ pub struct EnvShader {
     /// Per mesh: its pack's extended-light maps (quadrature only).
     quads: Vec<Option<Arc<EnvQuadrature>>>,
     irradiance: Option<Irradiance>,
+    /// Per mesh: the masking on its `G` (none: off for every mesh).
+    masking: Vec<Masking>,
     norm: f64,
 }
 
@@ -198,8 +201,20 @@ impl EnvShader {
                         .map(|p| LobeSampler::new(p.clone()))
                 })
                 .collect(),
+            masking: Vec::new(),
             norm: cie::d65_y_norm(RANGE_NM),
         }
+    }
+
+    /// The same shader with per-mesh masking (`masking[mi]`; meshes past its
+    /// end unmasked).
+    pub fn with_masking(mut self, masking: &[Masking]) -> EnvShader {
+        self.masking = masking.to_vec();
+        self
+    }
+
+    fn masking(&self, mi: usize) -> Masking {
+        self.masking.get(mi).copied().unwrap_or_default()
     }
 
     /// True when the shader runs the quadrature ([`EnvShader::shade_pixel`]).
@@ -275,6 +290,7 @@ impl EnvShader {
                         frame: frags[k].frame,
                         wr: local(&frags[k]),
                         sun_u: frags[k].sun_u,
+                        masking: self.masking(mi),
                     })
                     .collect();
                 let weight = m as f64 / (parts * ks.len()) as f64;
@@ -345,10 +361,12 @@ impl EnvShader {
         let lobe_pdf = |lobe: &LobeSampler, wi: [f64; 3]| {
             queries.iter().map(|q| lobe.pdf_in(q, wi)).sum::<f64>() / HERO as f64
         };
+        let masking = self.masking(mi);
         let mut add = |lobe: &LobeSampler, d: [f64; 3], wi: [f64; 3], p_sum: f64| {
             let radiance = self.env.spectrum(d);
+            let m = masking.factor(wi, wr_l);
             for &l in &lambdas {
-                let fc = lobe.brdf_cos(wi, wr_l, l);
+                let fc = lobe.brdf_cos(wi, wr_l, l) * m;
                 if fc > 0.0 {
                     let s = radiance.at(l) * fc * span_nm / (self.norm * p_sum);
                     if s.is_finite() {

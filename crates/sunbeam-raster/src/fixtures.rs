@@ -128,6 +128,7 @@ pub fn prepared(scene: Scene, mesh: Mesh, pack: Option<Arc<Pack>>) -> Prepared {
         pack,
         base_color: mi.base_color,
         diffuse_weight: mi.diffuse_weight,
+        masking: sunbeam_optics::masking::Masking::Off,
     };
     Prepared {
         meshes: vec![(Arc::new(mesh), mat)],

@@ -37,6 +37,7 @@ use std::path::Path;
 use std::sync::Arc;
 use sunbeam_common::{Error, Result};
 use sunbeam_optics::colour::ToneCurve;
+use sunbeam_optics::masking::Masking;
 use sunbeam_pack::Pack;
 use sunbeam_scene::Scene;
 
@@ -87,6 +88,8 @@ pub struct Material {
     /// Linear sRGB.
     pub base_color: [f64; 3],
     pub diffuse_weight: f64,
+    /// Shadowing-masking on the diffraction's `G` (scene `masking`, `rms_slope`).
+    pub masking: Masking,
 }
 
 /// A scene with its meshes and packs loaded (shared by both renderers).
@@ -109,6 +112,7 @@ pub struct EnvCache(Arc<std::sync::Mutex<Vec<EnvEntry>>>);
 
 struct EnvEntry {
     estimator: environment::EnvEstimator,
+    masking: Vec<Masking>,
     env: Arc<sunbeam_light::Environment>,
     packs: Vec<Option<Arc<Pack>>>,
     shader: Arc<environment::EnvShader>,
@@ -127,6 +131,7 @@ impl EnvCache {
         &self,
         env: Arc<sunbeam_light::Environment>,
         packs: &[Option<Arc<Pack>>],
+        masking: &[Masking],
         estimator: environment::EnvEstimator,
     ) -> Arc<environment::EnvShader> {
         let same_packs = |a: &[Option<Arc<Pack>>]| {
@@ -138,19 +143,21 @@ impl EnvCache {
                 })
         };
         let mut v = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(e) = v
-            .iter()
-            .find(|e| e.estimator == estimator && Arc::ptr_eq(&e.env, &env) && same_packs(&e.packs))
-        {
+        if let Some(e) = v.iter().find(|e| {
+            e.estimator == estimator
+                && e.masking == masking
+                && Arc::ptr_eq(&e.env, &env)
+                && same_packs(&e.packs)
+        }) {
             return e.shader.clone();
         }
-        let shader = Arc::new(environment::EnvShader::with_estimator(
-            env.clone(),
-            packs,
-            estimator,
-        ));
+        let shader = Arc::new(
+            environment::EnvShader::with_estimator(env.clone(), packs, estimator)
+                .with_masking(masking),
+        );
         v.push(EnvEntry {
             estimator,
+            masking: masking.to_vec(),
             env,
             packs: packs.to_vec(),
             shader: shader.clone(),
@@ -246,12 +253,20 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
                 "meshes[{i}].diffuse_weight must be in [0, 1]"
             )));
         }
+        let masking = match &pack {
+            Some(k) => mi
+                .masking_slope(i, k.manifest.rms_slope)
+                .map_err(|e| e.context(format!("meshes[{i}].pack {}", k_path(mi))))?
+                .map_or(Masking::Off, Masking::smith),
+            None => Masking::Off,
+        };
         meshes.push((
             mesh,
             Material {
                 pack,
                 base_color: mi.base_color,
                 diffuse_weight: mi.diffuse_weight,
+                masking,
             },
         ));
     }
@@ -261,6 +276,14 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
         environment,
         env_cache: EnvCache::default(),
     })
+}
+
+/// The pack file of a mesh instance, for messages.
+fn k_path(mi: &sunbeam_scene::MeshInstance) -> String {
+    mi.pack
+        .as_deref()
+        .map(|p| p.display().to_string())
+        .unwrap_or_default()
 }
 
 /// The scene's `environment` block as a light source (the sky built, the map read).
@@ -346,7 +369,8 @@ fn render_environment(
     let [w, h] = opts.size.unwrap_or(p.scene.size);
     let (sw, sh) = (w * s, h * s);
     let packs: Vec<_> = p.meshes.iter().map(|(_, m)| m.pack.clone()).collect();
-    let es = p.env_cache.get(env, &packs, opts.estimator);
+    let masking: Vec<Masking> = p.meshes.iter().map(|(_, m)| m.masking).collect();
+    let es = p.env_cache.get(env, &packs, &masking, opts.estimator);
     let shader = shade::Shader::new(p, opts);
     let scale = p.scene.exposure.exp2();
     let eye = p.scene.camera.eye;

@@ -89,7 +89,7 @@ impl<'a> Shader<'a> {
             None => cie::integrate_xyz_1nm(cie::DEFAULT_RANGE_NM, r),
             Some(s) => s.integrate(r),
         };
-        let g = gain::g(wi, wr, gain::DEFAULT_IOR);
+        let g = gain::g(wi, wr, gain::DEFAULT_IOR) * self.p.meshes[mi].1.masking.factor(wi, wr);
         xyz.map(|c| c * g)
     }
 

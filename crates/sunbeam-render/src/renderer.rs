@@ -187,7 +187,9 @@ struct MaterialU {
     tab_dv: f32,
     tab_w0: f32,
     tab_dw: f32,
-    _q: [f32; 3],
+    mask_sx: f32,
+    mask_sy: f32,
+    _q: f32,
     resp_on: u32,
     resp_n_theta: f32,
     resp_n_rho: f32,
@@ -339,6 +341,8 @@ impl Renderer {
                 ],
                 n_table: 1,
                 table_dt: 1.0,
+                mask_sx: mat.masking.rms_slope()[0] as f32,
+                mask_sy: mat.masking.rms_slope()[1] as f32,
                 ..Default::default()
             };
             let mut response: Option<Vec<[f32; 4]>> = None;
@@ -1388,6 +1392,8 @@ mod layout_tests {
                 tab_dv,
                 tab_w0,
                 tab_dw,
+                mask_sx,
+                mask_sy,
                 resp_on,
                 resp_n_theta,
                 resp_n_rho,

@@ -45,6 +45,7 @@ use crate::env::env_weights;
 use crate::grid::Grid;
 use sunbeam_light::Environment;
 use sunbeam_optics::gain;
+use sunbeam_optics::masking::Masking;
 use sunbeam_pack::Pack;
 
 /// Wavelength samples of the reference's maps (the player's: 96).
@@ -216,7 +217,16 @@ impl EnvQuadrature {
         sun_u: [f64; 2],
         part: (usize, usize),
     ) -> [f64; 3] {
-        self.integrate_many(env, &[Query { frame, wr, sun_u }], part)[0]
+        self.integrate_many(
+            env,
+            &[Query {
+                frame,
+                wr,
+                sun_u,
+                masking: Masking::Off,
+            }],
+            part,
+        )[0]
     }
 
     /// [`EnvQuadrature::integrate`] for several shading points at once (the
@@ -306,7 +316,7 @@ impl EnvQuadrature {
                 let wi = [dot(t), dot(b), dot(n)];
                 let wr = q.wr;
                 if wi[2] > 0.0 {
-                    let gain = gain::g(wi, wr, gain::DEFAULT_IOR);
+                    let gain = gain::g(wi, wr, gain::DEFAULT_IOR) * q.masking.factor(wi, wr);
                     let e = self.lookup_sun(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
                     for a in 0..3 {
                         xyz[a] += gain * e[a];
@@ -425,12 +435,15 @@ pub struct Query {
     pub wr: [f64; 3],
     /// The point of the sun's disc (two uniforms).
     pub sun_u: [f64; 2],
+    /// Shadowing-masking on `G` (sunbeam_optics::masking).
+    pub masking: Masking,
 }
 
 /// A query prepared for the sum.
 struct View<'a> {
     frame: Frame,
     wr: [f64; 3],
+    masking: Masking,
     rho_v: f64,
     phi_v: f64,
     table: Option<&'a OctTable>,
@@ -446,6 +459,7 @@ impl<'a> View<'a> {
         Some(View {
             frame: q.frame,
             wr,
+            masking: q.masking,
             rho_v: wr[0].hypot(wr[1]),
             phi_v: wr[1].atan2(wr[0]),
             table: quad.table.as_ref(),
@@ -579,7 +593,8 @@ impl<'a> View<'a> {
             return;
         }
         let ci = (1.0 - d2).sqrt();
-        let gain = gain::g([x, y, ci], self.wr, gain::DEFAULT_IOR) / ci;
+        let wi = [x, y, ci];
+        let gain = gain::g(wi, self.wr, gain::DEFAULT_IOR) * self.masking.factor(wi, self.wr) / ci;
         if gain > 0.0 && gain.is_finite() {
             let c = self.coefficients([x, y, ci]);
             self.add(quad, ci, r, area * gain, c, e, xyz);
@@ -642,7 +657,10 @@ impl<'a> View<'a> {
                 }
                 let dm = (1.0 - ci * ci).max(0.0).sqrt().max(1e-9);
                 let wi = [x * dm / d, y * dm / d, ci];
-                let gs = gain::g(wi, self.wr, gain::DEFAULT_IOR) * (ci + cr) * (ci + cr);
+                let gs = gain::g(wi, self.wr, gain::DEFAULT_IOR)
+                    * self.masking.factor(wi, self.wr)
+                    * (ci + cr)
+                    * (ci + cr);
                 let f = wgt * half.abs() * density(dm) / dm * gs;
                 if f > 0.0 && f.is_finite() {
                     self.add(quad, ci, r, area * f, c, e, xyz);

@@ -162,6 +162,93 @@ pub struct MeshInstance {
     /// Weight of the diffuse base colour blended with the diffraction colour (thesis' diffuse weight).
     #[serde(default = "default_diffuse_weight")]
     pub diffuse_weight: f64,
+    /// Shadowing and masking by the surface's own relief on top of `G`
+    /// (sunbeam_optics::masking): `off` (PHYSICS.md's reference) or `smith`.
+    #[serde(default)]
+    pub masking: MaskingMode,
+    /// The rms slopes `smith` uses, `[along t, along b]` or one value for both;
+    /// none: the pack's (`rms_slope` in its manifest).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_slope: Option<RmsSlope>,
+}
+
+/// `meshes[].masking`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MaskingMode {
+    /// `G` alone (PHYSICS.md 2).
+    #[default]
+    Off,
+    /// Smith's height-correlated shadowing-masking, Beckmann slopes.
+    Smith,
+}
+
+// Hand-written so that a bad value names its field (serde's derived messages
+// for enums do not).
+impl<'de> Deserialize<'de> for MaskingMode {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        match s.as_str() {
+            "off" => Ok(MaskingMode::Off),
+            "smith" => Ok(MaskingMode::Smith),
+            _ => Err(serde::de::Error::custom(format!(
+                "meshes[].masking \"{s}\": expected \"off\" or \"smith\""
+            ))),
+        }
+    }
+}
+
+/// `meshes[].rms_slope`: one value (isotropic) or `[x, y]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum RmsSlope {
+    Both(f64),
+    Axes([f64; 2]),
+}
+
+impl<'de> Deserialize<'de> for RmsSlope {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let bad = || serde::de::Error::custom("meshes[].rms_slope: expected a number or [x, y]");
+        match serde_json::Value::deserialize(d)? {
+            serde_json::Value::Number(n) => n.as_f64().map(RmsSlope::Both).ok_or_else(bad),
+            serde_json::Value::Array(a) if a.len() == 2 => match (a[0].as_f64(), a[1].as_f64()) {
+                (Some(x), Some(y)) => Ok(RmsSlope::Axes([x, y])),
+                _ => Err(bad()),
+            },
+            _ => Err(bad()),
+        }
+    }
+}
+
+impl RmsSlope {
+    pub fn axes(self) -> [f64; 2] {
+        match self {
+            RmsSlope::Both(v) => [v, v],
+            RmsSlope::Axes(a) => a,
+        }
+    }
+}
+
+impl MeshInstance {
+    /// The rms slopes the shading masks with, `None` when masking is off.
+    /// `pack_slope` is the pack's `rms_slope` (none for packs that predate it);
+    /// mesh `i` names the field in errors.
+    pub fn masking_slope(
+        &self,
+        i: usize,
+        pack_slope: Option<[f64; 2]>,
+    ) -> Result<Option<[f64; 2]>> {
+        match self.masking {
+            MaskingMode::Off => Ok(None),
+            MaskingMode::Smith => match self.rms_slope.map(RmsSlope::axes).or(pack_slope) {
+                Some(s) => Ok(Some(s)),
+                None => Err(Error::input(format!(
+                    "meshes[{i}].masking \"smith\" needs rms slopes: the pack has no rms_slope \
+                     (rebuild it with this sunbeam-pack) and meshes[{i}].rms_slope is not given"
+                ))),
+            },
+        }
+    }
 }
 
 fn one() -> f64 {
@@ -287,6 +374,8 @@ impl Scene {
                 pack,
                 base_color: default_base(),
                 diffuse_weight: default_diffuse_weight(),
+                masking: MaskingMode::Off,
+                rms_slope: None,
             }],
             exposure: 0.0,
             background: default_background(),
@@ -297,6 +386,11 @@ impl Scene {
             scene.lights.clear();
             scene.environment = Some(Scene::default_sky());
             scene.exposure = Scene::DEFAULT_SKY_EXPOSURE;
+            // The sky reaches every grazing view: without masking a limb pixel
+            // does not settle (docs/LIGHTING.md "Grazing views: masking").
+            if scene.meshes[0].pack.is_some() {
+                scene.meshes[0].masking = MaskingMode::Smith;
+            }
         }
         scene
     }
@@ -360,6 +454,15 @@ impl Scene {
         }
         if self.size[0] == 0 || self.size[1] == 0 || self.size[0] > 16384 || self.size[1] > 16384 {
             return Err(Error::input("size must be 1..16384 pixels per side"));
+        }
+        for (i, m) in self.meshes.iter().enumerate() {
+            if let Some(s) = m.rms_slope {
+                if !s.axes().iter().all(|v| v.is_finite() && *v >= 0.0) {
+                    return Err(Error::input(format!(
+                        "meshes[{i}].rms_slope must be finite and >= 0"
+                    )));
+                }
+            }
         }
         if let Some(env) = &self.environment {
             env.validate()?;
@@ -453,8 +556,65 @@ mod tests {
             assert!(msg.contains(field), "{bad}: {msg}");
         }
         // JSON has no NaN: a NaN intensity can only come from code; refused too.
+        // (masking: see masking_modes_and_slopes)
         let mut s = env_scene(r#"{"map":"a.hdr"}"#).unwrap();
         s.environment.as_mut().unwrap().intensity = f64::NAN;
         assert!(s.validate().is_err());
+    }
+
+    #[test]
+    fn masking_modes_and_slopes() {
+        let scene = |mesh: &str| -> Result<Scene> {
+            let text =
+                format!(r#"{{"camera":{{"eye":[0,0,3],"target":[0,0,0]}},"meshes":[{mesh}]}}"#);
+            let mut s: Scene =
+                serde_json::from_str(&text).map_err(|e| Error::input(e.to_string()))?;
+            s.validate()?;
+            Ok(s)
+        };
+        let m = &scene(r#"{"mesh":"a.glb"}"#).unwrap().meshes[0];
+        assert_eq!(m.masking, MaskingMode::Off);
+        assert_eq!(m.masking_slope(0, Some([0.3, 0.2])).unwrap(), None);
+        let m = &scene(r#"{"mesh":"a.glb","masking":"smith"}"#)
+            .unwrap()
+            .meshes[0];
+        assert_eq!(
+            m.masking_slope(0, Some([0.3, 0.2])).unwrap(),
+            Some([0.3, 0.2])
+        );
+        let msg = m.masking_slope(0, None).unwrap_err().to_string();
+        assert!(msg.contains("meshes[0].rms_slope"), "{msg}");
+        let m = &scene(r#"{"mesh":"a.glb","masking":"smith","rms_slope":0.25}"#)
+            .unwrap()
+            .meshes[0];
+        assert_eq!(
+            m.masking_slope(0, Some([0.3, 0.2])).unwrap(),
+            Some([0.25, 0.25])
+        );
+        let m = &scene(r#"{"mesh":"a.glb","masking":"smith","rms_slope":[0.4,0.1]}"#)
+            .unwrap()
+            .meshes[0];
+        assert_eq!(m.masking_slope(0, None).unwrap(), Some([0.4, 0.1]));
+        assert!(scene(r#"{"mesh":"a.glb","masking":"beckmann"}"#).is_err());
+        let msg = scene(r#"{"mesh":"a.glb","rms_slope":-1}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("meshes[0].rms_slope"), "{msg}");
+        // the sky-lit default scene masks (a pack is given), the point-lit one does not
+        let b = ([-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]);
+        let s = Scene::default_lit(
+            "m.glb".into(),
+            Some("p.ktx2".into()),
+            b,
+            DefaultLighting::Sky,
+        );
+        assert_eq!(s.meshes[0].masking, MaskingMode::Smith);
+        let p = Scene::default_lit(
+            "m.glb".into(),
+            Some("p.ktx2".into()),
+            b,
+            DefaultLighting::Point,
+        );
+        assert_eq!(p.meshes[0].masking, MaskingMode::Off);
     }
 }

@@ -159,6 +159,42 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
     std::fs::remove_dir_all(&d).ok();
 }
 
+/// A mesh's `masking` and `rms_slope` (docs/SCENE.md): bad values exit 2
+/// naming the scene file and the field, with no output.
+#[test]
+fn bad_masking_is_refused() {
+    let d = std::env::temp_dir().join(format!("sb-eval-mask-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    for (mesh_extra, field) in [
+        (r#""masking": "beckmann""#, "masking"),
+        (
+            r#""masking": "smith", "rms_slope": -0.5"#,
+            "meshes[0].rms_slope",
+        ),
+        (r#""masking": "smith", "rms_slope": [0.2]"#, "rms_slope"),
+    ] {
+        let sc = d.join("mask.json");
+        std::fs::write(
+            &sc,
+            format!(
+                r#"{{ "camera": {{ "eye": [0, 0.5, 2.5], "target": [0, 0, 0] }},
+  "meshes": [ {{ "mesh": "builtin:sphere", {mesh_extra} }} ], "size": [8, 8] }}"#
+            ),
+        )
+        .unwrap();
+        let out = d.join("mask.png");
+        let o = render(&sc, &out, &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{mesh_extra}: {err}");
+        assert!(
+            err.contains(field) && err.contains("mask.json"),
+            "{mesh_extra}: {err}"
+        );
+        assert!(!out.exists(), "{mesh_extra}: output written");
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
+
 /// Mean of the EXR's values (a crude "is it lit" probe, read with `exr`).
 fn sunbeam_raster_probe(path: &Path) -> f64 {
     let img = sunbeam_raster::LinearImage::read_exr(path).unwrap();

@@ -14,8 +14,9 @@
 # 512 x 512. Prints a markdown table. Environment: RES (the sphere's frame
 # size, default 64), SNAKE_W and SNAKE_H (the snake's, default 384 x 216),
 # REF_SAMPLES (default 256), SCENES (default "sphere snake"), SUPERSAMPLE (the
-# player's --supersample, default 1), SUNBEAM_BIN (the
-# folder of the binaries).
+# player's --supersample, default 1), SPHERE_MASKING and SNAKE_MASKING (the
+# meshes' "masking", default off and smith: docs/LIGHTING.md "Grazing views:
+# masking"), SUNBEAM_BIN (the folder of the binaries).
 set -euo pipefail
 out=${1:?usage: environment.sh OUT_DIR PACK.ktx2 SNAKE.glb [FRAMES ...]}
 pack=$(realpath "${2:?pack}")
@@ -31,17 +32,19 @@ res=${RES:-64}
 snake_w=${SNAKE_W:-384}
 snake_h=${SNAKE_H:-216}
 ref_samples=${REF_SAMPLES:-256}
+sphere_masking=${SPHERE_MASKING:-off}
+snake_masking=${SNAKE_MASKING:-smith}
 mkdir -p "$out"
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(d=${TMPDIR:-/tmp}/sunbeam-xdg-$(id -u); mkdir -p -m 700 "$d"; echo "$d")}
 sky='"environment": { "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 70, "turbidity": 3 }, "intensity": 1 }'
 cat > "$out/sphere.json" <<JSON
 { "camera": { "eye": [0, 0.25, 1.2], "target": [0, 0, 0] },
-  "meshes": [ { "mesh": "builtin:sphere", "pack": "$pack", "base_color": [0.03, 0.03, 0.035], "diffuse_weight": 0.15 } ],
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "$pack", "base_color": [0.03, 0.03, 0.035], "diffuse_weight": 0.15, "masking": "$sphere_masking" } ],
   $sky, "exposure": -1.5, "size": [$res, $res] }
 JSON
 cat > "$out/snake.json" <<JSON
 { "camera": { "eye": [0.0, -0.55, 1.05], "target": [0.0, -0.01, 0.0], "up": [0, 1, 0], "fov_y_deg": 28 },
-  "meshes": [ { "mesh": "$snake", "pack": "$pack", "base_color": [0.03, 0.03, 0.035], "diffuse_weight": 0.15 } ],
+  "meshes": [ { "mesh": "$snake", "pack": "$pack", "base_color": [0.03, 0.03, 0.035], "diffuse_weight": 0.15, "masking": "$snake_masking" } ],
   $sky, "exposure": -1.5, "size": [$snake_w, $snake_h] }
 JSON
 cie() { sed -E 's/.*mean ([0-9.]+) p99 ([0-9.]+) max ([0-9.]+).*/\1 \/ \2 \/ \3/'; }

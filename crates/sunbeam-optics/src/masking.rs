@@ -1,0 +1,189 @@
+//! Shadowing and masking by the surface's own relief (PHYSICS.md 2 lists it as
+//! an option of the model; docs/LIGHTING.md "Grazing views: masking").
+//!
+//! The gain `G` has `1 / cos(theta_r)`: a patch seen edge-on reflects its light
+//! into a vanishing projected area. On a curved body that makes a pixel at the
+//! limb a finite integral with an infinite-variance estimator (and on a mesh
+//! with interpolated normals, whose `cos(theta_r)` crosses zero linearly inside
+//! a triangle, an integral that diverges logarithmically). A real ridged
+//! surface hides part of itself at grazing angles: Smith's height-correlated
+//! masking-shadowing function for a Gaussian (Beckmann) slope distribution,
+//! anisotropic with the relief's own rms slopes along the patch's x and y,
+//!
+//! ```text
+//! G2 = 1 / (1 + Lambda(wi) + Lambda(wr))
+//! Lambda(w) = (erf(a) - 1)/2 + exp(-a^2) / (2 a sqrt(pi)),  a = 1 / (alpha_w tan theta)
+//! alpha_w^2 = (w_x^2 alpha_x^2 + w_y^2 alpha_y^2) / (w_x^2 + w_y^2),  alpha_x = sqrt(2) rms(dh/dx)
+//! ```
+//!
+//! (Walter et al. 2007; Heitz 2014 for the height-correlated form and the
+//! anisotropic projected roughness). `Lambda ~ 1/(2 a sqrt(pi))` as the
+//! direction grazes, so `G2 ~ cos(theta_r)` and `G * G2` stays bounded. At
+//! normal incidence and view `G2 = 1`.
+
+/// Which masking the shading applies on top of `G`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Masking {
+    /// None: PHYSICS.md's reference model.
+    #[default]
+    Off,
+    /// Smith, height-correlated, Beckmann slopes with these rms slopes of the
+    /// height field along the local x (`t`) and y (`b`) axes (`rms(dh/dx)`,
+    /// `rms(dh/dy)`, dimensionless).
+    Smith { rms_slope: [f64; 2] },
+}
+
+impl Masking {
+    /// Smith masking for rms slopes `[sx, sy]`; `Off` when both are zero.
+    pub fn smith(rms_slope: [f64; 2]) -> Masking {
+        if rms_slope[0] <= 0.0 && rms_slope[1] <= 0.0 {
+            Masking::Off
+        } else {
+            Masking::Smith { rms_slope }
+        }
+    }
+
+    /// The factor on `G` for local unit directions `wi` (to the light) and
+    /// `wr` (to the viewer); 1 when off, 0 when either is at or below the horizon.
+    pub fn factor(self, wi: [f64; 3], wr: [f64; 3]) -> f64 {
+        match self {
+            Masking::Off => 1.0,
+            Masking::Smith { rms_slope } => {
+                if !(wi[2] > 0.0 && wr[2] > 0.0) {
+                    return 0.0;
+                }
+                1.0 / (1.0 + lambda(wi, rms_slope) + lambda(wr, rms_slope))
+            }
+        }
+    }
+
+    /// The rms slopes (zeros when off): what the player's shader gets.
+    pub fn rms_slope(self) -> [f64; 2] {
+        match self {
+            Masking::Off => [0.0, 0.0],
+            Masking::Smith { rms_slope } => rms_slope,
+        }
+    }
+}
+
+/// Smith's `Lambda` for the Beckmann distribution, direction `w` (local, `w.z > 0`).
+fn lambda(w: [f64; 3], rms_slope: [f64; 2]) -> f64 {
+    let s2 = w[0] * w[0] + w[1] * w[1];
+    if s2 <= 0.0 {
+        return 0.0;
+    }
+    // alpha_w^2 tan^2 = 2 (wx^2 sx^2 + wy^2 sy^2) / wz^2
+    let at2 = 2.0
+        * (w[0] * w[0] * rms_slope[0] * rms_slope[0] + w[1] * w[1] * rms_slope[1] * rms_slope[1]);
+    if at2 <= 0.0 {
+        return 0.0;
+    }
+    let a = w[2] / at2.sqrt();
+    if a > 8.0 {
+        // erf(8) = 1 and exp(-64) ~ 1e-28: no masking.
+        return 0.0;
+    }
+    (erf(a) - 1.0) / 2.0 + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt())
+}
+
+/// The error function (Abramowitz & Stegun 7.1.26, |error| < 1.5e-7): the
+/// same few operations as the shader's, which has no `erf` (shaders/response_map.wgsl).
+pub fn erf(x: f64) -> f64 {
+    let t = 1.0 / (1.0 + 0.327_591_1 * x.abs());
+    let p = ((((1.061_405_429 * t - 1.453_152_027) * t + 1.421_413_741) * t - 0.284_496_736) * t
+        + 0.254_829_592)
+        * t;
+    let y = 1.0 - p * (-x * x).exp();
+    if x < 0.0 {
+        -y
+    } else {
+        y
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(theta_deg: f64, phi_deg: f64) -> [f64; 3] {
+        let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+        [t.sin() * p.cos(), t.sin() * p.sin(), t.cos()]
+    }
+
+    #[test]
+    fn erf_matches_known_values() {
+        // erf(0.5), erf(1), erf(2) to 10 digits (Abramowitz & Stegun table 7.1).
+        for (x, want) in [
+            (0.5, 0.520_499_877_8),
+            (1.0, 0.842_700_792_9),
+            (2.0, 0.995_322_265_0),
+        ] {
+            assert!((erf(x) - want).abs() < 2e-7, "erf({x})");
+            assert!((erf(-x) + want).abs() < 2e-7);
+        }
+    }
+
+    #[test]
+    fn off_is_one_and_normal_is_one() {
+        let m = Masking::smith([0.4, 0.2]);
+        assert_eq!(Masking::Off.factor(dir(80.0, 0.0), dir(89.0, 30.0)), 1.0);
+        assert!((m.factor(dir(0.0, 0.0), dir(0.0, 0.0)) - 1.0).abs() < 1e-15);
+        assert_eq!(Masking::smith([0.0, 0.0]), Masking::Off);
+    }
+
+    /// Lambda against a direct numerical integral of its definition:
+    /// Lambda = (1/mu) * integral over slopes q > mu of (q - mu) p(q) dq, with
+    /// p the 1D Gaussian of the slope along the direction's azimuth (variance
+    /// cos^2 sx^2 + sin^2 sy^2) and mu = cot(theta) (Smith 1967).
+    #[test]
+    fn lambda_matches_its_integral_definition() {
+        for (theta, phi, s) in [
+            (60.0, 0.0, [0.3, 0.3]),
+            (85.0, 30.0, [0.5, 0.15]),
+            (89.0, 90.0, [0.4, 0.1]),
+        ] {
+            let w = dir(theta, phi);
+            let (c, sn) = (
+                f64::cos(phi * std::f64::consts::PI / 180.0),
+                f64::sin(phi * std::f64::consts::PI / 180.0),
+            );
+            let var = c * c * s[0] * s[0] + sn * sn * s[1] * s[1];
+            let mu = 1.0 / f64::tan(theta * std::f64::consts::PI / 180.0);
+            let n = 200_000;
+            let hi = mu + 12.0 * var.sqrt();
+            let h = (hi - mu) / n as f64;
+            let mut sum = 0.0;
+            for k in 0..n {
+                let q = mu + (k as f64 + 0.5) * h;
+                sum += (q - mu) * (-q * q / (2.0 * var)).exp()
+                    / (2.0 * std::f64::consts::PI * var).sqrt()
+                    * h;
+            }
+            let want = sum / mu;
+            let got = lambda(w, s);
+            // erf to 1.5e-7 absolute (A&S 7.1.26)
+            assert!(
+                (got - want).abs() < 1e-5 * want + 2e-7,
+                "{theta} {phi}: {got} vs {want}"
+            );
+        }
+    }
+
+    /// G * G2 stays bounded as the view grazes (what makes a limb pixel's
+    /// estimator settle); G alone grows like 1 / cos(theta_r).
+    #[test]
+    fn masked_gain_is_bounded_at_grazing_views() {
+        let m = Masking::smith([0.4, 0.4]);
+        let wi = dir(40.0, 180.0);
+        let mut last = 0.0;
+        for k in 1..=6 {
+            let cr = 10f64.powi(-k);
+            let wr = [(1.0 - cr * cr).sqrt(), 0.0, cr];
+            let gm = crate::gain::g(wi, wr, 1.5) * m.factor(wi, wr);
+            assert!(gm.is_finite() && gm < 200.0, "cos {cr}: {gm}");
+            last = gm;
+        }
+        let wr = [(1.0f64 - 1e-12).sqrt(), 0.0, 1e-6];
+        assert!(crate::gain::g(wi, wr, 1.5) > 1e5 * last);
+    }
+}
