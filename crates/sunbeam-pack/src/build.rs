@@ -610,6 +610,16 @@ pub fn run(
 mod tests {
     use super::*;
 
+    fn square_pixels(width: usize, height: usize, d: f64, data: &[f64]) -> FieldRef<'_> {
+        FieldRef {
+            width,
+            height,
+            dx: d,
+            dy: d,
+            data,
+        }
+    }
+
     /// A tilted plane has the same slope everywhere: the rms is the slope,
     /// whatever the window (central and one-sided differences are exact on it).
     #[test]
@@ -618,13 +628,7 @@ mod tests {
         let data: Vec<f64> = (0..mx * my)
             .map(|i| 0.3 * (i % mx) as f64 * d - 0.1 * (i / mx) as f64 * d)
             .collect();
-        let f = FieldRef {
-            width: mx,
-            height: my,
-            dx: d,
-            dy: d,
-            data: &data,
-        };
+        let f = square_pixels(mx, my, d, &data);
         for sigma in [0.2e-6, 1.0] {
             let s = rms_slope(f, sigma);
             assert!(
@@ -644,13 +648,7 @@ mod tests {
         let data: Vec<f64> = (0..mx * my)
             .map(|i| a * (k * (i % mx) as f64 * d).sin())
             .collect();
-        let f = FieldRef {
-            width: mx,
-            height: my,
-            dx: d,
-            dy: d,
-            data: &data,
-        };
+        let f = square_pixels(mx, my, d, &data);
         let s = rms_slope(f, 0.0);
         let want = a * k / 2f64.sqrt() * (k * d).sin() / (k * d);
         assert!(
