@@ -508,25 +508,34 @@ fn shading_frame(normal: vec3<f32>, tangent: vec3<f32>) -> mat3x3<f32> {
 }
 
 // Below this cos(theta_r) at the pixel centre, the environment shades a
-// partly covered pixel at the mean of its covered samples (fs_main).
+// partly covered pixel at one of its covered samples (fs_main).
 const ENV_CENTRE_COS: f32 = 0.2;
 
-// Offset (pixels, from the centre) of the mean of the covered samples of a
-// pixel: the standard 4x MSAA positions (Vulkan, D3D, Metal alike).
-fn covered_centroid(covered: u32) -> vec2<f32> {
+// Offset (pixels, from the centre) of covered sample number floor(u n) of the
+// n covered samples of a pixel: the standard 4x MSAA positions (Vulkan, D3D,
+// Metal alike). With u uniform the pick is uniform over the covered samples,
+// so the resolved pixel (the shade times the coverage) has the mean of
+// shading every covered sample; the frames' sub-pixel jitter moves the samples
+// over the pixel.
+fn covered_pick(covered: u32, u: f32) -> vec2<f32> {
     if (g.msaa < 4u) {
         return vec2<f32>(0.0);
     }
     let pos = array<vec2<f32>, 4>(vec2<f32>(-0.125, -0.375), vec2<f32>(0.375, -0.125), vec2<f32>(-0.375, 0.125), vec2<f32>(0.125, 0.375));
-    var sum = vec2<f32>(0.0);
-    var n = 0.0;
-    for (var k = 0u; k < 4u; k = k + 1u) {
-        if (((covered >> k) & 1u) == 1u) {
-            sum = sum + pos[k];
-            n = n + 1.0;
+    let n = countOneBits(covered & 15u);
+    if (n == 0u) {
+        return vec2<f32>(0.0);
+    }
+    var k = min(u32(u * f32(n)), n - 1u);
+    for (var j = 0u; j < 4u; j = j + 1u) {
+        if (((covered >> j) & 1u) == 1u) {
+            if (k == 0u) {
+                return pos[j];
+            }
+            k = k - 1u;
         }
     }
-    return sum / max(n, 1.0);
+    return vec2<f32>(0.0);
 }
 
 @fragment
@@ -583,23 +592,28 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
         // except in a partly covered pixel whose centre sees the surface at a
         // grazing angle or from below (a silhouette): there the centre
         // extrapolates the attributes past the triangle, where the view falls
-        // below the horizon (black pixels) or just above it, where the gain G
-        // grows as 1 / cos(theta_r) (fireflies that no number of frames averages
-        // away), so it shades at the mean of the covered samples, reached along
-        // the attributes' screen derivatives (the triangle's plane: the point
-        // stays on the surface). Not `@interpolate(centroid)`: that may be any
-        // covered sample, and Mesa's llvmpipe takes one, 0.4 px off the centre of
-        // every pixel that an edge between triangles crosses, which shifted every
-        // sharp feature of the environment frame (the sun's glint: CIEDE2000 p99
-        // 4.6 against the reference at the centroid, 0.3 at the centre). The
-        // point lights shade at the centre, whose derivatives the footprint
-        // filter needs. Elsewhere (edges between triangles) the centre too: it
-        // is closer to the pixel's mean, which the reference takes (the sun's
-        // glint on the benchmark sphere: p99 0.3 against 0.9 with the covered
-        // samples' mean everywhere).
+        // below the horizon (black pixels), and the pixel's light changes
+        // fastest across it (G, the masking), so it shades at one covered
+        // sample, a new one each frame (covered_pick, stratified over the
+        // frames by env_qmc's base 31): the accumulated pixel is then the
+        // mean over the covered part of the pixel, as the reference takes it.
+        // The point is reached along the attributes' screen derivatives (the
+        // triangle's plane: it stays on the surface). Not
+        // `@interpolate(centroid)`: that may be any covered sample, and Mesa's
+        // llvmpipe takes one, 0.4 px off the centre of every pixel that an edge
+        // between triangles crosses, which shifted every sharp feature of the
+        // environment frame (the sun's glint: CIEDE2000 p99 4.6 against the
+        // reference at the centroid, 0.3 at the centre). The point lights shade
+        // at the centre, whose derivatives the footprint filter needs.
+        // Elsewhere (edges between triangles) the centre too: with the jitter
+        // it is an unbiased point of the pixel, and the sun's glint on the
+        // benchmark sphere is sharper that way (p99 0.3 against 0.9 with the
+        // covered samples' mean everywhere). Without masking a silhouette's
+        // samples have infinite variance (docs/LIGHTING.md "Grazing views").
         // (Derivatives here: envg is uniform, so this is uniform control flow.)
+        env_seed_at(vec2<u32>(in.clip.xy), envg.frame);
         let grazing = dot(wr, n) <= ENV_CENTRE_COS;
-        let off = select(vec2<f32>(0.0), covered_centroid(covered), grazing);
+        let off = select(vec2<f32>(0.0), covered_pick(covered, env_qmc(envg.frame + 1u, 31u)), grazing);
         let world_c = in.world + dpdx(in.world) * off.x + dpdy(in.world) * off.y;
         let normal_c = in.normal + dpdx(in.normal) * off.x + dpdy(in.normal) * off.y;
         let tangent_c = in.tangent + dpdx(in.tangent) * off.x + dpdy(in.tangent) * off.y;

@@ -359,6 +359,11 @@ fn env_pdf(wr: vec3<f32>, uv: vec2<f32>) -> f32 {
 // cells' sub-points.
 const ENV_DEFENSIVE: f32 = 0.25;
 
+// Below this cos(theta_r) a still frame takes ENV_GRAZING_SAMPLES times the
+// draws per pixel (env_shade).
+const ENV_GRAZING_COS: f32 = 0.2;
+const ENV_GRAZING_SAMPLES: u32 = 4u;
+
 // Density per unit (u, v) of a direction uniform over the hemisphere.
 fn env_hemi_pdf(wr: vec3<f32>, uv: vec2<f32>) -> f32 {
     let wxy = -uv - wr.xy;
@@ -481,6 +486,12 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     var ns = max(envg.samples, 1u);
     if (preview) {
         ns = 1u;
+    } else if (wr.z < ENV_GRAZING_COS) {
+        // Grazing views (limbs, silhouettes) vary most from sample to sample
+        // (G with its masking, the horizon's texels) and a silhouette pixel is
+        // covered in only part of the jittered frames: they take
+        // ENV_GRAZING_SAMPLES times the draws, so they settle with the rest.
+        ns = ns * ENV_GRAZING_SAMPLES;
     }
     for (var k = 0u; k < ns; k = k + 1u) {
         let q = 8u + 32u * k;

@@ -293,6 +293,24 @@ fn worst_pixels() {
         }
     }
     d.sort_by(|x, y| y.0.total_cmp(&x.0));
+    // The 5 x 5 neighbourhoods (luminance) of the three worst pixels.
+    for &(_, i) in d.iter().take(3) {
+        let (x, y) = (i % w, i / w);
+        for (name, img) in [("A", &a), ("B", &b)] {
+            eprintln!("{name} around ({x}, {y}):");
+            for yy in y.saturating_sub(2)..(y + 3).min(h) {
+                let row: Vec<String> = (x.saturating_sub(2)..(x + 3).min(w))
+                    .map(|xx| {
+                        format!(
+                            "{:7.4}",
+                            sunbeam_raster::linear::luminance(img.rgb[yy * w + xx])
+                        )
+                    })
+                    .collect();
+                eprintln!("  {}", row.join(" "));
+            }
+        }
+    }
     for &(e, i) in d.iter().take(25) {
         eprintln!(
             "dE {e:.1} at ({}, {}): Y {:.3} vs {:.3}",

@@ -29,9 +29,11 @@ pub(crate) struct Cli {
     /// applied), or the PNG screenshot of the window (with --frames).
     #[arg(short, long)]
     pub(crate) output: Option<PathBuf>,
-    /// Multisample anti-aliasing of silhouettes: 1 (off) or 4.
-    #[arg(long, default_value_t = 4)]
-    pub(crate) msaa: u32,
+    /// Multisample anti-aliasing of silhouettes: 1 (off) or 4. Default 4, except for
+    /// a headless frame of an environment scene (1: the frames' sub-pixel jitter is
+    /// its anti-aliasing, an exact box filter; MSAA on top widens it).
+    #[arg(long)]
+    pub(crate) msaa: Option<u32>,
     /// Headless: render K x K times the size and box-filter in linear light.
     #[arg(long, default_value_t = 1)]
     pub(crate) supersample: u32,
