@@ -293,8 +293,17 @@ fn worst_pixels() {
         }
     }
     d.sort_by(|x, y| y.0.total_cmp(&x.0));
-    // The 5 x 5 neighbourhoods (luminance) of the three worst pixels.
-    for &(_, i) in d.iter().take(3) {
+    // The 5 x 5 neighbourhoods (luminance) of the three worst pixels, or of
+    // the pixel `AT=x,y`.
+    let at: Option<usize> = std::env::var("AT").ok().and_then(|v| {
+        let (x, y) = v.split_once(',')?;
+        Some(y.trim().parse::<usize>().ok()? * w + x.trim().parse::<usize>().ok()?)
+    });
+    let picked: Vec<usize> = match at {
+        Some(i) => vec![i],
+        None => d.iter().take(3).map(|x| x.1).collect(),
+    };
+    for i in picked {
         let (x, y) = (i % w, i / w);
         for (name, img) in [("A", &a), ("B", &b)] {
             eprintln!("{name} around ({x}, {y}):");
