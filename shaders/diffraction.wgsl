@@ -507,10 +507,6 @@ fn shading_frame(normal: vec3<f32>, tangent: vec3<f32>) -> mat3x3<f32> {
     return mat3x3<f32>(t, cross(n, t), n);
 }
 
-// Below this cos(theta_r) at the pixel centre, the environment shades a
-// partly covered pixel at one of its covered samples (fs_main).
-const ENV_CENTRE_COS: f32 = 0.2;
-
 // Offset (pixels, from the centre) of covered sample number floor(u n) of the
 // n covered samples of a pixel: the standard 4x MSAA positions (Vulkan, D3D,
 // Metal alike). With u uniform the pick is uniform over the covered samples,
@@ -518,9 +514,6 @@ const ENV_CENTRE_COS: f32 = 0.2;
 // shading every covered sample; the frames' sub-pixel jitter moves the samples
 // over the pixel.
 fn covered_pick(covered: u32, u: f32) -> vec2<f32> {
-    if (g.msaa < 4u) {
-        return vec2<f32>(0.0);
-    }
     let pos = array<vec2<f32>, 4>(vec2<f32>(-0.125, -0.375), vec2<f32>(0.375, -0.125), vec2<f32>(-0.375, 0.125), vec2<f32>(0.125, 0.375));
     let n = countOneBits(covered & 15u);
     if (n == 0u) {
@@ -610,10 +603,13 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
         // benchmark sphere is sharper that way (p99 0.3 against 0.9 with the
         // covered samples' mean everywhere). Without masking a silhouette's
         // samples have infinite variance (docs/LIGHTING.md "Grazing views").
-        // (Derivatives here: envg is uniform, so this is uniform control flow.)
-        env_seed_at(vec2<u32>(in.clip.xy), envg.frame);
-        let grazing = dot(wr, n) <= ENV_CENTRE_COS;
-        let off = select(vec2<f32>(0.0), covered_pick(covered, env_qmc(envg.frame + 1u, 31u)), grazing);
+        // (Derivatives here: envg is uniform, so this is uniform control flow;
+        // the pick only moves the point along them.)
+        var off = vec2<f32>(0.0);
+        if (g.msaa >= 4u && dot(wr, n) <= ENV_GRAZING_COS) {
+            env_seed_at(vec2<u32>(in.clip.xy), envg.frame);
+            off = covered_pick(covered, env_qmc(envg.frame + 1u, 31u));
+        }
         let world_c = in.world + dpdx(in.world) * off.x + dpdy(in.world) * off.y;
         let normal_c = in.normal + dpdx(in.normal) * off.x + dpdy(in.normal) * off.y;
         let tangent_c = in.tangent + dpdx(in.tangent) * off.x + dpdy(in.tangent) * off.y;

@@ -359,8 +359,9 @@ fn env_pdf(wr: vec3<f32>, uv: vec2<f32>) -> f32 {
 // cells' sub-points.
 const ENV_DEFENSIVE: f32 = 0.25;
 
-// Below this cos(theta_r) a still frame takes ENV_GRAZING_SAMPLES times the
-// draws per pixel (env_shade).
+// A grazing view: below this cos(theta_r) a still frame takes
+// ENV_GRAZING_SAMPLES times the draws per pixel (env_shade), and with MSAA a
+// partly covered pixel shades at one of its covered samples (fs_main).
 const ENV_GRAZING_COS: f32 = 0.2;
 const ENV_GRAZING_SAMPLES: u32 = 4u;
 

@@ -57,6 +57,16 @@ impl Masking {
         }
     }
 
+    /// The model's gain with this masking: `G(wi, wr) G2(wi, wr)` (index 1.5,
+    /// [`crate::gain::DEFAULT_IOR`]), what every light direction is shaded with.
+    pub fn gain(self, wi: [f64; 3], wr: [f64; 3]) -> f64 {
+        let g = crate::gain::g(wi, wr, crate::gain::DEFAULT_IOR);
+        match self {
+            Masking::Off => g,
+            Masking::Smith { .. } => g * self.factor(wi, wr),
+        }
+    }
+
     /// The rms slopes (zeros when off): what the player's shader gets.
     pub fn rms_slope(self) -> [f64; 2] {
         match self {

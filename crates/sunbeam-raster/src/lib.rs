@@ -253,12 +253,12 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
                 "meshes[{i}].diffuse_weight must be in [0, 1]"
             )));
         }
-        let masking = match &pack {
-            Some(k) => mi
+        let masking = match (&pack, &mi.pack) {
+            (Some(k), Some(path)) => mi
                 .masking_slope(i, k.manifest.rms_slope)
-                .map_err(|e| e.context(format!("meshes[{i}].pack {}", k_path(mi))))?
+                .map_err(|e| e.context(format!("meshes[{i}].pack {}", path.display())))?
                 .map_or(Masking::Off, Masking::smith),
-            None => Masking::Off,
+            _ => Masking::Off,
         };
         meshes.push((
             mesh,
@@ -276,14 +276,6 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
         environment,
         env_cache: EnvCache::default(),
     })
-}
-
-/// The pack file of a mesh instance, for messages.
-fn k_path(mi: &sunbeam_scene::MeshInstance) -> String {
-    mi.pack
-        .as_deref()
-        .map(|p| p.display().to_string())
-        .unwrap_or_default()
 }
 
 /// The scene's `environment` block as a light source (the sky built, the map read).

@@ -14,8 +14,8 @@
 use crate::raster::Fragment;
 use crate::spectral::Samples;
 use crate::{Options, Prepared};
+use sunbeam_optics::cie;
 use sunbeam_optics::colour::{self, ToneMap};
-use sunbeam_optics::{cie, gain};
 
 pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -89,7 +89,7 @@ impl<'a> Shader<'a> {
             None => cie::integrate_xyz_1nm(cie::DEFAULT_RANGE_NM, r),
             Some(s) => s.integrate(r),
         };
-        let g = gain::g(wi, wr, gain::DEFAULT_IOR) * self.p.meshes[mi].1.masking.factor(wi, wr);
+        let g = self.p.meshes[mi].1.masking.gain(wi, wr);
         xyz.map(|c| c * g)
     }
 

@@ -44,7 +44,6 @@ use crate::build::{self, Options};
 use crate::env::env_weights;
 use crate::grid::Grid;
 use sunbeam_light::Environment;
-use sunbeam_optics::gain;
 use sunbeam_optics::masking::Masking;
 use sunbeam_pack::Pack;
 
@@ -206,7 +205,7 @@ impl EnvQuadrature {
     }
 
     /// The diffraction part (XYZ) towards local view `wr` (unit, `z > 0`) of
-    /// a surface with frame `frame`, lit by `env`: the sum over class
+    /// an unmasked surface with frame `frame`, lit by `env`: the sum over class
     /// `part.0` of `part.1` (1, 4, 16, .. a square) times `part.1`, plus the
     /// sun at the point `sun_u` of its disc.
     pub fn integrate(
@@ -316,7 +315,7 @@ impl EnvQuadrature {
                 let wi = [dot(t), dot(b), dot(n)];
                 let wr = q.wr;
                 if wi[2] > 0.0 {
-                    let gain = gain::g(wi, wr, gain::DEFAULT_IOR) * q.masking.factor(wi, wr);
+                    let gain = q.masking.gain(wi, wr);
                     let e = self.lookup_sun(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
                     for a in 0..3 {
                         xyz[a] += gain * e[a];
@@ -594,7 +593,7 @@ impl<'a> View<'a> {
         }
         let ci = (1.0 - d2).sqrt();
         let wi = [x, y, ci];
-        let gain = gain::g(wi, self.wr, gain::DEFAULT_IOR) * self.masking.factor(wi, self.wr) / ci;
+        let gain = self.masking.gain(wi, self.wr) / ci;
         if gain > 0.0 && gain.is_finite() {
             let c = self.coefficients([x, y, ci]);
             self.add(quad, ci, r, area * gain, c, e, xyz);
@@ -657,10 +656,7 @@ impl<'a> View<'a> {
                 }
                 let dm = (1.0 - ci * ci).max(0.0).sqrt().max(1e-9);
                 let wi = [x * dm / d, y * dm / d, ci];
-                let gs = gain::g(wi, self.wr, gain::DEFAULT_IOR)
-                    * self.masking.factor(wi, self.wr)
-                    * (ci + cr)
-                    * (ci + cr);
+                let gs = self.masking.gain(wi, self.wr) * (ci + cr) * (ci + cr);
                 let f = wgt * half.abs() * density(dm) / dm * gs;
                 if f > 0.0 && f.is_finite() {
                     self.add(quad, ci, r, area * f, c, e, xyz);
