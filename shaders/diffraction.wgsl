@@ -432,7 +432,18 @@ fn masking(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     if (wi.z <= 0.0 || wr.z <= 0.0) {
         return 0.0;
     }
-    return 1.0 / (1.0 + smith_lambda(wi) + smith_lambda(wr));
+    return tilt_cap(wi + wr) / (1.0 + smith_lambda(wi) + smith_lambda(wr));
+}
+
+// sunbeam_optics::masking::tilt_cap: G's obliquity with the half vector's
+// tilt held at most 3 Beckmann roughnesses (no steeper facets).
+fn tilt_cap(q: vec3<f32>) -> f32 {
+    let qxy2 = q.x * q.x + q.y * q.y;
+    if (qxy2 <= 0.0) {
+        return 1.0;
+    }
+    let t2 = 18.0 * (q.x * q.x * mat.mask_sx * mat.mask_sx + q.y * q.y * mat.mask_sy * mat.mask_sy) / qxy2;
+    return min(1.0, (1.0 + t2) * q.z * q.z / (qxy2 + q.z * q.z));
 }
 
 fn srgb_oetf(y: f32) -> f32 {

@@ -18,8 +18,12 @@
 //!
 //! (Walter et al. 2007; Heitz 2014 for the height-correlated form and the
 //! anisotropic projected roughness). `Lambda ~ 1/(2 a sqrt(pi))` as the
-//! direction grazes, so `G2 ~ cos(theta_r)` and `G * G2` stays bounded. At
-//! normal incidence and view `G2 = 1`.
+//! direction grazes, so `G2 ~ cos(theta_r)` and `G * G2` stays bounded for
+//! each light direction. At normal incidence and view `G2 = 1`. Where the
+//! light grazes too, `G`'s Kirchhoff obliquity (a facet facing the half
+//! vector) still grows without bound; `tilt_cap` holds the half vector's tilt
+//! at the steepest facet the slopes allow, so the factor is
+//! `G2 min(1, cos^2(theta_h) / cos^2(theta_T))`.
 
 /// Which masking the shading applies on top of `G`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -44,7 +48,8 @@ impl Masking {
     }
 
     /// The factor on `G` for local unit directions `wi` (to the light) and
-    /// `wr` (to the viewer); 1 when off, 0 when either is at or below the horizon.
+    /// `wr` (to the viewer): `G2` times the tilt cap; 1 when off, 0 when either
+    /// is at or below the horizon.
     pub fn factor(self, wi: [f64; 3], wr: [f64; 3]) -> f64 {
         match self {
             Masking::Off => 1.0,
@@ -52,7 +57,7 @@ impl Masking {
                 if !(wi[2] > 0.0 && wr[2] > 0.0) {
                     return 0.0;
                 }
-                1.0 / (1.0 + lambda(wi, rms_slope) + lambda(wr, rms_slope))
+                tilt_cap(wi, wr, rms_slope) / (1.0 + lambda(wi, rms_slope) + lambda(wr, rms_slope))
             }
         }
     }
@@ -74,6 +79,36 @@ impl Masking {
             Masking::Smith { rms_slope } => rms_slope,
         }
     }
+}
+
+/// Facets steeper than this many Beckmann roughnesses (`alpha = sqrt(2) s`)
+/// are taken to be absent: `exp(-9)`, about 1e-4, of the slopes lie beyond.
+pub const MAX_TILT_ALPHAS: f64 = 3.0;
+
+/// The cap on `G`'s Kirchhoff obliquity, `min(1, cos^2(theta_h) / cos^2(theta_T))`:
+/// `G` with the half vector's tilt `theta_h` held at most `theta_T`,
+/// `tan(theta_T) = 3 alpha_h` (the roughness along the half vector's azimuth).
+/// Why: `(1 + wi.wr)^2 / (ci + cr)^2 = |wi + wr|^4 / (4 (ci + cr)^2)` is the
+/// stationary-phase obliquity of a facet facing the half vector; where no facet
+/// is that steep the light there is the patch's own diffraction (the coherence
+/// window's blur of the specular lobe, which at grazing reaches tilts near
+/// 90 degrees), whose exact Kirchhoff obliquity is that of the mean surface
+/// (docs/LIGHTING.md "Grazing views: masking"). Without the cap a limb's light
+/// grows like `1 / cos(theta_r)` even with Smith's masking.
+fn tilt_cap(wi: [f64; 3], wr: [f64; 3], rms_slope: [f64; 2]) -> f64 {
+    let q = [wi[0] + wr[0], wi[1] + wr[1], wi[2] + wr[2]];
+    let qxy2 = q[0] * q[0] + q[1] * q[1];
+    if qxy2 <= 0.0 {
+        return 1.0;
+    }
+    // tan^2(theta_T) = 9 alpha_h^2 = 9 * 2 (qx^2 sx^2 + qy^2 sy^2) / |q_xy|^2
+    let t2 = MAX_TILT_ALPHAS
+        * MAX_TILT_ALPHAS
+        * 2.0
+        * (q[0] * q[0] * rms_slope[0] * rms_slope[0] + q[1] * q[1] * rms_slope[1] * rms_slope[1])
+        / qxy2;
+    // cos^2(theta_h) / cos^2(theta_T) = (1 + tan^2 theta_T) qz^2 / |q|^2
+    ((1.0 + t2) * q[2] * q[2] / (qxy2 + q[2] * q[2])).min(1.0)
 }
 
 /// Smith's `Lambda` for the Beckmann distribution, direction `w` (local, `w.z > 0`).
@@ -195,5 +230,63 @@ mod tests {
         }
         let wr = [(1.0f64 - 1e-12).sqrt(), 0.0, 1e-6];
         assert!(crate::gain::g(wi, wr, 1.5) > 1e5 * last);
+    }
+
+    /// Where a facet faces the half vector the cap is 1: moderate angles keep
+    /// G G2 exactly.
+    #[test]
+    fn tilt_cap_leaves_facet_geometry_alone() {
+        let s = [0.21, 0.43];
+        for (wi, wr) in [
+            (dir(0.0, 0.0), dir(30.0, 90.0)),
+            (dir(45.0, 0.0), dir(45.0, 180.0)),
+            (dir(60.0, 90.0), dir(20.0, 250.0)),
+        ] {
+            assert_eq!(tilt_cap(wi, wr, s), 1.0, "{wi:?} {wr:?}");
+        }
+        // Both grazing, 10 degrees off the forward direction: a half vector
+        // tilted 85 degrees, far past 3 alphas (about 61 degrees here).
+        let c = tilt_cap(dir(89.9, 0.0), dir(89.9, 190.0), s);
+        assert!(c > 0.0 && c < 0.05, "{c}");
+    }
+
+    /// The light a grazing view gets from the band where the light grazes
+    /// too: the integral over `wi` of `G G2` times a specular lobe of the
+    /// width a few-micrometre window gives (`exp(-|u|^2 / (2 0.05^2))`)
+    /// settles as `cos(theta_r)` goes to 0 with the cap, and grows like
+    /// `1 / cos(theta_r)` without it.
+    #[test]
+    fn grazing_band_light_is_bounded() {
+        let s = [0.21, 0.43];
+        let m = Masking::smith(s);
+        let band = |cr: f64, capped: bool| {
+            let wr = [(1.0 - cr * cr).sqrt(), 0.0, cr];
+            let (nc, np) = (400, 1200);
+            let mut sum = 0.0;
+            for ic in 0..nc {
+                let (t0, t1) = (ic as f64 / nc as f64, (ic + 1) as f64 / nc as f64);
+                let (c0, c1) = (t0 * t0 * t0, t1 * t1 * t1);
+                let ci = 0.5 * (c0 + c1);
+                let si = (1.0 - ci * ci).sqrt();
+                for ip in 0..np {
+                    // azimuths within 30 degrees of the forward direction
+                    let p = std::f64::consts::PI + ((ip as f64 + 0.5) / np as f64 - 0.5) * 1.05;
+                    let wi = [si * p.cos(), si * p.sin(), ci];
+                    let u2 = (wi[0] + wr[0]).powi(2) + (wi[1] + wr[1]).powi(2);
+                    let g = crate::gain::g(wi, wr, 1.5);
+                    let g2 = if capped {
+                        m.factor(wi, wr)
+                    } else {
+                        1.0 / (1.0 + lambda(wi, s) + lambda(wr, s))
+                    };
+                    sum += g * g2 * (-u2 / (2.0 * 0.05 * 0.05)).exp() * (c1 - c0);
+                }
+            }
+            sum * 1.05 / np as f64
+        };
+        let (a, b) = (band(1e-2, true), band(1e-4, true));
+        assert!(b < 1.3 * a, "capped: {a} at cos 1e-2, {b} at 1e-4");
+        let (a, b) = (band(1e-2, false), band(1e-4, false));
+        assert!(b > 10.0 * a, "uncapped: {a} at cos 1e-2, {b} at 1e-4");
     }
 }

@@ -57,7 +57,9 @@ pub struct Options {
     /// Samples per pixel (0 or 1: the pixel centre; else a perfect square `s * s`:
     /// a stratified `s x s` grid of sub-pixel positions, averaged in linear light:
     /// what a camera records, the anti-aliased reference). Under an environment
-    /// each sub-pixel sample also draws wavelengths and directions
+    /// the positions are jittered in their strata by the seed (also at 1
+    /// sample: a point of the pixel), and each sub-pixel sample also draws
+    /// wavelengths and directions
     /// ([`environment`], docs/LIGHTING.md).
     pub samples: u32,
     /// Seed of the environment's Monte Carlo sampling (frames with different
@@ -65,6 +67,9 @@ pub struct Options {
     pub seed: u64,
     /// How an environment is integrated ([`environment::EnvEstimator`]).
     pub estimator: environment::EnvEstimator,
+    /// The seed of the sub-pixel positions under an environment (None: `seed`'s).
+    /// Holding it across seeds leaves the directions' noise alone.
+    pub subpixel_seed: Option<u64>,
 }
 
 /// The grid side `s` of `samples = s * s` per pixel, or a usage error.
@@ -349,7 +354,8 @@ pub fn render_prepared_linear(p: &Prepared, opts: &Options) -> Result<LinearImag
 const BAND_FRAGMENTS: usize = 4 << 20;
 
 /// The environment path of [`render_prepared_linear`]: bands of output rows, each
-/// rasterised at `s x s` per pixel; every sub-pixel sample is shaded with the
+/// rasterised at `s x s` per pixel, each sample at a point of its stratum drawn
+/// from the seed (stratified jitter); every sub-pixel sample is shaded with the
 /// point lights (as without an environment) plus one environment sample
 /// ([`environment::EnvShader::sample`]).
 fn render_environment(
@@ -367,12 +373,20 @@ fn render_environment(
     let scale = p.scene.exposure.exp2();
     let eye = p.scene.camera.eye;
     let n = (s * s) as u64;
+    // Each seed puts the sub-pixel samples at other points of their strata,
+    // so the seeds' frames differ by the positions' noise too, and the mean
+    // over seeds converges to the pixel's area average (a fixed grid's error
+    // at a silhouette or a limb is the same in every seed).
+    let positions = raster::Positions::Jittered(
+        environment::EnvShader::rng(opts.subpixel_seed.unwrap_or(opts.seed), u64::MAX, u64::MAX)
+            .next_u64(),
+    );
     let mut out = LinearImage::new(w, h);
     let band = (BAND_FRAGMENTS / (sw as usize * s as usize).max(1)).max(1) as u32;
     let mut y0 = 0;
     while y0 < h {
         let y1 = (y0 + band).min(h);
-        let gbuf = raster::rasterise_rows(p, sw, sh, y0 * s..y1 * s);
+        let gbuf = raster::rasterise_rows_at(p, sw, sh, y0 * s..y1 * s, positions);
         let rows = &mut out.rgb[(y0 * w) as usize..(y1 * w) as usize];
         for_rows(rows, w as usize, opts.threads, |jr, row| {
             let y = y0 as usize + jr;

@@ -2,7 +2,8 @@
 //! result is a G-buffer of what each pixel centre sees.
 
 use crate::Prepared;
-use sunbeam_scene::camera::{transform, Mat4};
+use sunbeam_common::rng::SplitMix64;
+use sunbeam_scene::camera::transform;
 
 /// What a pixel centre sees: the front-most fragment's interpolated attributes.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -71,6 +72,48 @@ pub fn rasterise(p: &Prepared, w: u32, h: u32) -> Vec<Fragment> {
 /// Rows `rows` of [`rasterise`]'s G-buffer (the same fragments; a band keeps the
 /// memory of a heavily supersampled frame bounded).
 pub fn rasterise_rows(p: &Prepared, w: u32, h: u32, rows: std::ops::Range<u32>) -> Vec<Fragment> {
+    rasterise_rows_at(p, w, h, rows, Positions::Centres)
+}
+
+/// Where in its pixel each G-buffer sample sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Positions {
+    /// The pixel centre (the GPU's convention).
+    Centres,
+    /// A uniform point of the pixel from this seed and the pixel's position
+    /// (quantised to the [`SUBPIXEL_BITS`] grid): over a supersampled frame,
+    /// stratified jitter (one point per stratum), unbiased for any coverage.
+    Jittered(u64),
+}
+
+impl Positions {
+    /// Offset of sample `(i, j)` in its pixel, in 1/[`ONE`] pixel units.
+    fn offset(self, i: i64, j: i64) -> [i64; 2] {
+        match self {
+            Positions::Centres => [ONE / 2, ONE / 2],
+            Positions::Jittered(seed) => {
+                let mut g = SplitMix64::new(
+                    seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                        ^ (j as u64).wrapping_mul(0xD1B5_4A32_D192_ED03),
+                );
+                let v = g.next_u64();
+                [
+                    (v & (ONE as u64 - 1)) as i64,
+                    ((v >> 32) & (ONE as u64 - 1)) as i64,
+                ]
+            }
+        }
+    }
+}
+
+/// [`rasterise_rows`] with the samples at `at` in their pixels.
+pub fn rasterise_rows_at(
+    p: &Prepared,
+    w: u32,
+    h: u32,
+    rows: std::ops::Range<u32>,
+    at: Positions,
+) -> Vec<Fragment> {
     let vp = p.scene.camera.view_proj(w, h);
     let mut buf = vec![
         Fragment {
@@ -96,7 +139,7 @@ pub fn rasterise_rows(p: &Prepared, w: u32, h: u32, rows: std::ops::Range<u32>) 
                 }
             });
             for t in clip_near(cv) {
-                raster_triangle(&mut buf, w, h, &rows, mi as u32, mesh, idx, &t, &vp);
+                raster_triangle(&mut buf, w, h, &rows, at, mi as u32, mesh, idx, &t);
             }
         }
     }
@@ -114,11 +157,11 @@ fn raster_triangle(
     w: u32,
     h: u32,
     rows: &std::ops::Range<u32>,
+    at: Positions,
     mi: u32,
     mesh: &crate::Mesh,
     idx: [usize; 3],
     t: &[ClipVert; 3],
-    _vp: &Mat4,
 ) {
     if t.iter().any(|v| {
         v.c[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
@@ -164,19 +207,20 @@ fn raster_triangle(
     let maxx = s.iter().map(|v| v[0]).max().unwrap_or(0);
     let miny = s.iter().map(|v| v[1]).min().unwrap_or(0);
     let maxy = s.iter().map(|v| v[1]).max().unwrap_or(0);
-    // Pixel i covers centres x = i*ONE + ONE/2.
-    let i0 = ((minx - ONE / 2) as f64 / ONE as f64).ceil().max(0.0) as i64;
-    let i1 = (((maxx - ONE / 2) as f64 / ONE as f64).floor() as i64).min(w as i64 - 1);
-    let j0 = ((miny - ONE / 2) as f64 / ONE as f64)
-        .ceil()
-        .max(rows.start as f64) as i64;
-    let j1 = (((maxy - ONE / 2) as f64 / ONE as f64).floor() as i64)
+    // Pixel i's sample is at x = i*ONE + offset, offset in [0, ONE) (ONE/2:
+    // the centre), so the pixels whose samples can fall in [minx, maxx] are
+    // those the range meets.
+    let i0 = minx.div_euclid(ONE).max(0);
+    let i1 = maxx.div_euclid(ONE).min(w as i64 - 1);
+    let j0 = miny.div_euclid(ONE).max(rows.start as i64);
+    let j1 = maxy
+        .div_euclid(ONE)
         .min(h as i64 - 1)
         .min(rows.end as i64 - 1);
     for j in j0..=j1 {
-        let py = j * ONE + ONE / 2;
         for i in i0..=i1 {
-            let px = i * ONE + ONE / 2;
+            let o = at.offset(i, j);
+            let (px, py) = (i * ONE + o[0], j * ONE + o[1]);
             let e = [0, 1, 2].map(|k| edge(edges[k].0, edges[k].1, px, py));
             if (0..3).any(|k| e[k] + bias[k] < 0) {
                 continue;

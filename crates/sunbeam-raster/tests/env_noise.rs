@@ -8,14 +8,19 @@
 //!   cargo test --release -p sunbeam-raster --test env_noise -- --nocapture
 //! `THETAS=85,89` picks the views; `FIXED_LAMBDA=0.37` holds the wavelengths
 //! constant (the spectral share of the noise); `lobe_technique_alone`,
-//! `r_inside_bins` and `worst_pixels` (`A=a.exr B=b.exr`) dissect the rest.
+//! `r_inside_bins` and `worst_pixels` (`A=a.exr B=b.exr`) dissect the rest;
+//! `grazing_views` and `grazing_band_sum` follow a limb's light.
 
 use std::f64::consts::PI;
 use std::sync::Arc;
 use sunbeam_light::{sky::Sky, EnvMap, Environment};
-use sunbeam_optics::colour;
+use sunbeam_optics::{colour, masking::Masking};
 use sunbeam_pack::{build::BuildOptions, FieldRef, Pack};
 use sunbeam_raster::environment::{EnvShader, Uniforms};
+
+/// A pixel's colour difference and its index.
+type Px = (f64, usize);
+use sunbeam_response::quadrature::{EnvQuadrature, Query};
 
 fn ridge_pack() -> Arc<Pack> {
     let (n, dx, period, amp) = (64usize, 50e-9, 1.3e-6, 420e-9);
@@ -208,8 +213,9 @@ fn th_list() -> Vec<(f64, f64)> {
     }
 }
 
-/// The largest CIEDE2000 differences between two frames `A` and `B` (EXR),
-/// with their pixels and luminances.
+/// The largest CIEDE2000 differences between two frames `A` and `B` (EXR;
+/// over the pixels lit in `B`: give the reference as `B`), with their pixels
+/// and luminances.
 #[test]
 fn worst_pixels() {
     use sunbeam_raster::LinearImage;
@@ -254,8 +260,8 @@ fn worst_pixels() {
             v.last().copied().unwrap_or(0.0)
         )
     };
-    let (inner, edge): (Vec<&(f64, usize)>, Vec<&(f64, usize)>) =
-        d.iter().partition(|(_, i)| interior(*i));
+    eprintln!("lit in B {}", pct(d.iter().map(|x| x.0).collect()));
+    let (inner, edge): (Vec<&Px>, Vec<&Px>) = d.iter().partition(|(_, i)| interior(*i));
     eprintln!("interior {}", pct(inner.iter().map(|x| x.0).collect()));
     eprintln!("silhouette {}", pct(edge.iter().map(|x| x.0).collect()));
     let (mut ya, mut yb) = (0.0, 0.0);
@@ -328,5 +334,124 @@ fn worst_pixels() {
             sunbeam_raster::linear::luminance(a.rgb[i]),
             sunbeam_raster::linear::luminance(b.rgb[i])
         );
+    }
+}
+
+/// A flat frame's light at grazing views under the sky (`SUNBEAM_PACK`
+/// required, masked with the demo's slopes): the quadrature against Monte
+/// Carlo (`M` samples, default 20 000), per `cos(theta_r)` down to 1e-4
+/// (docs/LIGHTING.md "Grazing views: masking").
+#[test]
+fn grazing_views() {
+    let pack = Arc::new(
+        Pack::read(std::path::Path::new(
+            &std::env::var("SUNBEAM_PACK").unwrap(),
+        ))
+        .unwrap(),
+    );
+    let env = Arc::new(Environment::Sky(Box::new(Sky::new(35.0, 70.0, 3.0, 1.0))));
+    let mask = Masking::smith([0.21, 0.43]);
+    let (t, b, n) = ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]);
+    let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
+    let q = EnvQuadrature::build(&pack, &env, &EnvQuadrature::reference_options());
+    let es = EnvShader::new(env.clone(), &[Some(pack.clone())]).with_masking(&[mask]);
+    let m: u64 = std::env::var("M")
+        .map(|v| v.parse().unwrap())
+        .unwrap_or(20000);
+    for ph in [0.0f64, 90.0, 200.0] {
+        for cr in [0.3f64, 0.1, 0.03, 0.01, 0.003, 0.001, 1e-4] {
+            let ph = ph.to_radians();
+            let sr = (1.0 - cr * cr).sqrt();
+            let wl = [sr * ph.cos(), sr * ph.sin(), cr];
+            let yq = q.integrate_many(
+                &env,
+                &[Query {
+                    frame: (t, b, n),
+                    wr: wl,
+                    sun_u: [0.5, 0.5],
+                    masking: mask,
+                }],
+                (0, 1),
+            )[0][1];
+            let wr = world(wl);
+            let mut s1 = 0.0;
+            let mut s2 = 0.0;
+            let us = sunbeam_raster::environment::pixel_uniforms(5, 7, m);
+            for u in &us {
+                let y =
+                    colour::linear_srgb_to_xyz(es.sample(0, (t, b, n), wr, [0.0; 3], 0.0, u))[1];
+                s1 += y;
+                s2 += y * y;
+            }
+            let mean = s1 / m as f64;
+            let se = ((s2 / m as f64 - mean * mean).max(0.0) / m as f64).sqrt();
+            eprintln!("phi {:5.0} cr {cr:8.5}: quad Y {yq:10.4} (x cr {:8.5})  mc Y {mean:10.4} +- {se:8.4}", ph.to_degrees(), yq * cr);
+        }
+    }
+}
+
+/// The same at one wavelength (550 nm) under a white environment of radiance
+/// 1, as a direct sum of `G G2 R A / lambda^2` over the hemisphere with `R`
+/// from the pack (`NC` x `NPHI` cells, cubic in `cos(theta_i)`), split by
+/// `cos(theta_i)` bands: which directions hold a grazing view's light.
+#[test]
+fn grazing_band_sum() {
+    let pack = Pack::read(std::path::Path::new(
+        &std::env::var("SUNBEAM_PACK").unwrap(),
+    ))
+    .unwrap();
+    let mask = Masking::smith([0.21, 0.43]);
+    let lam = 550e-9;
+    let a = pack.manifest.coherent_area_m2() / (lam * lam);
+    let nphi: usize = std::env::var("NPHI")
+        .map(|v| v.parse().unwrap())
+        .unwrap_or(2000);
+    let nc: usize = std::env::var("NC")
+        .map(|v| v.parse().unwrap())
+        .unwrap_or(1000);
+    for ph in [0.0f64, 90.0] {
+        for cr in [0.1f64, 0.01, 0.003, 0.001, 1e-4] {
+            let ph = ph.to_radians();
+            let sr = (1.0 - cr * cr).sqrt();
+            let wr = [sr * ph.cos(), sr * ph.sin(), cr];
+            // ci from 0 to 1 in a grid uniform in sqrt(ci) near the horizon.
+            let mut bands = [0.0f64; 4]; // ci<0.01, <0.1, <0.3, rest
+            let mut top = (0.0, 0.0, 0.0, 0.0);
+            for ic in 0..nc {
+                let t0 = ic as f64 / nc as f64;
+                let t1 = (ic + 1) as f64 / nc as f64;
+                let (c0, c1) = (t0 * t0 * t0, t1 * t1 * t1);
+                let ci = 0.5 * (c0 + c1);
+                let si = (1.0 - ci * ci).sqrt();
+                let mut s = 0.0;
+                for ip in 0..nphi {
+                    let p = (ip as f64 + 0.5) / nphi as f64 * std::f64::consts::TAU;
+                    let wi = [si * p.cos(), si * p.sin(), ci];
+                    let g = mask.gain(wi, wr);
+                    if g == 0.0 {
+                        continue;
+                    }
+                    let r = pack.reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], lam);
+                    let v = g * r * a;
+                    if v * (c1 - c0) > top.0 {
+                        top = (v * (c1 - c0), ci, p.to_degrees(), r);
+                    }
+                    s += v;
+                }
+                s *= (c1 - c0) * std::f64::consts::TAU / nphi as f64;
+                let k = if ci < 0.01 {
+                    0
+                } else if ci < 0.1 {
+                    1
+                } else if ci < 0.3 {
+                    2
+                } else {
+                    3
+                };
+                bands[k] += s;
+            }
+            let tot: f64 = bands.iter().sum();
+            eprintln!("phi {:3.0} cr {cr:7.4}: total {tot:9.3}  ci<0.01 {:8.3} <0.1 {:8.3} <0.3 {:8.3} rest {:8.3}  top cell ci {:.4} phi {:.1} R {:.3e}", ph.to_degrees(), bands[0], bands[1], bands[2], bands[3], top.1, top.2, top.3);
+        }
     }
 }

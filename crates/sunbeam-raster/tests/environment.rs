@@ -229,6 +229,17 @@ fn sphere_under(
     seed: u64,
     estimator: EnvEstimator,
 ) -> LinearImage {
+    let opts = Options {
+        samples,
+        seed,
+        estimator,
+        ..Default::default()
+    };
+    sphere_with(env, size, eye, &opts)
+}
+
+/// [`sphere_under`] with explicit options.
+fn sphere_with(env: Environment, size: u32, eye: [f64; 3], opts: &Options) -> LinearImage {
     let (n, dx) = (64usize, 50e-9);
     let pack = pack_of(n, dx, &ridges(n, dx, 1.3e-6, 420e-9), Model::Window);
     let (mut scene, mesh) = fixtures::sphere_scene([size, size]);
@@ -237,16 +248,25 @@ fn sphere_under(
     scene.camera.target = [0.0, 0.0, 0.0];
     let mut p = fixtures::prepared(scene, mesh, Some(pack));
     p.environment = Some(Arc::new(env));
-    render_prepared_linear(
-        &p,
-        &Options {
-            samples,
-            seed,
-            estimator,
-            ..Default::default()
-        },
-    )
-    .unwrap()
+    render_prepared_linear(&p, opts).unwrap()
+}
+
+/// Pixels of a `size x size` frame whose eight neighbours are all lit in every
+/// one of `imgs` (away from the silhouette, where a sub-pixel sample can fall
+/// either side of an edge).
+fn interior_of(imgs: &[&LinearImage], size: usize) -> Vec<usize> {
+    let lit = |i: usize| {
+        imgs.iter()
+            .all(|m| sunbeam_raster::linear::luminance(m.rgb[i]) >= sunbeam_raster::linear::LIT_Y)
+    };
+    (0..size * size)
+        .filter(|&i| {
+            let (x, y) = (i % size, i / size);
+            (1..size - 1).contains(&x)
+                && (1..size - 1).contains(&y)
+                && (0..9).all(|k| lit((y + k / 3 - 1) * size + x + k % 3 - 1))
+        })
+        .collect()
 }
 
 /// The estimators' determinism and noise on a sky-lit ridge patch seen from
@@ -319,10 +339,21 @@ fn rotating_the_environment_equals_rotating_the_scene_back() {
     let rotated = sphere_under(map(r), 20, eye, 16, 5, EnvEstimator::MonteCarlo);
     let back = sunbeam_light::rot_y(eye, -r);
     let scene_rotated = sphere_under(map(0.0), 20, back, 16, 5, EnvEstimator::MonteCarlo);
-    let d = compare_linear(&rotated, &scene_rotated).unwrap();
-    eprintln!("rotated environment vs rotated scene: {d}");
-    assert!(d.pixels > 100, "{d}");
-    assert!(d.p99 < 0.05 && d.max < 1.0, "{d}");
+    // Over the interior: the rotated scene's silhouette moves by rounding, and
+    // a jittered sub-pixel sample can fall on either side of it.
+    let xyz = |p: [f32; 3]| colour::linear_srgb_to_xyz(p.map(f64::from));
+    let mut de: Vec<f64> = interior_of(&[&rotated, &scene_rotated], 20)
+        .into_iter()
+        .map(|i| colour::ciede2000_xyz(xyz(rotated.rgb[i]), xyz(scene_rotated.rgb[i])))
+        .collect();
+    de.sort_by(f64::total_cmp);
+    let (p99, max) = (de[(de.len() - 1) * 99 / 100], de[de.len() - 1]);
+    eprintln!(
+        "rotated environment vs rotated scene, {} interior pixels: p99 {p99:.4} max {max:.4}",
+        de.len()
+    );
+    assert!(de.len() > 80, "{} interior pixels", de.len());
+    assert!(p99 < 0.05 && max < 1.0, "p99 {p99} max {max}");
 }
 
 /// The lobe sampler's `pdf` is the density of its `sample`: over cells of equal
@@ -434,8 +465,8 @@ const MEAN_BOUND: f64 = 13.0;
 const P99_BOUND: f64 = 68.0;
 
 /// The quadrature on the sphere of [`seed_to_seed_noise_of_a_sky_lit_sphere`]:
-/// two seeds at 64 samples per pixel (their only difference: the sub-pixel
-/// positions, the sun's disc points and the texels' classes) differ by less
+/// two seeds at 64 samples per pixel and the same sub-pixel positions (their
+/// only difference: the sun's disc points and the texels' classes) differ by less
 /// than the bound measured when the quadrature was written, with a margin
 /// (on this 24-pixel sphere most pixels span a sharp lobe or the sun's glint,
 /// so 64 sub-pixel positions leave noise that the 64 x 64 sphere of
@@ -449,8 +480,18 @@ fn quadrature_is_quiet_and_agrees_with_monte_carlo() {
     let sky = || Environment::Sky(Box::new(Sky::new(25.0, 120.0, 3.0, 1.0)));
     let eye = [0.0, 0.6, 2.6];
     let q = EnvEstimator::Quadrature;
-    let a = sphere_under(sky(), 24, eye, 64, 1, q);
-    let b = sphere_under(sky(), 24, eye, 64, 2, q);
+    // The same sub-pixel positions in both: the directions' noise alone (the
+    // positions' is large on this small sphere, whose sun glint is a fraction
+    // of a pixel).
+    let at = |seed| Options {
+        samples: 64,
+        seed,
+        estimator: q,
+        subpixel_seed: Some(9),
+        ..Default::default()
+    };
+    let a = sphere_with(sky(), 24, eye, &at(1));
+    let b = sphere_with(sky(), 24, eye, &at(2));
     let d = compare_linear(&a, &b).unwrap();
     eprintln!("quadrature, 24 x 24, 64 samples, seed 1 vs 2: {d}");
     assert!(d.pixels > 150, "{d}");
@@ -468,16 +509,7 @@ fn quadrature_is_quiet_and_agrees_with_monte_carlo() {
     }
     // Interior pixels (all eight neighbours lit): at the silhouette the Monte
     // Carlo estimate still has fireflies at 1024 samples (grazing views).
-    let lit =
-        |i: usize| sunbeam_raster::linear::luminance(m.rgb[i]) >= sunbeam_raster::linear::LIT_Y;
-    let interior: Vec<usize> = (0..24 * 24)
-        .filter(|&i| {
-            let (x, y) = (i % 24, i / 24);
-            (1..23).contains(&x)
-                && (1..23).contains(&y)
-                && (0..9).all(|k| lit((y + k / 3 - 1) * 24 + x + k % 3 - 1))
-        })
-        .collect();
+    let interior = interior_of(&[&m], 24);
     let xyz = |p: [f32; 3]| colour::linear_srgb_to_xyz(p.map(f64::from));
     let sums = |img: &LinearImage| {
         let mut s = [0.0; 3];
@@ -515,6 +547,7 @@ fn quadrature_is_quiet_and_agrees_with_monte_carlo() {
 }
 
 /// Bounds of [`quadrature_is_quiet_and_agrees_with_monte_carlo`]'s seed-to-seed
-/// noise: measured 0.42 and 2.11 (2026-11-25), with a margin of 25 %.
-const Q_MEAN_BOUND: f64 = 0.53;
-const Q_P99_BOUND: f64 = 2.65;
+/// noise at held sub-pixel positions: measured 0.49 and 2.28 (2026-11-25), with
+/// a margin of 25 %.
+const Q_MEAN_BOUND: f64 = 0.61;
+const Q_P99_BOUND: f64 = 2.85;

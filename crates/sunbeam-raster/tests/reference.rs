@@ -53,6 +53,35 @@ fn lambert_quad_centre_and_coverage() {
     }
 }
 
+/// The environment path's sub-pixel samples are jittered in their pixels by
+/// the seed: over seeds, a quad's covered sample count converges to its exact
+/// projected area, which the pixel centres miss (its edges fall at 0.05 px).
+#[test]
+fn jittered_samples_cover_the_exact_area() {
+    let (scene, mesh) = fixtures::quad_scene([16, 16]);
+    let mut p = fixtures::prepared(scene.clone(), mesh, None);
+    // Square quad of side 1 centred on the axis: half side in pixels.
+    let half_px = 5.05;
+    let t = (scene.camera.fov_y_deg.to_radians() / 2.0).tan();
+    p.scene.camera.eye = [0.0, 0.0, 0.5 * 8.0 / (half_px * t)];
+    let area = (2.0 * half_px) * (2.0 * half_px);
+    let count = |g: &[sunbeam_raster::raster::Fragment]| {
+        g.iter().filter(|f| f.mesh.is_some()).count() as f64
+    };
+    let centres = count(&raster::rasterise(&p, 16, 16));
+    assert!((centres - area).abs() > 2.0, "{centres} vs {area}");
+    let n = 400;
+    let mut sum = 0.0;
+    for seed in 0..n {
+        let at = raster::Positions::Jittered(seed);
+        sum += count(&raster::rasterise_rows_at(&p, 16, 16, 0..16, at));
+    }
+    let mean = sum / n as f64;
+    // One seed's count varies by about 3 (the 40 edge pixels' Bernoulli
+    // coverage): 0.15 for the mean of 400.
+    assert!((mean - area).abs() < 0.6, "{mean} vs {area}");
+}
+
 #[test]
 fn sphere_back_faces_are_hidden_and_depth_is_front_most() {
     let (scene, mesh) = fixtures::sphere_scene([48, 48]);
