@@ -61,7 +61,7 @@ pub enum EnvEstimator {
 }
 
 /// Largest number of interleaved classes a pixel's samples share ([`EnvShader::shade_pixel`]).
-pub const MAX_PARTS: usize = 64;
+pub const MAX_PARTS: usize = 1024;
 
 /// One covered sub-pixel sample of a pixel for [`EnvShader::shade_pixel`].
 #[derive(Debug, Clone, Copy)]
@@ -227,8 +227,11 @@ impl EnvShader {
     ///
     /// Interleaved sampling (Keller and Heidrich 2001): the samples of each
     /// mesh share the texels of its maps. With `m` samples of a mesh, the
-    /// texels are split into `K` classes (`K` the largest of 64, 16, 4, 1 not
-    /// above `m`), the samples are dealt the classes in turn after a random
+    /// texels are split into `K` classes (`K` the largest of 1024, 256, 64,
+    /// 16, 4, 1 not above `m` nor above `max(64, m / 4)`: at most 64 up to 256
+    /// samples, then `m / 4`, so that a pixel sums its texels four times
+    /// whatever `m` and more sub-pixel positions cost little more than their
+    /// rasterisation), the samples are dealt the classes in turn after a random
     /// permutation from `rng` (so every class has `m / K` samples, give or
     /// take one), and a sample of class `c` with `m_c` members sums its class
     /// with weight `m / m_c` (times `K` inside the sum over one class): the
@@ -267,9 +270,9 @@ impl EnvShader {
             if m == 0 {
                 continue;
             }
-            let parts = [MAX_PARTS, 16, 4, 1]
+            let parts = [MAX_PARTS, 256, 64, 16, 4, 1]
                 .into_iter()
-                .find(|&k| k <= m)
+                .find(|&k| k <= m && k <= (m / 4).max(64))
                 .unwrap_or(1);
             let mut perm: Vec<usize> = (0..parts).collect();
             for i in (1..parts).rev() {

@@ -98,14 +98,16 @@ fn furnace_through_the_renderer() {
         scene.camera.eye = [0.0, 0.0, 3.0];
         let mut p = fixtures::prepared(scene, mesh, Some(pack));
         p.environment = Some(env);
-        for (estimator, tol) in [
-            (EnvEstimator::MonteCarlo, 0.03),
-            (EnvEstimator::Quadrature, 0.01),
+        // 4096 samples: 1024 interleaved classes of 4 samples each.
+        for (estimator, tol, samples) in [
+            (EnvEstimator::MonteCarlo, 0.03, 256),
+            (EnvEstimator::Quadrature, 0.01, 256),
+            (EnvEstimator::Quadrature, 0.01, 4096),
         ] {
             let img = render_prepared_linear(
                 &p,
                 &Options {
-                    samples: 256,
+                    samples,
                     seed: 3,
                     estimator,
                     ..Default::default()
@@ -122,7 +124,9 @@ fn furnace_through_the_renderer() {
                 .collect();
             assert!(ys.len() > 30, "{} lit pixels", ys.len());
             let y = ys.iter().sum::<f64>() / ys.len() as f64;
-            eprintln!("furnace {n} x {dx:e} {model:?}: Y = {y:.5} over the frame ({estimator:?})");
+            eprintln!(
+                "furnace {n} x {dx:e} {model:?}: Y = {y:.5} over the frame ({estimator:?}, {samples} samples)"
+            );
             assert!(
                 (y - 1.0).abs() < tol,
                 "{n} px {model:?} {estimator:?}: Y = {y}"
