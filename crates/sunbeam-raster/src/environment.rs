@@ -61,7 +61,7 @@ pub enum EnvEstimator {
 }
 
 /// Largest number of interleaved classes a pixel's samples share ([`EnvShader::shade_pixel`]).
-pub const MAX_PARTS: usize = 1024;
+pub const MAX_PARTS: usize = 4096;
 
 /// One covered sub-pixel sample of a pixel for [`EnvShader::shade_pixel`].
 #[derive(Debug, Clone, Copy)]
@@ -227,8 +227,8 @@ impl EnvShader {
     ///
     /// Interleaved sampling (Keller and Heidrich 2001): the samples of each
     /// mesh share the texels of its maps. With `m` samples of a mesh, the
-    /// texels are split into `K` classes (`K` the largest of 1024, 256, 64,
-    /// 16, 4, 1 not above `m` nor above `max(64, m / 4)`: at most 64 up to 256
+    /// texels are split into `K` classes (`K` the largest of 4096, 1024, 256,
+    /// 64, 16, 4, 1 not above `m` nor above `max(64, m / 4)`: at most 64 up to 256
     /// samples, then `m / 4`, so that a pixel sums its texels four times
     /// whatever `m` and more sub-pixel positions cost little more than their
     /// rasterisation), the samples are dealt the classes in turn after a random
@@ -270,7 +270,7 @@ impl EnvShader {
             if m == 0 {
                 continue;
             }
-            let parts = [MAX_PARTS, 256, 64, 16, 4, 1]
+            let parts = [MAX_PARTS, 1024, 256, 64, 16, 4, 1]
                 .into_iter()
                 .find(|&k| k <= m && k <= (m / 4).max(64))
                 .unwrap_or(1);

@@ -78,9 +78,9 @@ pub fn samples_side(samples: u32) -> Result<u32> {
         return Ok(1);
     }
     let s = (samples as f64).sqrt().round() as u32;
-    if s * s != samples || s > 64 {
+    if s * s != samples || s > 128 {
         return Err(Error::usage(format!(
-            "--samples {samples}: give a square number of samples per pixel (1, 4, 9, 16, ... 4096)"
+            "--samples {samples}: give a square number of samples per pixel (1, 4, 9, 16, ... 16384)"
         )));
     }
     Ok(s)

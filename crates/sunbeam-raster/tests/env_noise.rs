@@ -260,6 +260,10 @@ fn worst_pixels() {
             v.last().copied().unwrap_or(0.0)
         )
     };
+    eprintln!(
+        "A against B (sunbeam-play --compare's figure): {}",
+        sunbeam_raster::linear::compare_linear(&a, &b).unwrap()
+    );
     eprintln!("lit in B {}", pct(d.iter().map(|x| x.0).collect()));
     let (inner, edge): (Vec<&Px>, Vec<&Px>) = d.iter().partition(|(_, i)| interior(*i));
     eprintln!("interior {}", pct(inner.iter().map(|x| x.0).collect()));
@@ -454,4 +458,22 @@ fn grazing_band_sum() {
             eprintln!("phi {:3.0} cr {cr:7.4}: total {tot:9.3}  ci<0.01 {:8.3} <0.1 {:8.3} <0.3 {:8.3} rest {:8.3}  top cell ci {:.4} phi {:.1} R {:.3e}", ph.to_degrees(), bands[0], bands[1], bands[2], bands[3], top.1, top.2, top.3);
         }
     }
+}
+
+/// The mean of frames `A` and `B` (EXR, linear light) written to `OUT`: the
+/// mean of two seeds' references without rendering them again.
+#[test]
+fn mean_frames() {
+    use sunbeam_raster::LinearImage;
+    let read =
+        |k: &str| LinearImage::read_exr(std::path::Path::new(&std::env::var(k).unwrap())).unwrap();
+    let (mut a, b) = (read("A"), read("B"));
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    for (p, q) in a.rgb.iter_mut().zip(&b.rgb) {
+        for c in 0..3 {
+            p[c] = 0.5 * (p[c] + q[c]);
+        }
+    }
+    a.write_exr(std::path::Path::new(&std::env::var("OUT").unwrap()))
+        .unwrap();
 }

@@ -196,16 +196,17 @@ pub(crate) struct RenderArgs {
     /// Output: FRAME.png (display values) or FRAME.exr (linear light, exposure applied).
     #[arg(short, long)]
     pub(crate) output: PathBuf,
-    /// Samples per pixel: a stratified s x s grid averaged in linear light (1, 4, 9, 16, ...);
-    /// default 1, or 16 for a scene with an `environment` (Monte Carlo).
+    /// Samples per pixel: a stratified s x s grid averaged in linear light (1, 4, 9, 16,
+    /// ... 16384; under an `environment` each jittered in its cell by --seed);
+    /// default 1, or 16 for a scene with an `environment`.
     #[arg(long)]
     pub(crate) samples: Option<u32>,
     /// What lights the default scene of --mesh/--pack: the built-in sky (default) or the
     /// point light (docs/SCENE.md "The default scene").
     #[arg(long, default_value = "sky", value_parser = clap::builder::PossibleValuesParser::new(["sky", "point"]))]
     pub(crate) lighting: String,
-    /// Seed of the environment lighting's Monte Carlo sampling (scenes with an
-    /// `environment`; two seeds differ by the estimator's noise only). Given
+    /// Seed of the environment lighting's sampling (scenes with an `environment`:
+    /// sub-pixel positions and directions; two seeds differ by the estimator's noise only). Given
     /// more than once, the frame is the mean of the seeds' frames in linear light.
     #[arg(long, default_values_t = [1u64], action = clap::ArgAction::Append)]
     pub(crate) seed: Vec<u64>,
