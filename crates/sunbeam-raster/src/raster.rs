@@ -1,11 +1,12 @@
 //! Triangle rasterisation with the GPU's conventions (see the crate docs): the
-//! result is a G-buffer of what each pixel centre sees.
+//! result is a G-buffer of what each pixel's sample point sees (its centre, or
+//! a point jittered by a seed: [`Positions`]).
 
 use crate::Prepared;
 use sunbeam_common::rng::SplitMix64;
 use sunbeam_scene::camera::transform;
 
-/// What a pixel centre sees: the front-most fragment's interpolated attributes.
+/// What a pixel's sample point sees: the front-most fragment's interpolated attributes.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Fragment {
     /// Index into `Prepared::meshes`; None for the background.

@@ -13,7 +13,9 @@
 # (`--bench`, the sum reset every frame, against `--lambert` in the same run) at
 # 512 x 512. Prints a markdown table. Environment: RES (the sphere's frame
 # size, default 64), SNAKE_W and SNAKE_H (the snake's, default 384 x 216),
-# REF_SAMPLES (default 256), SCENES (default "sphere snake"), SUPERSAMPLE (the
+# REF_SAMPLES (default 4096: the sub-pixel positions are jittered by the seed,
+# and a silhouette needs thousands of them; above 256 they cost little more),
+# SCENES (default "sphere snake"), SUPERSAMPLE (the
 # player's --supersample, default 1), SPHERE_MASKING and SNAKE_MASKING (the
 # meshes' "masking", default off and smith: docs/LIGHTING.md "Grazing views:
 # masking"), SUNBEAM_BIN (the folder of the binaries).
@@ -31,7 +33,7 @@ res=${RES:-64}
 # and nearly every pixel is a silhouette; 384 x 216 gives it ~15 px.
 snake_w=${SNAKE_W:-384}
 snake_h=${SNAKE_H:-216}
-ref_samples=${REF_SAMPLES:-256}
+ref_samples=${REF_SAMPLES:-4096}
 sphere_masking=${SPHERE_MASKING:-off}
 snake_masking=${SNAKE_MASKING:-smith}
 mkdir -p "$out"
