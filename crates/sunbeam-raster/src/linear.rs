@@ -139,6 +139,57 @@ pub fn luminance(p: [f32; 3]) -> f64 {
     colour::linear_srgb_to_xyz(p.map(f64::from))[1]
 }
 
+/// The pixel-wise mean of frames of one size in linear light (e.g. several
+/// seeds' frames of one scene): summed in order, then divided by their count.
+pub fn mean_of(frames: &[LinearImage]) -> Result<LinearImage> {
+    let Some((first, rest)) = frames.split_first() else {
+        return Err(Error::usage("the mean of no frames"));
+    };
+    let mut mean = first.clone();
+    for f in rest {
+        if (f.width, f.height) != (mean.width, mean.height) {
+            return Err(Error::input(format!(
+                "image sizes differ: {}x{} vs {}x{}",
+                f.width, f.height, mean.width, mean.height
+            )));
+        }
+        for (m, p) in mean.rgb.iter_mut().zip(&f.rgb) {
+            for c in 0..3 {
+                m[c] += p[c];
+            }
+        }
+    }
+    let k = frames.len() as f32;
+    for m in &mut mean.rgb {
+        for v in m.iter_mut() {
+            *v /= k;
+        }
+    }
+    Ok(mean)
+}
+
+/// Indices of the pixels whose eight neighbours (and themselves) are lit
+/// (`Y >= LIT_Y`) in every one of `frames` (one size): the interior of the
+/// lit area, away from silhouettes, where a sub-pixel sample can fall on
+/// either side of an edge.
+pub fn interior_pixels(frames: &[&LinearImage]) -> Vec<usize> {
+    let Some(f0) = frames.first() else {
+        return Vec::new();
+    };
+    let (w, h) = (f0.width as usize, f0.height as usize);
+    let lit = |i: usize| frames.iter().all(|f| luminance(f.rgb[i]) >= LIT_Y);
+    (0..w * h)
+        .filter(|&i| {
+            let (x, y) = (i % w, i / w);
+            x > 0
+                && y > 0
+                && x + 1 < w
+                && y + 1 < h
+                && (0..9).all(|k| lit((y + k / 3 - 1) * w + x + k % 3 - 1))
+        })
+        .collect()
+}
+
 /// CIEDE2000 between two linear images over the pixels that are lit in the
 /// reference `b` (`Y >= LIT_Y`): mean, 99th percentile, max (PHYSICS.md 4, with
 /// Lab relative to the D65 white of Y = 1, so values above 1 are allowed).
@@ -186,6 +237,26 @@ mod tests {
         assert_eq!(d.rgb[0][0], 2.5);
         assert_eq!(d.rgb[1][0], 4.5);
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn mean_and_interior() {
+        let mut a = LinearImage::new(4, 3);
+        let mut b = LinearImage::new(4, 3);
+        for (i, (p, q)) in a.rgb.iter_mut().zip(b.rgb.iter_mut()).enumerate() {
+            *p = [0.5, 0.5, 0.5];
+            *q = [1.0 + i as f32, 0.5, 0.0];
+        }
+        let m = mean_of(&[a.clone(), b.clone()]).unwrap();
+        assert_eq!(m.rgb[5], [(0.5 + 6.0) / 2.0, 0.5, 0.25]);
+        assert!(mean_of(&[]).is_err());
+        assert!(mean_of(&[a.clone(), LinearImage::new(3, 3)]).is_err());
+        // 4 x 3, all lit: the interior is (1, 1) and (2, 1).
+        assert_eq!(interior_pixels(&[&a, &b]), vec![5, 6]);
+        // (3, 0) dark in b: (2, 1) has it as a neighbour.
+        b.rgb[3] = [0.0; 3];
+        assert_eq!(interior_pixels(&[&a, &b]), vec![5]);
+        assert_eq!(interior_pixels(&[&a]), vec![5, 6]);
     }
 
     #[test]

@@ -238,17 +238,11 @@ fn worst_pixels() {
     // the interior's luminance ratio: a bias shows in the ratio and in the
     // 2 x 2 block average, noise falls with the blocks.
     let (w, h) = (a.width as usize, a.height as usize);
-    let lit = |x: usize, y: usize| {
-        sunbeam_raster::linear::luminance(b.rgb[y * w + x]) >= sunbeam_raster::linear::LIT_Y
-    };
-    let interior = |i: usize| {
-        let (x, y) = (i % w, i / w);
-        x > 0
-            && y > 0
-            && x + 1 < w
-            && y + 1 < h
-            && (0..9).all(|k| lit(x + k % 3 - 1, y + k / 3 - 1))
-    };
+    let mut inside = vec![false; w * h];
+    for i in sunbeam_raster::linear::interior_pixels(&[&b]) {
+        inside[i] = true;
+    }
+    let interior = |i: usize| inside[i];
     let pct = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         let n = v.len().max(1);
@@ -467,13 +461,8 @@ fn mean_frames() {
     use sunbeam_raster::LinearImage;
     let read =
         |k: &str| LinearImage::read_exr(std::path::Path::new(&std::env::var(k).unwrap())).unwrap();
-    let (mut a, b) = (read("A"), read("B"));
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    for (p, q) in a.rgb.iter_mut().zip(&b.rgb) {
-        for c in 0..3 {
-            p[c] = 0.5 * (p[c] + q[c]);
-        }
-    }
-    a.write_exr(std::path::Path::new(&std::env::var("OUT").unwrap()))
+    sunbeam_raster::linear::mean_of(&[read("A"), read("B")])
+        .unwrap()
+        .write_exr(std::path::Path::new(&std::env::var("OUT").unwrap()))
         .unwrap();
 }

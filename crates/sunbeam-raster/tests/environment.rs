@@ -255,24 +255,6 @@ fn sphere_with(env: Environment, size: u32, eye: [f64; 3], opts: &Options) -> Li
     render_prepared_linear(&p, opts).unwrap()
 }
 
-/// Pixels of a `size x size` frame whose eight neighbours are all lit in every
-/// one of `imgs` (away from the silhouette, where a sub-pixel sample can fall
-/// either side of an edge).
-fn interior_of(imgs: &[&LinearImage], size: usize) -> Vec<usize> {
-    let lit = |i: usize| {
-        imgs.iter()
-            .all(|m| sunbeam_raster::linear::luminance(m.rgb[i]) >= sunbeam_raster::linear::LIT_Y)
-    };
-    (0..size * size)
-        .filter(|&i| {
-            let (x, y) = (i % size, i / size);
-            (1..size - 1).contains(&x)
-                && (1..size - 1).contains(&y)
-                && (0..9).all(|k| lit((y + k / 3 - 1) * size + x + k % 3 - 1))
-        })
-        .collect()
-}
-
 /// The estimators' determinism and noise on a sky-lit ridge patch seen from
 /// the front: the same seed gives the same frame whatever the thread count;
 /// two seeds give frames whose mean luminance agrees to 3 % (under Monte
@@ -346,7 +328,7 @@ fn rotating_the_environment_equals_rotating_the_scene_back() {
     // Over the interior: the rotated scene's silhouette moves by rounding, and
     // a jittered sub-pixel sample can fall on either side of it.
     let xyz = |p: [f32; 3]| colour::linear_srgb_to_xyz(p.map(f64::from));
-    let mut de: Vec<f64> = interior_of(&[&rotated, &scene_rotated], 20)
+    let mut de: Vec<f64> = sunbeam_raster::linear::interior_pixels(&[&rotated, &scene_rotated])
         .into_iter()
         .map(|i| colour::ciede2000_xyz(xyz(rotated.rgb[i]), xyz(scene_rotated.rgb[i])))
         .collect();
@@ -503,17 +485,10 @@ fn quadrature_is_quiet_and_agrees_with_monte_carlo() {
     let mc: Vec<LinearImage> = (11..15)
         .map(|seed| sphere_under(sky(), 24, eye, 256, seed, EnvEstimator::MonteCarlo))
         .collect();
-    let mut m = LinearImage::new(24, 24);
-    for img in &mc {
-        for (o, p) in m.rgb.iter_mut().zip(&img.rgb) {
-            for c in 0..3 {
-                o[c] += p[c] / mc.len() as f32;
-            }
-        }
-    }
+    let m = sunbeam_raster::linear::mean_of(&mc).unwrap();
     // Interior pixels (all eight neighbours lit): at the silhouette the Monte
     // Carlo estimate still has fireflies at 1024 samples (grazing views).
-    let interior = interior_of(&[&m], 24);
+    let interior = sunbeam_raster::linear::interior_pixels(&[&m]);
     let xyz = |p: [f32; 3]| colour::linear_srgb_to_xyz(p.map(f64::from));
     let sums = |img: &LinearImage| {
         let mut s = [0.0; 3];

@@ -72,26 +72,15 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
     }
     // The frame in linear light: one seed's, or the mean of several seeds'.
     let linear = || -> Result<sunbeam_raster::LinearImage> {
-        let mut mean = sunbeam_raster::render_linear(&scene, &opts)?;
+        let mut frames = vec![sunbeam_raster::render_linear(&scene, &opts)?];
         for &seed in &a.seed[1..] {
             let o = sunbeam_raster::Options {
                 seed,
                 ..opts.clone()
             };
-            let img = sunbeam_raster::render_linear(&scene, &o)?;
-            for (m, p) in mean.rgb.iter_mut().zip(&img.rgb) {
-                for c in 0..3 {
-                    m[c] += p[c];
-                }
-            }
+            frames.push(sunbeam_raster::render_linear(&scene, &o)?);
         }
-        let k = a.seed.len() as f32;
-        for m in &mut mean.rgb {
-            for v in m.iter_mut() {
-                *v /= k;
-            }
-        }
-        Ok(mean)
+        sunbeam_raster::linear::mean_of(&frames)
     };
     let exr = a
         .output

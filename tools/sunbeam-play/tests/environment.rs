@@ -75,35 +75,21 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 /// The reference (`sunbeam-eval render --samples S --seed K -o ref.exr`), averaged over seeds.
 fn reference(scene: &Path, samples: u32, seeds: &[u64], out: &Path) -> LinearImage {
     let s = sunbeam_scene::Scene::load(scene).unwrap();
-    let mut acc: Option<LinearImage> = None;
-    for &seed in seeds {
-        let img = sunbeam_raster::render_linear(
-            &s,
-            &sunbeam_raster::Options {
-                samples,
-                seed,
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        match &mut acc {
-            None => acc = Some(img),
-            Some(a) => {
-                for (p, q) in a.rgb.iter_mut().zip(&img.rgb) {
-                    for c in 0..3 {
-                        p[c] += q[c];
-                    }
-                }
-            }
-        }
-    }
-    let mut a = acc.unwrap();
-    let k = seeds.len() as f32;
-    for p in &mut a.rgb {
-        for v in p.iter_mut() {
-            *v /= k;
-        }
-    }
+    let frames: Vec<LinearImage> = seeds
+        .iter()
+        .map(|&seed| {
+            sunbeam_raster::render_linear(
+                &s,
+                &sunbeam_raster::Options {
+                    samples,
+                    seed,
+                    ..Default::default()
+                },
+            )
+            .unwrap()
+        })
+        .collect();
+    let a = sunbeam_raster::linear::mean_of(&frames).unwrap();
     a.write_exr(out).unwrap();
     a
 }
