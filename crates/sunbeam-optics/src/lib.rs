@@ -6,7 +6,9 @@
 //!   the spectral integral of PHYSICS.md 2.
 //! - [`colour`]: XYZ -> linear sRGB, CIELAB, CIEDE2000, and THE tone mapping +
 //!   sRGB encoding shared by the player and the CPU reference renderer.
-//! - [`gain`]: `G(wi, wr)` with Schlick's Fresnel (n = 1.5 by default).
+//! - [`gain`]: `G(wi, wr)` with the exact Fresnel power reflectance, once
+//!   (n = 1.5, absolute reflectance by default), and the diffuse base's `1 - F`.
+//! - [`grazing`]: the window model's exact Kirchhoff amplitude (PHYSICS.md 2b).
 //! - [`masking`]: optional Smith shadowing-masking on top of `G` (grazing views).
 //! - [`truth`]: the ground truth (window and tiled models), sharing no code
 //!   with `sunbeam-pack`.
@@ -15,6 +17,7 @@ pub mod cie;
 mod cie_data;
 pub mod colour;
 pub mod gain;
+pub mod grazing;
 pub mod masking;
 pub mod truth;
 

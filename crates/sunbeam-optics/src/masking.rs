@@ -20,10 +20,9 @@
 //! anisotropic projected roughness). `Lambda ~ 1/(2 a sqrt(pi))` as the
 //! direction grazes, so `G2 ~ cos(theta_r)` and `G * G2` stays bounded for
 //! each light direction. At normal incidence and view `G2 = 1`. Where the
-//! light grazes too, `G`'s Kirchhoff obliquity (a facet facing the half
-//! vector) still grows without bound; `tilt_cap` holds the half vector's tilt
-//! at the steepest facet the slopes allow, so the factor is
-//! `G2 min(1, cos^2(theta_h) / cos^2(theta_T))`.
+//! light grazes too, the window's own diffraction is bounded by the exact
+//! Kirchhoff term (PHYSICS.md 2b, [`crate::grazing`]), not by masking: masking
+//! is a mesh's option, never what keeps the albedo below 1.
 
 /// Which masking the shading applies on top of `G`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -48,8 +47,8 @@ impl Masking {
     }
 
     /// The factor on `G` for local unit directions `wi` (to the light) and
-    /// `wr` (to the viewer): `G2` times the tilt cap; 1 when off, 0 when either
-    /// is at or below the horizon.
+    /// `wr` (to the viewer): `G2`; 1 when off, 0 when either is at or below
+    /// the horizon.
     pub fn factor(self, wi: [f64; 3], wr: [f64; 3]) -> f64 {
         match self {
             Masking::Off => 1.0,
@@ -57,15 +56,15 @@ impl Masking {
                 if !(wi[2] > 0.0 && wr[2] > 0.0) {
                     return 0.0;
                 }
-                tilt_cap(wi, wr, rms_slope) / (1.0 + lambda(wi, rms_slope) + lambda(wr, rms_slope))
+                1.0 / (1.0 + lambda(wi, rms_slope) + lambda(wr, rms_slope))
             }
         }
     }
 
-    /// The model's gain with this masking: `G(wi, wr) G2(wi, wr)` (index 1.5,
-    /// [`crate::gain::DEFAULT_IOR`]), what every light direction is shaded with.
-    pub fn gain(self, wi: [f64; 3], wr: [f64; 3]) -> f64 {
-        let g = crate::gain::g(wi, wr, crate::gain::DEFAULT_IOR);
+    /// The model's gain with this masking: `G(wi, wr) G2(wi, wr)` for the
+    /// skin `mat`, what every light direction is shaded with.
+    pub fn gain(self, wi: [f64; 3], wr: [f64; 3], mat: crate::gain::Material) -> f64 {
+        let g = crate::gain::g(wi, wr, mat);
         match self {
             Masking::Off => g,
             Masking::Smith { .. } => g * self.factor(wi, wr),
@@ -79,36 +78,6 @@ impl Masking {
             Masking::Smith { rms_slope } => rms_slope,
         }
     }
-}
-
-/// Facets steeper than this many Beckmann roughnesses (`alpha = sqrt(2) s`)
-/// are taken to be absent: `exp(-9)`, about 1e-4, of the slopes lie beyond.
-pub const MAX_TILT_ALPHAS: f64 = 3.0;
-
-/// The cap on `G`'s Kirchhoff obliquity, `min(1, cos^2(theta_h) / cos^2(theta_T))`:
-/// `G` with the half vector's tilt `theta_h` held at most `theta_T`,
-/// `tan(theta_T) = 3 alpha_h` (the roughness along the half vector's azimuth).
-/// Why: `(1 + wi.wr)^2 / (ci + cr)^2 = |wi + wr|^4 / (4 (ci + cr)^2)` is the
-/// stationary-phase obliquity of a facet facing the half vector; where no facet
-/// is that steep the light there is the patch's own diffraction (the coherence
-/// window's blur of the specular lobe, which at grazing reaches tilts near
-/// 90 degrees), whose exact Kirchhoff obliquity is that of the mean surface
-/// (docs/LIGHTING.md "Grazing views: masking"). Without the cap a limb's light
-/// grows like `1 / cos(theta_r)` even with Smith's masking.
-fn tilt_cap(wi: [f64; 3], wr: [f64; 3], rms_slope: [f64; 2]) -> f64 {
-    let q = [wi[0] + wr[0], wi[1] + wr[1], wi[2] + wr[2]];
-    let qxy2 = q[0] * q[0] + q[1] * q[1];
-    if qxy2 <= 0.0 {
-        return 1.0;
-    }
-    // tan^2(theta_T) = 9 alpha_h^2 = 9 * 2 (qx^2 sx^2 + qy^2 sy^2) / |q_xy|^2
-    let t2 = MAX_TILT_ALPHAS
-        * MAX_TILT_ALPHAS
-        * 2.0
-        * (q[0] * q[0] * rms_slope[0] * rms_slope[0] + q[1] * q[1] * rms_slope[1] * rms_slope[1])
-        / qxy2;
-    // cos^2(theta_h) / cos^2(theta_T) = (1 + tan^2 theta_T) qz^2 / |q|^2
-    ((1.0 + t2) * q[2] * q[2] / (qxy2 + q[2] * q[2])).min(1.0)
 }
 
 /// Smith's `Lambda` for the Beckmann distribution, direction `w` (local, `w.z > 0`).
@@ -224,42 +193,28 @@ mod tests {
         for k in 1..=6 {
             let cr = 10f64.powi(-k);
             let wr = [(1.0 - cr * cr).sqrt(), 0.0, cr];
-            let gm = crate::gain::g(wi, wr, 1.5) * m.factor(wi, wr);
+            let gm = crate::gain::g(wi, wr, crate::gain::Material::RELATIVE) * m.factor(wi, wr);
             assert!(gm.is_finite() && gm < 200.0, "cos {cr}: {gm}");
             last = gm;
         }
         let wr = [(1.0f64 - 1e-12).sqrt(), 0.0, 1e-6];
-        assert!(crate::gain::g(wi, wr, 1.5) > 1e5 * last);
-    }
-
-    /// Where a facet faces the half vector the cap is 1: moderate angles keep
-    /// G G2 exactly.
-    #[test]
-    fn tilt_cap_leaves_facet_geometry_alone() {
-        let s = [0.21, 0.43];
-        for (wi, wr) in [
-            (dir(0.0, 0.0), dir(30.0, 90.0)),
-            (dir(45.0, 0.0), dir(45.0, 180.0)),
-            (dir(60.0, 90.0), dir(20.0, 250.0)),
-        ] {
-            assert_eq!(tilt_cap(wi, wr, s), 1.0, "{wi:?} {wr:?}");
-        }
-        // Both grazing, 10 degrees off the forward direction: a half vector
-        // tilted 85 degrees, far past 3 alphas (about 61 degrees here).
-        let c = tilt_cap(dir(89.9, 0.0), dir(89.9, 190.0), s);
-        assert!(c > 0.0 && c < 0.05, "{c}");
+        assert!(crate::gain::g(wi, wr, crate::gain::Material::RELATIVE) > 1e5 * last);
     }
 
     /// The light a grazing view gets from the band where the light grazes
-    /// too: the integral over `wi` of `G G2` times a specular lobe of the
-    /// width a few-micrometre window gives (`exp(-|u|^2 / (2 0.05^2))`)
-    /// settles as `cos(theta_r)` goes to 0 with the cap, and grows like
-    /// `1 / cos(theta_r)` without it.
+    /// too, from a flat window patch's specular lobe (`sigma` 3 um at 500 nm),
+    /// with the exact window term (PHYSICS.md 2b): bounded as `cos(theta_r)`
+    /// goes to 0 with Smith masking; without it, it still grows like
+    /// `1 / cos(theta_r)` (the lobe reaches light with `cos(theta_i)` far above
+    /// `cos(theta_r)`, where `q_z^2 / (4 cos_r cos_i)` is large): the amplitude
+    /// window's Kirchhoff model is not energy-conserving at grazing views
+    /// (docs/LIGHTING.md "Grazing views").
     #[test]
-    fn grazing_band_light_is_bounded() {
+    fn grazing_band_light_is_bounded_when_masked() {
         let s = [0.21, 0.43];
         let m = Masking::smith(s);
-        let band = |cr: f64, capped: bool| {
+        let (k, sg) = (2.0 * std::f64::consts::PI / 500e-9, 3e-6);
+        let band = |cr: f64, exact: bool, mask: Masking| {
             let wr = [(1.0 - cr * cr).sqrt(), 0.0, cr];
             let (nc, np) = (400, 1200);
             let mut sum = 0.0;
@@ -269,24 +224,27 @@ mod tests {
                 let ci = 0.5 * (c0 + c1);
                 let si = (1.0 - ci * ci).sqrt();
                 for ip in 0..np {
-                    // azimuths within 30 degrees of the forward direction
-                    let p = std::f64::consts::PI + ((ip as f64 + 0.5) / np as f64 - 0.5) * 1.05;
+                    let p = std::f64::consts::PI + ((ip as f64 + 0.5) / np as f64 - 0.5) * 0.2;
                     let wi = [si * p.cos(), si * p.sin(), ci];
-                    let u2 = (wi[0] + wr[0]).powi(2) + (wi[1] + wr[1]).powi(2);
-                    let g = crate::gain::g(wi, wr, 1.5);
-                    let g2 = if capped {
-                        m.factor(wi, wr)
+                    let uvw = [-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]];
+                    let pa = (-(k * k) * sg * sg * (uvw[0].powi(2) + uvw[1].powi(2)) / 2.0).exp();
+                    let r = if exact {
+                        let du = -k * k * sg * sg * uvw[0] * pa;
+                        let dv = -k * k * sg * sg * uvw[1] * pa;
+                        crate::grazing::window_reflectance(uvw, [pa, 0.0], [du, 0.0], [dv, 0.0], k, [sg, sg])
                     } else {
-                        1.0 / (1.0 + lambda(wi, s) + lambda(wr, s))
+                        pa * pa
                     };
-                    sum += g * g2 * (-u2 / (2.0 * 0.05 * 0.05)).exp() * (c1 - c0);
+                    sum += mask.gain(wi, wr, crate::gain::Material::default()) * r * (c1 - c0);
                 }
             }
-            sum * 1.05 / np as f64
+            sum * 0.2 / np as f64
         };
-        let (a, b) = (band(1e-2, true), band(1e-4, true));
-        assert!(b < 1.3 * a, "capped: {a} at cos 1e-2, {b} at 1e-4");
-        let (a, b) = (band(1e-2, false), band(1e-4, false));
-        assert!(b > 10.0 * a, "uncapped: {a} at cos 1e-2, {b} at 1e-4");
+        let (a, b) = (band(1e-2, true, m), band(1e-4, true, m));
+        assert!(b < 1.3 * a, "masked: {a} at cos 1e-2, {b} at 1e-4");
+        let (a, b) = (band(1e-2, true, Masking::Off), band(1e-4, true, Masking::Off));
+        assert!(b > 10.0 * a, "unmasked, exact term: {a} at cos 1e-2, {b} at 1e-4");
+        // The exact term is below Beckmann's obliquity everywhere in the band.
+        assert!(band(1e-3, true, Masking::Off) < band(1e-3, false, Masking::Off));
     }
 }

@@ -11,7 +11,7 @@
 //! **Window model**: `R(f) = |sum_j g_j e^{i k w h_j} e^{-2 pi i f.(x_j - x_c)}|^2 / (sum_j g_j)^2`
 //! with `x_c` the patch centre, taken as the mean of the pixel positions
 //! `((Mx-1) dx / 2, (My-1) dy / 2)`, and `g` the Gaussian centred there with
-//! `sigma = min(coherence/4, Lmin/6)`, `Lmin = min(Mx dx, My dy)`.
+//! `sigma = min(coherence/(4 sqrt 2), Lmin/6)`, `Lmin = min(Mx dx, My dy)`.
 //!
 //! **Tiled model**: `R(f) = sum_b |Pd[b]|^2 phi(f - b/L) / (Mx My)^2` with
 //! `Pd` the DFT of `exp(i k w h)` over the pixel indices `(c, My-1-r)`, the
@@ -215,7 +215,7 @@ impl Truth {
             .map(|r| ((my - 1 - r) as f64 - 0.5 * (my as f64 - 1.0)) * dy)
             .collect();
         let lmin = (mx as f64 * dx).min(my as f64 * dy);
-        let sigma = (p.coherence_m / 4.0).min(lmin / 6.0);
+        let sigma = (p.coherence_m / (4.0 * std::f64::consts::SQRT_2)).min(lmin / 6.0);
         let gauss = |d: f64| (-(d * d) / (2.0 * sigma * sigma)).exp();
         let gx: Vec<f64> = xs.iter().map(|&x| gauss(x)).collect();
         let gy: Vec<f64> = ys.iter().map(|&y| gauss(y)).collect();
@@ -257,7 +257,7 @@ impl Truth {
         (self.mx, self.my, self.dx, self.dy)
     }
 
-    /// The window model's Gaussian sigma in metres: `min(coherence/4, Lmin/6)`.
+    /// The window model's Gaussian sigma in metres: `min(coherence/(4 sqrt 2), Lmin/6)`.
     pub fn window_sigma_m(&self) -> f64 {
         self.sigma_window_m
     }
@@ -426,21 +426,22 @@ impl Truth {
 
     /// XYZ of the reflected light for local directions `wi` (to the light) and
     /// `wr` (to the viewer), PHYSICS.md 2: the 1 nm integral over 380..780 nm
-    /// of `R S cmf / sum S ybar`, times `G` (Schlick, n = 1.5).
+    /// of `R S cmf / sum S ybar`, times `G` (the thesis' relative
+    /// normalisation: a flat patch head-on gives Y = 1, so `R` reads directly).
     pub fn colour_xyz(&self, wi_local: [f64; 3], wr_local: [f64; 3]) -> [f64; 3] {
-        self.colour_xyz_with(wi_local, wr_local, cie::DEFAULT_RANGE_NM, gain::DEFAULT_IOR)
+        self.colour_xyz_with(wi_local, wr_local, cie::DEFAULT_RANGE_NM, gain::Material::RELATIVE)
     }
 
     /// [`Truth::colour_xyz`] with an explicit wavelength range (nm, inclusive, 1 nm
-    /// steps) and index of refraction.
+    /// steps) and skin material (index, normalisation).
     pub fn colour_xyz_with(
         &self,
         wi: [f64; 3],
         wr: [f64; 3],
         range_nm: (u32, u32),
-        n_ior: f64,
+        mat: gain::Material,
     ) -> [f64; 3] {
-        let g = gain::g(wi, wr, n_ior);
+        let g = gain::g(wi, wr, mat);
         if g == 0.0 {
             return [0.0; 3];
         }

@@ -29,7 +29,7 @@ fn furnace(t: &Truth, lambda: f64, half: f64, n: usize) -> f64 {
             let wr = [0.0, 0.0, 1.0];
             let (u, v, w) = (-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
             let r = t.reflectance(u, v, w, lambda);
-            sum += gain::g(wi, wr, 1.5) * r * h * h;
+            sum += gain::g(wi, wr, gain::Material::RELATIVE) * r * h * h;
         }
     }
     sum * a

@@ -153,7 +153,7 @@ fn naive(
     match model {
         Model::Window => {
             let lmin = (mx as f64 * f.dx).min(my as f64 * f.dy);
-            let sigma = (coherence / 4.0).min(lmin / 6.0);
+            let sigma = (coherence / (4.0 * std::f64::consts::SQRT_2)).min(lmin / 6.0);
             let xc = (mx as f64 - 1.0) * f.dx / 2.0;
             let yc = (my as f64 - 1.0) * f.dy / 2.0;
             let (mut re, mut im, mut gs) = (0.0, 0.0, 0.0);

@@ -275,7 +275,10 @@ pub fn plan(f: FieldRef, o: &BuildOptions) -> Result<Plan> {
 
     let (wx, wy, window_sigma, norm_name, norm_value) = match o.model {
         Model::Window => {
-            let sigma = sigma_s.min(lx.min(ly) / 6.0);
+            // The window acts on the amplitude: sqrt 2 narrower than the
+            // tiled model's Gaussian on the power, so that a flat patch's lobe
+            // |FT g|^2 is exactly the tiled model's phi (PHYSICS.md 2).
+            let sigma = (sigma_s / std::f64::consts::SQRT_2).min(lx.min(ly) / 6.0);
             let gx: Vec<f64> = (0..mx)
                 .map(|c| (-((c as f64 - cx) * f.dx).powi(2) / (2.0 * sigma * sigma)).exp())
                 .collect();

@@ -43,6 +43,26 @@ pub fn kb(x: f64, taps: usize, beta: f64) -> f64 {
     beta / (w * beta.sinh()) * bessel_i0(beta * (1.0 - r * r).sqrt())
 }
 
+/// `d kb / dx` at offset `x` (bins): what the amplitude's derivative along
+/// the frequency needs (PHYSICS.md 2b). `d/dx I0(beta sqrt(1 - r^2)) =
+/// -beta^2 (2 r / W) I1(z)/z` with `I1(z)/z = 1/2 sum_k (z^2/4)^k / (k! (k+1)!)`:
+/// a series of positive terms, smooth up to the support's edge.
+pub fn kb_derivative(x: f64, taps: usize, beta: f64) -> f64 {
+    let w = taps as f64;
+    let r = 2.0 * x / w;
+    if r.abs() >= 1.0 {
+        return 0.0;
+    }
+    let q = beta * beta * (1.0 - r * r) / 4.0;
+    let (mut term, mut sum, mut k) = (1.0f64, 1.0f64, 1.0f64);
+    while term > 1e-17 * sum && k < 500.0 {
+        term *= q / (k * (k + 1.0));
+        sum += term;
+        k += 1.0;
+    }
+    -beta / (w * beta.sinh()) * beta * beta * (2.0 * r / w) * 0.5 * sum
+}
+
 /// Its Fourier transform at `nu` (cycles per bin), 1 at 0.
 pub fn kb_hat(nu: f64, taps: usize, beta: f64) -> f64 {
     let w = taps as f64;
@@ -111,5 +131,20 @@ mod tests {
         assert!((bessel_i0(1.0) - 1.266_065_878).abs() < 1e-8);
         assert!((bessel_i0(5.0) / 27.239_871_82 - 1.0).abs() < 1e-8);
         assert!((bessel_i0(10.0) / 2_815.716_628 - 1.0).abs() < 1e-8);
+    }
+
+    /// The derivative against a central difference of the kernel itself.
+    #[test]
+    fn kb_derivative_matches_central_difference() {
+        for taps in [4usize, 6, 8] {
+            let beta = kb_beta(taps);
+            for i in 0..40 {
+                let x = -(taps as f64) / 2.0 + 0.05 + i as f64 * (taps as f64 - 0.1) / 40.0;
+                let h = 1e-5;
+                let fd = (kb(x + h, taps, beta) - kb(x - h, taps, beta)) / (2.0 * h);
+                let d = kb_derivative(x, taps, beta);
+                assert!((d - fd).abs() < 1e-7 * (1.0 + fd.abs()), "{taps} {x}: {d} vs {fd}");
+            }
+        }
     }
 }

@@ -17,6 +17,8 @@ pub struct Pack {
 struct Taps {
     idx: [i64; 64],
     w: [f64; 64],
+    /// `d w / d kappa` (window model only).
+    dw: [f64; 64],
     n: usize,
 }
 
@@ -78,6 +80,7 @@ impl Pack {
         let mut t = Taps {
             idx: [0; 64],
             w: [0.0; 64],
+            dw: [0.0; 64],
             n: 0,
         };
         for j in 0..taps {
@@ -92,6 +95,9 @@ impl Pack {
             };
             t.idx[t.n] = k + k_half;
             t.w[t.n] = wt;
+            if m.model == Model::Window {
+                t.dw[t.n] = kernel::kb_derivative(d, taps, m.kernel.beta);
+            }
             t.n += 1;
         }
         t
@@ -147,10 +153,76 @@ impl Pack {
         }
     }
 
+    /// The reflectance that shading uses (PHYSICS.md 2b): for the window
+    /// model `R_U` of [`sunbeam_optics::grazing::window_reflectance`], from the
+    /// amplitude and its derivatives along `u` and `v` through the derivative
+    /// of the pack's own interpolation kernel ([`kernel::kb_derivative`]); the
+    /// tiled model keeps Beckmann's factor: [`Pack::reflectance`].
+    pub fn shading_reflectance(&self, u: f64, v: f64, w: f64, lambda_m: f64) -> f64 {
+        let m = &self.manifest;
+        if m.model == Model::Tiled || m.window_sigma_m <= 0.0 {
+            return self.reflectance(u, v, w, lambda_m);
+        }
+        if !(u.is_finite()
+            && v.is_finite()
+            && w.is_finite()
+            && lambda_m.is_finite()
+            && lambda_m > 0.0)
+        {
+            return 0.0;
+        }
+        let c = series::coefficients_f64(m.basis, self.t(w, lambda_m), m.terms);
+        let kappa_x = -u / lambda_m * m.bin_scale_m[0];
+        let kappa_y = -v / lambda_m * m.bin_scale_m[1];
+        if kappa_x.abs() > 1e9 || kappa_y.abs() > 1e9 {
+            return 0.0;
+        }
+        let tx = self.taps(kappa_x, m.crop.kx, 0);
+        let ty = self.taps(kappa_y, m.crop.ky, 1);
+        let layer = m.layer_texels();
+        // amplitude, d/dkappa_x, d/dkappa_y
+        let mut acc = [[0.0f64; 2]; 3];
+        for jy in 0..ty.n {
+            for jx in 0..tx.n {
+                let base = 2 * (ty.idx[jy] as usize * m.crop.width + tx.idx[jx] as usize);
+                let mut a = [0.0f64; 2];
+                for (n, cn) in c.iter().enumerate() {
+                    let i = base + 2 * n * layer;
+                    let (re, im) = (self.terms[i] as f64, self.terms[i + 1] as f64);
+                    a[0] += cn[0] * re - cn[1] * im;
+                    a[1] += cn[0] * im + cn[1] * re;
+                }
+                let wts = [
+                    tx.w[jx] * ty.w[jy],
+                    tx.dw[jx] * ty.w[jy],
+                    tx.w[jx] * ty.dw[jy],
+                ];
+                for (s, wt) in acc.iter_mut().zip(wts) {
+                    s[0] += wt * a[0];
+                    s[1] += wt * a[1];
+                }
+            }
+        }
+        // d/du = (d kappa_x / du) d/dkappa_x = -(bin_scale_x / lambda) d/dkappa_x
+        let sx = -m.bin_scale_m[0] / lambda_m;
+        let sy = -m.bin_scale_m[1] / lambda_m;
+        let k = 2.0 * std::f64::consts::PI / lambda_m;
+        let sg = m.window_sigma_m;
+        sunbeam_optics::grazing::window_reflectance(
+            [u, v, w],
+            acc[0],
+            acc[1].map(|d| d * sx),
+            acc[2].map(|d| d * sy),
+            k,
+            [sg, sg],
+        )
+    }
+
     /// XYZ for local directions `wi` (to the light) and `wr` (to the viewer),
     /// PHYSICS.md 2: `G(wi, wr) * sum_i R(lambda_i) S(lambda_i) cmf(lambda_i) / sum_i S(lambda_i) ybar(lambda_i)`
     /// over `lambda_samples` midpoint samples of the pack's wavelength range
-    /// (so a flat mirror at normal incidence gives Y = 1 exactly).
+    /// (so a flat mirror at normal incidence gives Y = 1 exactly: the relative
+    /// normalisation of plots and of the comparison with the truth).
     pub fn colour_xyz(
         &self,
         wi_local: [f64; 3],
@@ -159,7 +231,7 @@ impl Pack {
     ) -> [f64; 3] {
         use sunbeam_optics::{cie, gain};
         let m = &self.manifest;
-        let g = gain::g(wi_local, wr_local, gain::DEFAULT_IOR);
+        let g = gain::g(wi_local, wr_local, gain::Material::RELATIVE);
         if !(g.is_finite() && g > 0.0) || lambda_samples == 0 {
             return [0.0; 3];
         }

@@ -91,7 +91,7 @@ fn target2_parseval_over_the_full_dft() {
     let f = rough(mx, my, dx, dy, 250e-9, 11);
     // Closed form: M^2 sum g^2 / (sum g)^2 with the window of PHYSICS.md 2.
     let (lx, ly) = (mx as f64 * dx, my as f64 * dy);
-    let sigma = (65e-6f64 / 4.0).min(lx.min(ly) / 6.0);
+    let sigma = (65e-6f64 / (4.0 * std::f64::consts::SQRT_2)).min(lx.min(ly) / 6.0);
     let (cx, cy) = ((mx as f64 - 1.0) / 2.0, (my as f64 - 1.0) / 2.0);
     let (mut sg, mut sg2) = (0.0, 0.0);
     for r in 0..my {
@@ -159,7 +159,7 @@ fn exact_terms(
     let (mx, my) = (f.width, f.height);
     let (lo, hi) = f.finite_range().unwrap();
     let (hc, hh) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
-    let sigma = (65e-6f64 / 4.0).min((mx as f64 * f.dx).min(my as f64 * f.dy) / 6.0);
+    let sigma = (65e-6f64 / (4.0 * std::f64::consts::SQRT_2)).min((mx as f64 * f.dx).min(my as f64 * f.dy) / 6.0);
     let (cx, cy) = (
         (mx as f64 - 1.0) / 2.0 * f.dx,
         (my as f64 - 1.0) / 2.0 * f.dy,

@@ -129,6 +129,7 @@ pub fn prepared(scene: Scene, mesh: Mesh, pack: Option<Arc<Pack>>) -> Prepared {
         base_color: mi.base_color,
         diffuse_weight: mi.diffuse_weight,
         masking: sunbeam_optics::masking::Masking::Off,
+        skin: sunbeam_optics::gain::Material::default(),
     };
     Prepared {
         meshes: vec![(Arc::new(mesh), mat)],

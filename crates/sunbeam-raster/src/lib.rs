@@ -95,6 +95,8 @@ pub struct Material {
     pub diffuse_weight: f64,
     /// Shadowing-masking on the diffraction's `G` (scene `masking`, `rms_slope`).
     pub masking: Masking,
+    /// The skin's interface: index and normalisation of `G` (scene `ior`, `reflectance`).
+    pub skin: sunbeam_optics::gain::Material,
 }
 
 /// A scene with its meshes and packs loaded (shared by both renderers).
@@ -258,6 +260,20 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
                 "meshes[{i}].diffuse_weight must be in [0, 1]"
             )));
         }
+        let (lo, hi) = sunbeam_scene::IOR_RANGE;
+        if !(mi.ior.is_finite() && mi.ior > lo && mi.ior <= hi) {
+            return Err(Error::input(format!(
+                "meshes[{i}].ior {} must be in ({lo}, {hi}]",
+                mi.ior
+            )));
+        }
+        let skin = sunbeam_optics::gain::Material {
+            ior: mi.ior,
+            reflectance: match mi.reflectance {
+                sunbeam_scene::ReflectanceMode::Absolute => sunbeam_optics::gain::Reflectance::Absolute,
+                sunbeam_scene::ReflectanceMode::Relative => sunbeam_optics::gain::Reflectance::Relative,
+            },
+        };
         let masking = match (&pack, &mi.pack) {
             (Some(k), Some(path)) => mi
                 .masking_slope(i, k.manifest.rms_slope)
@@ -272,6 +288,7 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
                 base_color: mi.base_color,
                 diffuse_weight: mi.diffuse_weight,
                 masking,
+                skin,
             },
         ));
     }

@@ -553,7 +553,7 @@ impl LobeSampler {
         let r = self
             .pack
             .reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], lambda_m);
-        gain::g(wi, wr, gain::DEFAULT_IOR) * r * self.area_m2 / (lambda_m * lambda_m)
+        gain::g(wi, wr, gain::Material::default()) * r * self.area_m2 / (lambda_m * lambda_m)
     }
 }
 
@@ -646,15 +646,8 @@ fn direction_of(c: [f64; 2]) -> [f64; 3] {
 /// integrand in frequency space that does not depend on the pack, up to the
 /// view's constant `1 / cos(theta_r)`; defined (finite, positive) at the horizon.
 fn gain_over_cos(wi: [f64; 3], wr: [f64; 3], min_cos: f64) -> f64 {
-    let s = [wi[0] + wr[0], wi[1] + wr[1], wi[2] + wr[2]];
-    let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
-    let cos_h = if len > 0.0 {
-        (wi[0] * s[0] + wi[1] * s[1] + wi[2] * s[2]) / len
-    } else {
-        0.0
-    };
-    let f = gain::schlick(cos_h, gain::DEFAULT_IOR) / gain::f0(gain::DEFAULT_IOR);
+    let f = gain::fresnel(gain::cos_half(wi, wr), gain::DEFAULT_IOR);
     let dot = wi[0] * wr[0] + wi[1] * wr[1] + wi[2] * wr[2];
     let den = wi[2] + wr[2];
-    f * f * (1.0 + dot) * (1.0 + dot) / (den * den) / wi[2].max(min_cos)
+    f * (1.0 + dot) * (1.0 + dot) / (den * den) / wi[2].max(min_cos)
 }

@@ -4,11 +4,14 @@
 //! ```text
 //! n = normalize(N), t = normalize(T - n (n.T)), b = n x t
 //! wi = light direction, wr = normalize(eye - p); local d' = (d.t, d.b, d.n)
-//! diffraction XYZ = G(wi', wr') * sum_l R(u, v, w, l) weight(l)   (0 unless wi'.z > 0 and wr'.z > 0)
-//! rgb += intensity * ( dw * base * max(wi'.z, 0) + (1 - dw) * M_srgb XYZ )
+//! diffraction XYZ = G(wi', wr') * sum_l R_U(u, v, w, l) weight(l)   (0 unless wi'.z > 0 and wr'.z > 0)
+//! rgb += intensity * ( dw * base * max(wi'.z, 0) (1 - F(th_i)) + (1 - dw) * M_srgb XYZ )
 //! ```
-//! with `(u, v, w) = -wi' - wr'`, `dw` the mesh's diffuse weight (1 for a mesh
-//! without a pack: base colour only). The background is its linear colour.
+//! with `(u, v, w) = -wi' - wr'`, `G` the mesh's skin's (absolute by default,
+//! `sunbeam_optics::gain`) times its masking, `R_U` the reflectance with the
+//! window's exact grazing term (`Pack::shading_reflectance`, PHYSICS.md 2b),
+//! `dw` the mesh's diffuse weight (1 and no `(1 - F)` for a mesh without a
+//! pack: base colour only). The background is its linear colour.
 //! Display value = sRGB OETF(tone curve(2^exposure * rgb)).
 
 use crate::raster::Fragment;
@@ -84,12 +87,13 @@ impl<'a> Shader<'a> {
             return [0.0; 3];
         }
         let (u, v, w) = (-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
-        let r = |l: f64| pack.reflectance(u, v, w, l);
+        let r = |l: f64| pack.shading_reflectance(u, v, w, l);
         let xyz = match &self.samples {
             None => cie::integrate_xyz_1nm(cie::DEFAULT_RANGE_NM, r),
             Some(s) => s.integrate(r),
         };
-        let g = self.p.meshes[mi].1.masking.gain(wi, wr);
+        let mat = &self.p.meshes[mi].1;
+        let g = mat.masking.gain(wi, wr, mat.skin);
         xyz.map(|c| c * g)
     }
 
@@ -121,13 +125,19 @@ impl<'a> Shader<'a> {
             };
             let wi_l = local(wi);
             let cos_i = wi_l[2].max(0.0);
+            // The base gets what the interface does not reflect (PHYSICS.md 2).
+            let base_in = if mat.pack.is_some() {
+                cos_i * mat.skin.transmission(cos_i)
+            } else {
+                cos_i
+            };
             let diff = if dw < 1.0 {
                 colour::xyz_to_linear_srgb(self.diffraction_xyz(mi, wi_l, wr_l))
             } else {
                 [0.0; 3]
             };
             for k in 0..3 {
-                rgb[k] += light.intensity * (dw * mat.base_color[k] * cos_i + (1.0 - dw) * diff[k]);
+                rgb[k] += light.intensity * (dw * mat.base_color[k] * base_in + (1.0 - dw) * diff[k]);
             }
         }
         rgb

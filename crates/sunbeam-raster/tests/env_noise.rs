@@ -147,7 +147,7 @@ fn lobe_technique_alone() {
                 eprintln!(
                     "  worst {:.2}: wi {wi:.3?} R {r:.3e} G {:.3} pdf {:.3e}",
                     worst.0,
-                    sunbeam_optics::gain::g(wi, wr, 1.5),
+                    sunbeam_optics::gain::g(wi, wr, sunbeam_optics::gain::Material::default()),
                     ls.pdf(wi, wr, l)
                 );
             }
@@ -425,7 +425,7 @@ fn grazing_band_sum() {
                 for ip in 0..nphi {
                     let p = (ip as f64 + 0.5) / nphi as f64 * std::f64::consts::TAU;
                     let wi = [si * p.cos(), si * p.sin(), ci];
-                    let g = mask.gain(wi, wr);
+                    let g = mask.gain(wi, wr, sunbeam_optics::gain::Material::default());
                     if g == 0.0 {
                         continue;
                     }

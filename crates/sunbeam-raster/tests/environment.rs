@@ -176,7 +176,7 @@ fn estimator_matches_quadrature_under_the_sky() {
             let ph = (ip as f64 + 0.5) * dph;
             let wi = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
             let cell = th.sin() * dth * dph;
-            let gg = gain::g(wi, wr_l, gain::DEFAULT_IOR);
+            let gg = gain::g(wi, wr_l, gain::Material::default());
             let d = world(wi);
             for nm in (380..=780).step_by(10) {
                 let l = nm as f64 * 1e-9;
@@ -202,7 +202,7 @@ fn estimator_matches_quadrature_under_the_sky() {
     let wi = [0, 1, 2]
         .map(|k| s[0] * [t, b, nrm][k][0] + s[1] * [t, b, nrm][k][1] + s[2] * [t, b, nrm][k][2]);
     if wi[2] > 0.0 {
-        let gg = gain::g(wi, wr_l, gain::DEFAULT_IOR);
+        let gg = gain::g(wi, wr_l, gain::Material::default());
         for nm in (380..=780).step_by(10) {
             let l = nm as f64 * 1e-9;
             let r = truth.reflectance(-wi[0] - wr_l[0], -wi[1] - wr_l[1], -wi[2] - wr_l[2], l);

@@ -169,7 +169,7 @@ impl EnvResponse {
                 let wi = [wx, wy, (1.0 - r2).sqrt()];
                 let w = -(wi[2] + wr_l[2]);
                 let c = env.coefficients(world(wi));
-                let f = gain::g(wi, wr_l, gain::DEFAULT_IOR) / (wi[2] * pdf);
+                let f = gain::g(wi, wr_l, gain::Material::default()) / (wi[2] * pdf);
                 for (ck, ek) in c.iter().zip(&self.basis) {
                     let e = ek.lookup(uv[0], uv[1], w);
                     for a in 0..3 {
@@ -186,7 +186,7 @@ impl EnvResponse {
                 if wi[2] > 0.0 {
                     let (uu, vv, w) = (-wi[0] - wr_l[0], -wi[1] - wr_l[1], -wi[2] - wr_l[2]);
                     // The map holds Omega_sun E_sun.
-                    let f = gain::g(wi, wr_l, gain::DEFAULT_IOR);
+                    let f = gain::g(wi, wr_l, gain::Material::default());
                     let e = e_sun.lookup(uu, vv, w);
                     for a in 0..3 {
                         xyz[a] += f * e[a];

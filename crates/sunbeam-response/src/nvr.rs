@@ -87,7 +87,7 @@ pub fn prefilter_nvr_sample(
             let wi = [wx, wy, (1.0 - r2).sqrt()];
             let w = -(wi[2] + N[2]);
             let c = env.coefficients(world(rotate_from_normal(r, wi, false)));
-            let f = gain::g(wi, N, gain::DEFAULT_IOR) / (wi[2] * pdf);
+            let f = gain::g(wi, N, gain::Material::default()) / (wi[2] * pdf);
             for (ck, ek) in c.iter().zip(&e.basis) {
                 let v = ek.lookup(uv[0], uv[1], w);
                 for a in 0..3 {
@@ -103,7 +103,7 @@ pub fn prefilter_nvr_sample(
             let wi = rotate_from_normal(r, [dot(t), dot(b), dot(n)], true);
             if wi[2] > 0.0 {
                 let (uu, vv, w) = (-wi[0] - N[0], -wi[1] - N[1], -wi[2] - N[2]);
-                let f = gain::g(wi, N, gain::DEFAULT_IOR);
+                let f = gain::g(wi, N, gain::Material::default());
                 let v = e_sun.lookup(uu, vv, w);
                 for a in 0..3 {
                     xyz[a] += f * v[a];

@@ -156,7 +156,7 @@ impl Proposal {
             } else {
                 at(0)
             };
-            let gain = gain::g(wi, wr, gain::DEFAULT_IOR);
+            let gain = gain::g(wi, wr, gain::Material::default());
             if inside {
                 sum += v * gain / wi[2].max(0.05);
                 n_in += 1;

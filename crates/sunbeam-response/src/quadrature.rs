@@ -315,7 +315,7 @@ impl EnvQuadrature {
                 let wi = [dot(t), dot(b), dot(n)];
                 let wr = q.wr;
                 if wi[2] > 0.0 {
-                    let gain = q.masking.gain(wi, wr);
+                    let gain = q.masking.gain(wi, wr, sunbeam_optics::gain::Material::default());
                     let e = self.lookup_sun(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
                     for a in 0..3 {
                         xyz[a] += gain * e[a];
@@ -593,7 +593,7 @@ impl<'a> View<'a> {
         }
         let ci = (1.0 - d2).sqrt();
         let wi = [x, y, ci];
-        let gain = self.masking.gain(wi, self.wr) / ci;
+        let gain = self.masking.gain(wi, self.wr, sunbeam_optics::gain::Material::default()) / ci;
         if gain > 0.0 && gain.is_finite() {
             let c = self.coefficients([x, y, ci]);
             self.add(quad, ci, r, area * gain, c, e, xyz);
@@ -656,7 +656,7 @@ impl<'a> View<'a> {
                 }
                 let dm = (1.0 - ci * ci).max(0.0).sqrt().max(1e-9);
                 let wi = [x * dm / d, y * dm / d, ci];
-                let gs = self.masking.gain(wi, self.wr) * (ci + cr) * (ci + cr);
+                let gs = self.masking.gain(wi, self.wr, sunbeam_optics::gain::Material::default()) * (ci + cr) * (ci + cr);
                 let f = wgt * half.abs() * density(dm) / dm * gs;
                 if f > 0.0 && f.is_finite() {
                     self.add(quad, ci, r, area * f, c, e, xyz);

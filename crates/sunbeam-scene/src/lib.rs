@@ -170,6 +170,46 @@ pub struct MeshInstance {
     /// none: the pack's (`rms_slope` in its manifest).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rms_slope: Option<RmsSlope>,
+    /// The skin's refractive index (Fresnel, PHYSICS.md 2): 1.5 by default,
+    /// in (1, 4].
+    #[serde(default = "default_ior")]
+    pub ior: f64,
+    /// `absolute` (default: a dielectric reflects F(0) = 4 % head-on) or
+    /// `relative` (divided by F(0), the thesis' normalisation).
+    #[serde(default)]
+    pub reflectance: ReflectanceMode,
+}
+
+/// `meshes[].reflectance`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ReflectanceMode {
+    /// Physical reflectance (what engines assume for a dielectric).
+    #[default]
+    Absolute,
+    /// Divided by `F(0)`: a flat patch head-on reflects 1.
+    Relative,
+}
+
+// Hand-written so that a bad value names its field.
+impl<'de> Deserialize<'de> for ReflectanceMode {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        match s.as_str() {
+            "absolute" => Ok(ReflectanceMode::Absolute),
+            "relative" => Ok(ReflectanceMode::Relative),
+            _ => Err(serde::de::Error::custom(format!(
+                "meshes[].reflectance \"{s}\": expected \"absolute\" or \"relative\""
+            ))),
+        }
+    }
+}
+
+/// The range `meshes[].ior` accepts.
+pub const IOR_RANGE: (f64, f64) = (1.0, 4.0);
+
+fn default_ior() -> f64 {
+    1.5
 }
 
 /// `meshes[].masking`.
@@ -376,6 +416,8 @@ impl Scene {
                 diffuse_weight: default_diffuse_weight(),
                 masking: MaskingMode::Off,
                 rms_slope: None,
+                ior: default_ior(),
+                reflectance: ReflectanceMode::Absolute,
             }],
             exposure: 0.0,
             background: default_background(),
