@@ -5,9 +5,15 @@
 //   t_l = 2 pi w H / lambda, c_n(t_l) (Chebyshev: i^n eps_n J_n by Miller's
 //   backward recurrence; Taylor: (i t)^n / n!), only the terms |t_l| needs,
 //   amplitude = sum over Kaiser-Bessel taps of weight * sum_n c_n F_n[tap]
-//   (window model, squared after the sum) or power = sum of weight * |sum_n c_n F_n|^2
+//   (window model, squared after the sum; in the direct mode with the
+//   window's exact grazing term, PHYSICS.md 2b: the amplitude's derivatives
+//   along u and v from the kernel's derivative, R_U, as
+//   sunbeam_pack::Pack::shading_reflectance) or power = sum of weight * |sum_n c_n F_n|^2
 //   (tiled model), exactly as sunbeam_pack::Pack::reflectance;
-// XYZ = G * sum_l R_l weight_l; linear sRGB; diffuse blend; exposure; tone curve; sRGB OETF.
+// XYZ = G * G2 * sum_l R_l weight_l (the skin's gain and Smith masking:
+// shaders/material.wgsl, prepended); linear sRGB; diffuse blend
+// dw * base * cos_i * (1 - F(th_i)) + (1 - dw) * rgb (the base alone, cos_i,
+// without a pack); exposure; tone curve; sRGB OETF.
 //
 // Modes: 0 = default: the same sum precomputed per pack, T(u, v, w) (XYZ
 // without G), read from the response map (crates/sunbeam-response: a 3D texture
@@ -38,9 +44,9 @@ struct Globals {
     output: u32,
     exposure_scale: f32,
     n_lambda: u32,
-    f0: f32,
     // samples per pixel of the colour target (1 or 4)
     msaa: u32,
+    _g0: u32,
 };
 
 struct Material {
@@ -79,7 +85,9 @@ struct Material {
     // Smith masking (sunbeam_optics::masking): rms slopes along t and b; 0 = off
     mask_sx: f32,
     mask_sy: f32,
-    _q2: f32,
+    // the skin (sunbeam_optics::gain::Material): refractive index, and what G
+    // is divided by (1 absolute, F(0) relative; Material::norm)
+    ior: f32,
     // response map (sunbeam-response): 1 when bound; texels (angle, radius, s);
     // radial warp rho = asinh(r / r0) / rho_scale; 1 = average over the footprint
     resp_on: u32,
@@ -89,7 +97,13 @@ struct Material {
     resp_r0: f32,
     resp_rho_scale: f32,
     resp_footprint: u32,
-    _r0: f32,
+    norm: f32,
+    // window model: the coherence window's sigma (manifest window_sigma_m) in
+    // um, for R_U in the direct mode; 0 = plain R
+    window_sigma_um: f32,
+    _s0: f32,
+    _s1: f32,
+    _s2: f32,
 };
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -259,8 +273,32 @@ fn tap_weight(d: f32, axis: u32) -> f32 {
     return exp(-d * d / (2.0 * s * s));
 }
 
+// d tap_weight / d kappa of the window model (sunbeam_pack::kernel::kb_derivative):
+// -kb_norm beta^2 (2 r / W) I1(z) / z with I1(z)/z = 1/2 sum_k (z^2/4)^k / (k! (k+1)!).
+fn tap_dweight(d: f32) -> f32 {
+    let w = f32(mat.taps);
+    let r = 2.0 * d / w;
+    if (abs(r) >= 1.0) {
+        return 0.0;
+    }
+    let q = mat.beta * mat.beta * (1.0 - r * r) / 4.0;
+    var term = 1.0;
+    var sum = 1.0;
+    for (var k = 1; k < 60; k = k + 1) {
+        let kk = f32(k);
+        term = term * q / (kk * (kk + 1.0));
+        sum = sum + term;
+        if (term < 1e-8 * sum) {
+            break;
+        }
+    }
+    return -mat.kb_norm * mat.beta * mat.beta * (2.0 * r / w) * 0.5 * sum;
+}
+
 var<private> wx: array<f32, MAX_TAPS>;
 var<private> wy: array<f32, MAX_TAPS>;
+var<private> dwx: array<f32, MAX_TAPS>;
+var<private> dwy: array<f32, MAX_TAPS>;
 
 fn term_at(n: u32, tx: u32, ty: u32) -> vec2<f32> {
     return terms[(n * mat.crop_h + ty) * mat.crop_w + tx];
@@ -270,8 +308,11 @@ fn cmul(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
 }
 
-// R at fractional bin (kappa_x, kappa_y) with coef[0..count] set.
-fn reflectance(kappa: vec2<f32>, count: u32) -> f32 {
+// R at fractional bin (kappa_x, kappa_y) with coef[0..count] set; with
+// `grazing` (the window model's R_U, PHYSICS.md 2b) at (u, v, w) = uvw and
+// 1 / lambda = inv_l (1/um): |P + (u dP/du + v dP/dv) / (sigma^2 k^2 |q|^2)|^2
+// (sunbeam_optics::grazing::window_reflectance).
+fn reflectance(kappa: vec2<f32>, count: u32, grazing: bool, uvw: vec3<f32>, inv_l: f32) -> f32 {
     let taps = i32(mat.taps);
     let k0x = i32(floor(kappa.x)) - taps / 2 + 1;
     let k0y = i32(floor(kappa.y)) - taps / 2 + 1;
@@ -279,25 +320,32 @@ fn reflectance(kappa: vec2<f32>, count: u32) -> f32 {
         let kx = k0x + j;
         if (kx < -mat.kx || kx > mat.kx) {
             wx[j] = 0.0;
+            dwx[j] = 0.0;
         } else {
             wx[j] = tap_weight(kappa.x - f32(kx), 0u);
+            dwx[j] = select(0.0, tap_dweight(kappa.x - f32(kx)), grazing);
         }
         let ky = k0y + j;
         if (ky < -mat.ky || ky > mat.ky) {
             wy[j] = 0.0;
+            dwy[j] = 0.0;
         } else {
             wy[j] = tap_weight(kappa.y - f32(ky), 1u);
+            dwy[j] = select(0.0, tap_dweight(kappa.y - f32(ky)), grazing);
         }
     }
     var amp = vec2<f32>(0.0);
+    // d amp / d kappa_x, d kappa_y (R_U)
+    var ampx = vec2<f32>(0.0);
+    var ampy = vec2<f32>(0.0);
     var power = 0.0;
     for (var jy = 0; jy < taps; jy = jy + 1) {
-        if (wy[jy] == 0.0) {
+        if (wy[jy] == 0.0 && dwy[jy] == 0.0) {
             continue;
         }
         let ty = u32(k0y + jy + mat.ky);
         for (var jx = 0; jx < taps; jx = jx + 1) {
-            if (wx[jx] == 0.0) {
+            if (wx[jx] == 0.0 && dwx[jx] == 0.0) {
                 continue;
             }
             let tx = u32(k0x + jx + mat.kx);
@@ -308,12 +356,26 @@ fn reflectance(kappa: vec2<f32>, count: u32) -> f32 {
             let wgt = wx[jx] * wy[jy];
             if (mat.model == 0u) {
                 amp = amp + wgt * a;
+                ampx = ampx + dwx[jx] * wy[jy] * a;
+                ampy = ampy + wx[jx] * dwy[jy] * a;
             } else {
                 power = power + wgt * dot(a, a);
             }
         }
     }
     if (mat.model == 0u) {
+        if (grazing) {
+            // d/du = (d kappa_x / du) d/dkappa_x = -(bin_scale_x / lambda) d/dkappa_x;
+            // sigma and k in um, so the factors are dimensionless.
+            let q2 = dot(uvw, uvw);
+            let k = TAU * inv_l;
+            let sk = mat.window_sigma_um * k;
+            let c = 1.0 / (sk * sk * q2);
+            let a = amp
+                + (uvw.x * c * (-mat.bin_scale_um.x * inv_l)) * ampx
+                + (uvw.y * c * (-mat.bin_scale_um.y * inv_l)) * ampy;
+            return dot(a, a);
+        }
         return dot(amp, amp);
     }
     return power;
@@ -356,7 +418,8 @@ fn diffraction_xyz(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
         if (g.mode == 1u) {
             r = reflectance_nearest(kappa, count);
         } else {
-            r = reflectance(kappa, count);
+            let grazing = mat.model == 0u && mat.window_sigma_um > 0.0;
+            r = reflectance(kappa, count, grazing, vec3<f32>(u, v, w), s.w);
         }
         xyz = xyz + r * s.xyz;
     }
@@ -387,63 +450,34 @@ fn response_xyz(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
 }
 
 // ---------------------------------------------------------------- response map
-// The material functions are in shaders/response_map.wgsl (prepended to this file).
+// The material functions are in shaders/response_map.wgsl and
+// shaders/material.wgsl (prepended to this file).
 fn resp_grid() -> SbGrid {
-    return SbGrid(vec3<f32>(mat.resp_n_theta, mat.resp_n_rho, mat.resp_n_s), mat.resp_r0, mat.resp_rho_scale, g.f0);
+    return SbGrid(vec3<f32>(mat.resp_n_theta, mat.resp_n_rho, mat.resp_n_s), mat.resp_r0, mat.resp_rho_scale);
+}
+
+// This mesh's skin (shaders/material.wgsl).
+fn skin() -> SbSkin {
+    return SbSkin(mat.ior, mat.norm, vec2<f32>(mat.mask_sx, mat.mask_sy));
 }
 
 fn response_map_xyz(wi: vec3<f32>, uvw: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, jx: vec3<f32>, jy: vec3<f32>) -> vec3<f32> {
     let gr = resp_grid();
     if (mat.resp_footprint == 1u) {
-        return sb_diffraction_xyz_filtered(wi, uvw, dx, dy, jx, jy, gr);
+        return sb_diffraction_xyz_filtered(wi, uvw, dx, dy, jx, jy, gr, skin());
     }
-    return sb_diffraction_xyz(wi, -uvw - wi, gr);
+    return sb_diffraction_xyz(wi, -uvw - wi, gr, skin());
 }
 
 // ---------------------------------------------------------------- colour
-// sunbeam_optics::gain::g (shaders/response_map.wgsl)
+// The mesh's gain with its masking, G G2 (sunbeam_optics::masking::Masking::gain).
 fn gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    return sb_gain(wi, wr, g.f0) * masking(wi, wr);
+    return sb_gain(wi, wr, skin()) * masking(wi, wr);
 }
 
-// sunbeam_optics::masking: Smith's height-correlated shadowing-masking for
-// Beckmann slopes with the material's rms slopes; 1 when off.
-fn smith_lambda(w: vec3<f32>) -> f32 {
-    let at2 = 2.0 * (w.x * w.x * mat.mask_sx * mat.mask_sx + w.y * w.y * mat.mask_sy * mat.mask_sy);
-    if (at2 <= 0.0) {
-        return 0.0;
-    }
-    let a = w.z / sqrt(at2);
-    if (a > 8.0) {
-        return 0.0;
-    }
-    // erf by Abramowitz & Stegun 7.1.26 (a >= 0), as the reference
-    let t = 1.0 / (1.0 + 0.3275911 * a);
-    let p = ((((1.061405429 * t - 1.453152027) * t + 1.421413741) * t - 0.284496736) * t + 0.254829592) * t;
-    let e = exp(-a * a);
-    // (erf(a) - 1) / 2 = -p e / 2
-    return -0.5 * p * e + e / (2.0 * a * 1.7724538509);
-}
-
+// The mesh's Smith masking G2 (1 when off).
 fn masking(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    if (mat.mask_sx <= 0.0 && mat.mask_sy <= 0.0) {
-        return 1.0;
-    }
-    if (wi.z <= 0.0 || wr.z <= 0.0) {
-        return 0.0;
-    }
-    return tilt_cap(wi + wr) / (1.0 + smith_lambda(wi) + smith_lambda(wr));
-}
-
-// sunbeam_optics::masking::tilt_cap: G's obliquity with the half vector's
-// tilt held at most 3 Beckmann roughnesses (no steeper facets).
-fn tilt_cap(q: vec3<f32>) -> f32 {
-    let qxy2 = q.x * q.x + q.y * q.y;
-    if (qxy2 <= 0.0) {
-        return 1.0;
-    }
-    let t2 = 18.0 * (q.x * q.x * mat.mask_sx * mat.mask_sx + q.y * q.y * mat.mask_sy * mat.mask_sy) / qxy2;
-    return min(1.0, (1.0 + t2) * q.z * q.z / (qxy2 + q.z * q.z));
+    return sb_masking(wi, wr, vec2<f32>(mat.mask_sx, mat.mask_sy));
 }
 
 fn srgb_oetf(y: f32) -> f32 {
@@ -502,22 +536,6 @@ fn xyz_to_rgb(c: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(g.xyz_to_rgb[0].xyz, c), dot(g.xyz_to_rgb[1].xyz, c), dot(g.xyz_to_rgb[2].xyz, c));
 }
 
-// The local frame (columns t, b, n) of an interpolated normal and
-// orientation: t made orthogonal to n (any perpendicular when degenerate).
-fn shading_frame(normal: vec3<f32>, tangent: vec3<f32>) -> mat3x3<f32> {
-    let n = normalize(normal);
-    var t = tangent - n * dot(n, tangent);
-    if (length(t) < 1e-12) {
-        var a = vec3<f32>(1.0, 0.0, 0.0);
-        if (abs(n.x) >= 0.9) {
-            a = vec3<f32>(0.0, 1.0, 0.0);
-        }
-        t = a - n * dot(n, a);
-    }
-    t = normalize(t);
-    return mat3x3<f32>(t, cross(n, t), n);
-}
-
 // Offset (pixels, from the centre) of covered sample number floor(u n) of the
 // n covered samples of a pixel: the standard 4x MSAA positions (Vulkan, D3D,
 // Metal alike). With u uniform the pick is uniform over the covered samples,
@@ -544,7 +562,7 @@ fn covered_pick(covered: u32, u: f32) -> vec2<f32> {
 
 @fragment
 fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f32> {
-    let fr = shading_frame(in.normal, in.tangent);
+    let fr = sb_frame(in.normal, in.tangent);
     let t = fr[0];
     let b = fr[1];
     let n = fr[2];
@@ -561,6 +579,8 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
         let wi = g.lights[i].xyz;
         let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
         let cos_i = max(wi_l.z, 0.0);
+        // The base gets what the skin does not reflect (PHYSICS.md 2).
+        let base_in = cos_i * sb_base_transmission(cos_i, mat.ior, diffract);
         // Response-map coordinates and their screen derivatives, here in uniform
         // control flow (derivatives are undefined inside the branch below).
         let uvw = -wi_l - wr_l;
@@ -587,7 +607,7 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
             }
             diff = xyz_to_rgb(xyz);
         }
-        rgb = rgb + g.lights[i].w * (dw * base * cos_i + (1.0 - dw) * diff);
+        rgb = rgb + g.lights[i].w * (dw * base * base_in + (1.0 - dw) * diff);
     }
     // The scene's environment (shaders/environment.wgsl): one Monte Carlo
     // estimate per frame, accumulated by the caller.
@@ -624,7 +644,7 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
         let world_c = in.world + dpdx(in.world) * off.x + dpdy(in.world) * off.y;
         let normal_c = in.normal + dpdx(in.normal) * off.x + dpdy(in.normal) * off.y;
         let tangent_c = in.tangent + dpdx(in.tangent) * off.x + dpdy(in.tangent) * off.y;
-        let fc = shading_frame(normal_c, tangent_c);
+        let fc = sb_frame(normal_c, tangent_c);
         let wr_c = normalize(g.eye.xyz - world_c);
         let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
         rgb = rgb + env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, vec2<u32>(in.clip.xy));

@@ -1,22 +1,28 @@
 // Sunbeam environment lighting in the player (docs/PLAY.md "Environment";
 // contract: docs/LIGHTING.md, crates/sunbeam-response/src/env.rs).
 //
-// Appended to shaders/response_map.wgsl + shaders/diffraction.wgsl (it uses
-// their Globals `g`, SbGrid, sb_resp_coords and sb_gain). Per pixel and frame,
-// for a surface with local frame (t, b, n) and view wr (local):
+// Appended to shaders/material.wgsl + shaders/response_map.wgsl +
+// shaders/diffraction.wgsl (it uses their Globals `g`, Material `mat`, SbGrid,
+// sb_resp_coords, the mesh's gain with its masking `gain` and
+// sb_base_transmission). Per pixel and frame, for a surface with local frame
+// (t, b, n) and view wr (local):
 //
 // - diffraction: `samples` draws (u, v), each from the proposal pyramid
 //   (hierarchical sample warping over the dual cells of the polar grid, the
 //   same cell weights and density as sunbeam_response::Proposal) or, with
 //   probability ENV_DEFENSIVE, uniform over the hemisphere, weighed by the
 //   mixture's density (EnvResponse::draw / density); wi = (-u - wr_x, -v - wr_y, sqrt(..)),
-//   XYZ += [G / wi_z] sum_k c_k(wi) E_k(u, v, w) / pdf(u, v), with c_k from the
+//   XYZ += [G G2 / wi_z] sum_k c_k(wi) E_k(u, v, w) / pdf(u, v), with c_k from the
 //   coefficient table and E_k the extended-light response maps (same coordinates
 //   and sampler as the point-light map);
 // - the sun (sky only): one direction uniform on its disc,
-//   XYZ += G(wi, wr) [Omega_sun E_sun](u, v, w) (the map holds the product);
-// - diffuse: one cosine-weighted direction, base * L_rgb(d) (the irradiance
-//   estimate pi L over pi), plus the sun's base / pi * Omega cos(theta_sun) rgb_sun.
+//   XYZ += G G2(wi, wr) [Omega_sun E_sun](u, v, w) (the map holds the product);
+// - diffuse: one cosine-weighted direction d, base * L_rgb(d) (1 - F(theta_d))
+//   (the estimate of the transmitted irradiance, the integral of
+//   L (1 - F) cos over the hemisphere, pi L (1 - F) over pi: the skin's
+//   Fresnel per sampled direction), plus the sun's
+//   base / pi * Omega cos(theta_sun) (1 - F(theta_sun)) rgb_sun (F at the
+//   disc's centre); 1 - F only under a skin (a mesh with a pack).
 //
 // Random numbers: the PCG hash (Jarzynski and Olano 2020, "Hash functions for
 // GPU rendering") of the pixel, the frame index (frames accumulated since the
@@ -129,7 +135,7 @@ fn env_qmc(i: u32, base: u32) -> f32 {
 
 // ---------------------------------------------------------------- lookups
 fn env_grid() -> SbGrid {
-    return SbGrid(vec3<f32>(envp.n_theta, envp.n_rho, envp.n_s_f), envp.r0, envp.rho_scale, g.f0);
+    return SbGrid(vec3<f32>(envp.n_theta, envp.n_rho, envp.n_s_f), envp.r0, envp.rho_scale);
 }
 
 // Trilinear read of one map at texel coordinates c (as sb_resp_sample).
@@ -215,7 +221,8 @@ fn env_reaches_disc(x0: f32, x1: f32, y0: f32, y1: f32, wr: vec3<f32>) -> bool {
 // cell holds no real cell or misses the view's disc; else the mean, over its
 // four sub-points (fractions 0.25 / 0.75 of its real extent) inside the disc,
 // of the stored value interpolated between the two s layers of that point
-// times G / max(wi_z, 0.05); 0.05 * max(v G) when no sub-point is inside.
+// times G / max(wi_z, 0.05) (the mesh's skin; unmasked); 0.05 * max(v G) when
+// no sub-point is inside.
 // Sub-points, not the centre: across a coarse cell G / cos, s and the rim
 // change, and centre weights starved the lit cells by factors of 30-400.
 fn env_cell_weight(l: u32, x: u32, y: u32, wr: vec3<f32>) -> f32 {
@@ -257,12 +264,12 @@ fn env_cell_weight(l: u32, x: u32, y: u32, wr: vec3<f32>) -> f32 {
         let k1 = min(k0 + 1u, envp.n_s - 1u);
         let f = sc - f32(k0);
         let v = mix(pyramid[o + (k0 * hl + y) * wl + x], pyramid[o + (k1 * hl + y) * wl + x], f);
-        let gain = sb_gain(wi, wr, g.f0);
+        let gn = sb_gain(wi, wr, skin());
         if (inside) {
-            sum = sum + v * gain / max(wz, 0.05);
+            sum = sum + v * gn / max(wz, 0.05);
             n_in = n_in + 1u;
         } else {
-            fallback = max(fallback, v * gain);
+            fallback = max(fallback, v * gn);
         }
     }
     if (n_in > 0u) {
@@ -461,16 +468,18 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     }
     env_seed_at(px, envg.frame);
     var rgb = vec3<f32>(0.0);
-    // Diffuse: one cosine-weighted direction (pdf cos / pi) plus the sun's disc.
+    // Diffuse: one cosine-weighted direction (pdf cos / pi) plus the sun's
+    // disc, each times the share the skin transmits at its incidence.
     if (dw > 0.0) {
         let r = sqrt(env_qmc(envg.frame + 1u, 23u));
         let phi = SB_TAU * env_qmc(envg.frame + 1u, 29u);
         let wl = vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(1.0 - r * r, 0.0)));
         let d = wl.x * t + wl.y * b + wl.z * n;
-        var irr_over_pi = env_basis_rgb(env_coefficients(d));
+        var irr_over_pi = env_basis_rgb(env_coefficients(d)) * sb_base_transmission(wl.z, mat.ior, diffract);
         if (envg.has_sun == 1u) {
             let cs = max(dot(envg.sun_dir.xyz, n), 0.0);
-            irr_over_pi = irr_over_pi + envg.sun_rgb.xyz * envg.sun_rgb.w * cs / ENV_PI;
+            irr_over_pi = irr_over_pi
+                + envg.sun_rgb.xyz * envg.sun_rgb.w * cs / ENV_PI * sb_base_transmission(cs, mat.ior, diffract);
         }
         rgb = rgb + dw * base * irr_over_pi;
     }
@@ -543,7 +552,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
         let c = env_coefficients(d);
         let rc = sb_resp_coords(uvw, gr);
         let e = c.x * env_map(env_e0, rc, gr) + c.y * env_map(env_e1, rc, gr) + c.z * env_map(env_e2, rc, gr);
-        let wgt = sb_gain(wi, wr, g.f0) * masking(wi, wr) / (wi.z * pdf);
+        let wgt = gain(wi, wr) / (wi.z * pdf);
         xyz = xyz + e * wgt;
     }
     xyz = xyz / f32(ns);
@@ -558,7 +567,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
             let uvw = -wi - wr;
             let rc = sb_resp_coords(uvw, gr);
             // the map holds Omega_sun E_sun (EnvResponse::sun)
-            xyz = xyz + sb_gain(wi, wr, g.f0) * masking(wi, wr) * env_map(env_esun, rc, gr);
+            xyz = xyz + gain(wi, wr) * env_map(env_esun, rc, gr);
         }
     }
     return rgb + (1.0 - dw) * xyz_to_rgb(xyz);

@@ -1,23 +1,30 @@
 // The engine interface of the response-map material: what
 // `sunbeam-play --export-shader glsl|hlsl|msl|spv` translates (with
-// shaders/response_map.wgsl prepended), documented in docs/ENGINES.md.
+// shaders/material.wgsl and shaders/response_map.wgsl prepended), documented
+// in docs/ENGINES.md.
 //
 // Bindings (group 0): 0 the material's numbers, 1 the response map (3D texture,
 // RGBA16F from NAME.response.ktx2), 2 its sampler (linear; repeat in x,
 // clamp-to-edge in y and z).
 // Call sunbeam_shade(t, b, n, wi, wr) per light: linear sRGB for a light of
 // intensity 1 (multiply by the light's colour and intensity, sum over lights,
-// then expose and tone-map as the engine does). The entry point
-// sunbeam_fragment shows the call with the five directions as varyings.
+// then expose and tone-map as the engine does); sb_frame(normal, orientation)
+// gives (t, b, n) from the interpolated attributes as the player does. The
+// entry point sunbeam_fragment shows both calls with the attributes and the
+// two directions as varyings.
 
 struct SunbeamMaterial {
-    // xyz: the map's texels along angle, radius, s (grid.n_theta, n_rho, n_s);
-    // w: Schlick F0 of the surface (0.04 for a refractive index of 1.5)
+    // xyz: the map's texels along angle, radius, s (grid.n_theta, n_rho, n_s); w: unused
     grid: vec4<f32>,
     // x: r0 (grid.r0), y: asinh(2 / r0), z: diffuse weight dw in [0, 1], w: unused
     warp: vec4<f32>,
     // rgb: linear sRGB base colour (the Lambert part), a: unused
     base: vec4<f32>,
+    // the skin (PHYSICS.md 2): x: refractive index (1.5), y: what G is divided
+    // by (1 for absolute reflectance, the default; F(0) = ((n - 1)/(n + 1))^2
+    // for relative), zw: Smith masking's rms slopes along t and b (the pack's
+    // rms_slope; (0, 0): no masking)
+    skin: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> sunbeam: SunbeamMaterial;
@@ -33,33 +40,38 @@ fn sb_xyz_to_linear_srgb(c: vec3<f32>) -> vec3<f32> {
     );
 }
 
-// One light of intensity 1, linear sRGB: dw * base * cos(theta_i) +
-// (1 - dw) * diffraction (docs/PLAY.md "Shading"). t: the surface's
-// orientation (the mesh's _ORIENTATION, the patch's +x), n: the normal,
-// b = n x t; wi towards the light, wr towards the viewer; all unit, any common
-// space (world space in a forward pass).
+// One light of intensity 1, linear sRGB (docs/PLAY.md "Shading"):
+// dw * base * cos(theta_i) (1 - F(theta_i)) + (1 - dw) * G G2 T, with G the
+// skin's gain (exact Fresnel, absolute or relative), G2 Smith's masking and
+// T the map. t: the surface's orientation (the mesh's _ORIENTATION, the
+// patch's +x), n: the normal, b = n x t; wi towards the light, wr towards the
+// viewer; all unit, any common space (world space in a forward pass).
 fn sunbeam_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
     let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
-    let gr = SbGrid(sunbeam.grid.xyz, sunbeam.warp.x, sunbeam.warp.y, sunbeam.grid.w);
+    let gr = SbGrid(sunbeam.grid.xyz, sunbeam.warp.x, sunbeam.warp.y);
+    let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw);
     let dw = sunbeam.warp.z;
     var diff = vec3<f32>(0.0);
     if (wi_l.z > 0.0 && wr_l.z > 0.0) {
-        diff = sb_xyz_to_linear_srgb(sb_diffraction_xyz(wi_l, wr_l, gr));
+        let xyz = sb_diffraction_xyz(wi_l, wr_l, gr, skin) * sb_masking(wi_l, wr_l, skin.slope);
+        diff = sb_xyz_to_linear_srgb(xyz);
     }
-    return dw * sunbeam.base.rgb * max(wi_l.z, 0.0) + (1.0 - dw) * diff;
+    let cos_i = max(wi_l.z, 0.0);
+    return dw * sunbeam.base.rgb * cos_i * sb_base_transmission(cos_i, skin.ior, true) + (1.0 - dw) * diff;
 }
 
 struct SunbeamVaryings {
-    @location(0) t: vec3<f32>,
-    @location(1) b: vec3<f32>,
-    @location(2) n: vec3<f32>,
-    @location(3) wi: vec3<f32>,
-    @location(4) wr: vec3<f32>,
+    // the interpolated normal and orientation (any length; sb_frame orthonormalises)
+    @location(0) normal: vec3<f32>,
+    @location(1) orientation: vec3<f32>,
+    @location(2) wi: vec3<f32>,
+    @location(3) wr: vec3<f32>,
 };
 
 @fragment
 fn sunbeam_fragment(v: SunbeamVaryings) -> @location(0) vec4<f32> {
-    let c = sunbeam_shade(normalize(v.t), normalize(v.b), normalize(v.n), normalize(v.wi), normalize(v.wr));
+    let f = sb_frame(v.normal, v.orientation);
+    let c = sunbeam_shade(f[0], f[1], f[2], normalize(v.wi), normalize(v.wr));
     return vec4<f32>(c, 1.0);
 }

@@ -2,24 +2,24 @@
 //
 // The one source of the diffraction colour that sunbeam-play draws (it is
 // prepended to shaders/diffraction.wgsl) and that `sunbeam-play --export-shader`
-// translates for other engines (with shaders/export.wgsl). Everything is in the
-// local frame of the surface: t (the patch's +x, the baked orientation),
-// b = n x t, n; wi towards the light, wr towards the viewer, both unit.
+// translates for other engines (with shaders/export.wgsl). It follows
+// shaders/material.wgsl (SbSkin, sb_gain: the skin's Fresnel and gain).
+// Everything is in the local frame of the surface: t (the patch's +x, the
+// baked orientation), b = n x t, n; wi towards the light, wr towards the
+// viewer, both unit.
 //
 // The including module declares the map and its sampler:
 //   var resp_tex: texture_3d<f32>;  RGBA16F, RGB = XYZ without the gain G
 //   var resp_smp: sampler;          linear, repeat in x (angle), clamp in y, z
 
-// The map's grid and the material's Fresnel reflectance at normal incidence
-// (from the map's KTX2 key `sunbeam.response`: grid.n_theta, n_rho, n_s, r0).
+// The map's grid (from the map's KTX2 key `sunbeam.response`: grid.n_theta,
+// n_rho, n_s, r0).
 struct SbGrid {
     // texels along angle, radius, s
     n: vec3<f32>,
     // radial warp: rho = asinh(r / r0) / rho_scale, rho_scale = asinh(2 / r0)
     r0: f32,
     rho_scale: f32,
-    // Schlick F0 (0.04 for n = 1.5)
-    f0: f32,
 };
 
 const SB_TAU: f32 = 6.283185307179586;
@@ -51,35 +51,12 @@ fn sb_resp_sample(c: vec3<f32>, gr: SbGrid) -> vec3<f32> {
     return textureSampleLevel(resp_tex, resp_smp, (cc + 0.5) / n, 0.0).xyz;
 }
 
-fn sb_schlick(c: f32, f0: f32) -> f32 {
-    let m = 1.0 - clamp(c, 0.0, 1.0);
-    return f0 + (1.0 - f0) * m * m * m * m * m;
-}
-
-// The gain G of PHYSICS.md 2 (sunbeam_optics::gain::g): 1 for a flat mirror at
-// normal incidence.
-fn sb_gain(wi: vec3<f32>, wr: vec3<f32>, f0: f32) -> f32 {
-    let ci = wi.z;
-    let cr = wr.z;
-    if (!(ci > 0.0 && cr > 0.0)) {
-        return 0.0;
-    }
-    let s = wi + wr;
-    let len = length(s);
-    var ch = 0.0;
-    if (len > 0.0) {
-        ch = dot(wi, s) / len;
-    }
-    let f = sb_schlick(ch, f0);
-    let d = 1.0 + dot(wi, wr);
-    return (f * f * d * d) / (f0 * f0 * (ci + cr) * (ci + cr) * cr);
-}
-
-// G T at one direction pair (XYZ; D65 white at Y = 1 for a flat mirror seen
-// head-on under a light of intensity 1).
-fn sb_diffraction_xyz(wi: vec3<f32>, wr: vec3<f32>, gr: SbGrid) -> vec3<f32> {
+// G T at one direction pair (XYZ, without the masking; D65 white at Y = F(0)
+// (absolute) or 1 (relative) for a flat mirror seen head-on under a light of
+// intensity 1).
+fn sb_diffraction_xyz(wi: vec3<f32>, wr: vec3<f32>, gr: SbGrid, skin: SbSkin) -> vec3<f32> {
     let uvw = -wi - wr;
-    return sb_resp_sample(sb_resp_coords(uvw, gr), gr) * sb_gain(wi, wr, gr.f0);
+    return sb_resp_sample(sb_resp_coords(uvw, gr), gr) * sb_gain(wi, wr, skin);
 }
 
 // G T averaged over the pixel (XYZ): the footprint is the parallelogram spanned
@@ -88,11 +65,11 @@ fn sb_diffraction_xyz(wi: vec3<f32>, wr: vec3<f32>, gr: SbGrid) -> vec3<f32> {
 // it (a box filter, as a camera pixel integrates), as many per axis as texels it
 // spans, one when it is within a texel. Each sample has its own (u, v, w), so
 // its own texel coordinates and gain G(wi, wr') with wr' = -(u, v, w)' - wi.
-fn sb_diffraction_xyz_filtered(wi: vec3<f32>, uvw: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, jx: vec3<f32>, jy: vec3<f32>, gr: SbGrid) -> vec3<f32> {
+fn sb_diffraction_xyz_filtered(wi: vec3<f32>, uvw: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, jx: vec3<f32>, jy: vec3<f32>, gr: SbGrid, skin: SbSkin) -> vec3<f32> {
     let nx = u32(clamp(ceil(length(jx)), 1.0, 4.0));
     let ny = u32(clamp(ceil(length(jy)), 1.0, 4.0));
     if (nx * ny == 1u) {
-        return sb_resp_sample(sb_resp_coords(uvw, gr), gr) * sb_gain(wi, -uvw - wi, gr.f0);
+        return sb_resp_sample(sb_resp_coords(uvw, gr), gr) * sb_gain(wi, -uvw - wi, skin);
     }
     var acc = vec3<f32>(0.0);
     for (var a = 0u; a < nx; a = a + 1u) {
@@ -101,7 +78,7 @@ fn sb_diffraction_xyz_filtered(wi: vec3<f32>, uvw: vec3<f32>, dx: vec3<f32>, dy:
             let oy = (f32(b) + 0.5) / f32(ny) - 0.5;
             let q = uvw + ox * dx + oy * dy;
             let wr = normalize(-q - wi);
-            acc = acc + sb_resp_sample(sb_resp_coords(-wi - wr, gr), gr) * sb_gain(wi, wr, gr.f0);
+            acc = acc + sb_resp_sample(sb_resp_coords(-wi - wr, gr), gr) * sb_gain(wi, wr, skin);
         }
     }
     return acc / f32(nx * ny);

@@ -4,7 +4,12 @@
 //! evaluation of the pack, no response map, no GPU), both anti-aliased and
 //! compared in linear light, CIEDE2000 over lit pixels p99 < 2 (issue 12). The
 //! page must load with no WebGL or console errors (render.mjs fails on any).
-//! Scenes: a front-lit sphere and the baked snake, each with a ridge pack.
+//! Scenes: a front-lit sphere and the baked snake, each with a ridge pack
+//! (absolute reflectance, the default; their exposures were raised by
+//! log2(1 / F(0)) = 4.64 stops from those of the relative normalisation, so
+//! the frames are as bright and the comparisons as sensitive as they were),
+//! and the sphere lit from the side with another skin: Smith masking with the
+//! pack's slopes, an index of 1.4, relative reflectance.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -114,8 +119,37 @@ fn threejs_renders_the_sphere_and_the_snake_like_the_reference() {
     let sphere = r#"{ "camera": { "eye": [0, 0, 1.6], "target": [0, 0, 0], "fov_y_deg": 35 },
   "lights": [ { "direction": [0.15, 0.1, 1], "intensity": 1 } ],
   "meshes": [ { "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1 } ],
-  "exposure": 0, "size": [48, 48] }"#;
+  "exposure": 4.64, "size": [48, 48] }"#;
     compare(&render, &d, sphere, "sphere");
+
+    // The skin's uniforms: Smith masking with the pack's rms slopes (from the
+    // map's copy of the manifest), another index, the relative normalisation;
+    // the sphere lit from the side, where the masking shows: the reference
+    // must differ visibly from the unmasked one, or the comparison would not
+    // show that three.js applies it.
+    let skin = r#"{ "camera": { "eye": [0, 0, 1.6], "target": [0, 0, 0], "fov_y_deg": 35 },
+  "lights": [ { "direction": [1, 0.3, 0.25], "intensity": 1 } ],
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1,
+                "masking": "smith", "ior": 1.4, "reflectance": "relative" } ],
+  "exposure": 0, "size": [48, 48] }"#;
+    compare(&render, &d, skin, "sphere-skin");
+    let unmasked = d.join("sphere-skin-unmasked.json");
+    std::fs::write(&unmasked, skin.replace("\"masking\": \"smith\", ", "")).unwrap();
+    let unmasked_ref = d.join("sphere-skin-unmasked.exr");
+    run_ok(
+        Command::new(tool("sunbeam-eval"))
+            .arg("render")
+            .arg(&unmasked)
+            .args(["--samples", "16", "-q", "-o"])
+            .arg(&unmasked_ref),
+    );
+    let c = compare_linear(
+        &LinearImage::read_exr(&d.join("sphere-skin-ref.exr")).unwrap(),
+        &LinearImage::read_exr(&unmasked_ref).unwrap(),
+    )
+    .unwrap();
+    eprintln!("masked vs unmasked reference: {c}");
+    assert!(c.p99 > 5.0, "the masking changed nothing visible: {c}");
 
     let glb = d.join("snake.glb");
     run_ok(
@@ -128,7 +162,7 @@ fn threejs_renders_the_sphere_and_the_snake_like_the_reference() {
     let snake = r#"{ "camera": { "eye": [0, 0.3, 1.0], "target": [0, 0, 0], "fov_y_deg": 35 },
   "lights": [ { "direction": [0.2, 0.5, 1], "intensity": 1 }, { "direction": [-0.5, 0.3, 0.6], "intensity": 0.5 } ],
   "meshes": [ { "mesh": "snake.glb", "pack": "ridges.ktx2", "base_color": [0.05, 0.05, 0.05], "diffuse_weight": 0.2 } ],
-  "exposure": 1, "size": [96, 48] }"#;
+  "exposure": 5.64, "size": [96, 48] }"#;
     compare(&render, &d, snake, "snake");
 
     // The material from the GLB alone (sunbeam-bake --pack writes

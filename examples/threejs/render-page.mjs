@@ -5,8 +5,8 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import {
-  adaptExportedGlsl, addOrientation, builtinGeometry, parseResponseMap, sceneCamera,
-  SunbeamDiffractionPlugin, sunbeamMaterial, updateSunbeamUniforms,
+  adaptExportedGlsl, addOrientation, builtinGeometry, extensionSkin, maskingSlope, parseResponseMap,
+  sceneCamera, SunbeamDiffractionPlugin, sunbeamMaterial, updateSunbeamUniforms,
 } from './sunbeam-three.mjs';
 
 // Colours are linear values as given (no sRGB conversion of inputs or outputs).
@@ -32,14 +32,19 @@ window.sunbeamRender = async (job) => {
       if (!maps.has(url)) maps.set(url, parseResponseMap(await (await fetch(url)).arrayBuffer()));
       return maps.get(url);
     };
-    const make = (map, baseColor, diffuseWeight) => sunbeamMaterial({
-      exportedGlsl: exported, map, baseColor, diffuseWeight, lights: desc.lights, exposure: desc.exposure,
+    const make = (map, baseColor, diffuseWeight, skin) => sunbeamMaterial({
+      exportedGlsl: exported, map, baseColor, diffuseWeight, ...skin, lights: desc.lights, exposure: desc.exposure,
+    });
+    // The scene's skin for a mesh: its index, normalisation and masking (the
+    // pack's rms slopes unless the scene gives them).
+    const sceneSkin = (m, map) => ({
+      ior: m.ior, reflectance: m.reflectance, rmsSlope: map ? maskingSlope(m.masking, m.rmsSlope, map, m.what) : [0, 0],
     });
     for (const m of meshes) {
       // The scene's pack wins; else the GLB's own SUNBEAM_materials_diffraction.
       const sceneMap = m.map ? await loadMap(m.map) : null;
       if (m.builtin) {
-        root.add(new THREE.Mesh(builtinGeometry(m.builtin), make(sceneMap, m.baseColor, m.diffuseWeight)));
+        root.add(new THREE.Mesh(builtinGeometry(m.builtin), make(sceneMap, m.baseColor, m.diffuseWeight, sceneSkin(m, sceneMap))));
         continue;
       }
       const loader = new GLTFLoader();
@@ -51,11 +56,17 @@ window.sunbeamRender = async (job) => {
         addOrientation(o.geometry);
         const ext = o.userData.sunbeam;
         if (sceneMap || !ext || m.packGiven) {
-          o.material = make(sceneMap, m.baseColor, m.diffuseWeight);
+          o.material = make(sceneMap, m.baseColor, m.diffuseWeight, sceneSkin(m, sceneMap));
         } else {
           const url = m.extMaps?.[ext.responseMap.uri];
           if (!url) return { error: `${m.url}: SUNBEAM_materials_diffraction map ${ext.responseMap.uri} not served` };
-          o.material = make(await loadMap(url), ext.baseColor ?? m.baseColor, ext.diffuseWeight ?? m.diffuseWeight);
+          const map = await loadMap(url);
+          // The extension's skin; the scene's masking when the extension says none.
+          const skin = extensionSkin(ext, map, `${m.what} (${m.url}: SUNBEAM_materials_diffraction)`);
+          if (ext.masking === undefined) skin.rmsSlope = maskingSlope(m.masking, m.rmsSlope, map, m.what);
+          if (ext.ior === undefined && ext.f0 === undefined) skin.ior = m.ior;
+          if (ext.reflectance === undefined) skin.reflectance = m.reflectance;
+          o.material = make(map, ext.baseColor ?? m.baseColor, ext.diffuseWeight ?? m.diffuseWeight, skin);
         }
       }
       root.add(gltf.scene);

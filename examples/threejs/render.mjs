@@ -72,7 +72,12 @@ const sceneDir = dirname(resolve(opt.scene));
 if (!scene.camera || !Array.isArray(scene.camera.eye) || !Array.isArray(scene.camera.target)) fail(2, `${opt.scene}: camera.eye and camera.target are required`);
 if (!Array.isArray(scene.meshes) || scene.meshes.length === 0) fail(2, `${opt.scene}: meshes: at least one mesh is required`);
 scene.meshes.forEach((m, i) => {
-  if ((m.masking ?? 'off') !== 'off') fail(2, `${opt.scene}: meshes[${i}].masking: only "off" is rendered here (docs/SCENE.md); the player and sunbeam-eval render "smith"`);
+  const at = `${opt.scene}: meshes[${i}]`;
+  if (!['off', 'smith'].includes(m.masking ?? 'off')) fail(2, `${at}.masking "${m.masking}": expected "off" or "smith"`);
+  const s = m.rms_slope;
+  if (s !== undefined && !((typeof s === 'number' && s >= 0) || (Array.isArray(s) && s.length === 2 && s.every((v) => typeof v === 'number' && v >= 0)))) fail(2, `${at}.rms_slope: expected a number or [x, y], finite and >= 0`);
+  if (m.ior !== undefined && !(typeof m.ior === 'number' && m.ior > 1 && m.ior <= 4)) fail(2, `${at}.ior: expected a refractive index in (1, 4]`);
+  if (!['absolute', 'relative'].includes(m.reflectance ?? 'absolute')) fail(2, `${at}.reflectance "${m.reflectance}": expected "absolute" or "relative"`);
 });
 if (scene.environment) fail(2, `${opt.scene}: environment: sky and map lighting are not rendered yet; light the scene with lights[] (docs/SCENE.md)`);
 scene.lights = scene.lights ?? [{ direction: [0.3, 1.0, 0.6], intensity: 1 }];
@@ -110,6 +115,12 @@ const meshes = scene.meshes.map((m, i) => {
   const out = {
     baseColor: m.base_color ?? [0.05, 0.05, 0.05],
     diffuseWeight: m.diffuse_weight ?? 0.2,
+    // the skin (docs/SCENE.md): index, normalisation, masking
+    ior: m.ior ?? 1.5,
+    reflectance: m.reflectance ?? 'absolute',
+    masking: m.masking ?? 'off',
+    rmsSlope: m.rms_slope ?? null,
+    what: `meshes[${i}]`,
   };
   if (m.mesh.startsWith('builtin:')) out.builtin = m.mesh.slice(8);
   else {

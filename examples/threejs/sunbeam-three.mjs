@@ -3,9 +3,11 @@
 //
 // The shading code is not a port: it is the GLSL ES 3.00 that
 // `sunbeam-play --export-shader glsl-es` writes from the player's own WGSL
-// (shaders/response_map.wgsl), adapted here only in its declarations (a plain
-// struct uniform instead of a uniform block, our varyings and light loop
-// instead of its demo entry point). docs/ENGINES.md documents the interface.
+// (shaders/material.wgsl: the frame, exact Fresnel, G, Smith masking, the
+// diffuse base's share; shaders/response_map.wgsl: the map), adapted here only
+// in its declarations (a plain struct uniform instead of a uniform block, our
+// varyings and light loop instead of its demo entry point). docs/ENGINES.md
+// documents the interface.
 //
 // The response map (NAME.response.ktx2, docs/PACK_FORMAT.md "Response map") is
 // read with ktx-parse (shipped with three) into a Data3DTexture: RGBA half
@@ -55,10 +57,46 @@ export function adaptExportedGlsl(src) {
     out.push(l);
   }
   const text = out.join('\n');
-  if (!text.includes('vec3 sunbeam_shade(') || !text.includes('_group_0_binding_1_fs')) {
-    throw new Error('exported GLSL: sunbeam_shade or the map binding not found (docs/ENGINES.md)');
+  if (!text.includes('vec3 sunbeam_shade(') || !text.includes('mat3x3 sb_frame(') || !text.includes('_group_0_binding_1_fs')) {
+    throw new Error('exported GLSL: sunbeam_shade, sb_frame or the map binding not found (docs/ENGINES.md)');
   }
   return text;
+}
+
+/** Fresnel reflectance at normal incidence, ((n - 1)/(n + 1))^2 (sunbeam_optics::gain::f0). */
+export function fresnelF0(ior) {
+  const r = (ior - 1) / (ior + 1);
+  return r * r;
+}
+
+/**
+ * The exported material's `skin` uniform (docs/ENGINES.md): [ior, norm, sx, sy]
+ * with `norm` what G is divided by (1 for 'absolute' reflectance, the
+ * default; F(0) for 'relative', sunbeam_optics::gain::Material::norm) and
+ * (sx, sy) Smith masking's rms slopes ([0, 0]: no masking).
+ */
+export function skinUniform({ ior = 1.5, reflectance = 'absolute', rmsSlope = [0, 0] } = {}) {
+  if (!(ior > 1 && ior <= 4)) throw new Error(`ior ${ior}: expected a refractive index in (1, 4]`);
+  if (reflectance !== 'absolute' && reflectance !== 'relative') throw new Error(`reflectance '${reflectance}': expected 'absolute' or 'relative'`);
+  const s = typeof rmsSlope === 'number' ? [rmsSlope, rmsSlope] : rmsSlope;
+  if (!Array.isArray(s) || s.length !== 2 || !s.every((v) => Number.isFinite(v) && v >= 0)) throw new Error('rmsSlope: expected a number or [x, y], finite and >= 0');
+  return new THREE.Vector4(ior, reflectance === 'relative' ? fresnelF0(ior) : 1, s[0], s[1]);
+}
+
+/**
+ * The rms slopes a mesh masks with (sunbeam_scene::MeshInstance::masking_slope):
+ * none ([0, 0]) unless `masking` is 'smith'; then `rmsSlope` (a number or
+ * [x, y]) if given, else the pack's (`rms_slope` of its manifest, which the
+ * response map carries in `info.pack`). `what` names the field in errors.
+ */
+export function maskingSlope(masking, rmsSlope, map, what) {
+  const m = masking ?? 'off';
+  if (m === 'off') return [0, 0];
+  if (m !== 'smith') throw new Error(`${what}.masking '${m}': expected 'off' or 'smith'`);
+  if (rmsSlope !== undefined && rmsSlope !== null) return typeof rmsSlope === 'number' ? [rmsSlope, rmsSlope] : rmsSlope;
+  const own = map?.info?.pack?.rms_slope;
+  if (!own) throw new Error(`${what}.masking 'smith' needs rms slopes: the pack has no rms_slope and none is given`);
+  return own;
 }
 
 const MAX_LIGHTS = 4;
@@ -96,15 +134,11 @@ in vec3 vNormal;
 in vec3 vOrient;
 layout(location = 0) out vec4 fragColor;
 void main() {
-  // The player's frame (shaders/diffraction.wgsl fs_main): t orthogonalised against n.
-  vec3 n = normalize(vNormal);
-  vec3 t = vOrient - n * dot(n, vOrient);
-  if (length(t) < 1e-12) {
-    vec3 a = abs(n.x) >= 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
-    t = a - n * dot(n, a);
-  }
-  t = normalize(t);
-  vec3 b = cross(n, t);
+  // The player's frame (shaders/material.wgsl sb_frame): t orthogonalised against n.
+  mat3 f = sb_frame(vNormal, vOrient);
+  vec3 t = f[0];
+  vec3 b = f[1];
+  vec3 n = f[2];
   vec3 wr = normalize(sbEye - vWorld);
   vec3 rgb = vec3(0.0);
   for (int i = 0; i < ${MAX_LIGHTS}; i++) {
@@ -131,11 +165,14 @@ void main() {
 /**
  * The material: `exportedGlsl` (adapted, see adaptExportedGlsl), `map` from
  * parseResponseMap or null (base colour only), `baseColor` linear [r, g, b],
- * `diffuseWeight`, `lights` [{direction: [x, y, z] towards the light, intensity}],
- * `exposure` in stops, `display`: clip and sRGB-encode (for a canvas; off for
- * linear float targets). Uniforms can be changed later (material.uniforms).
+ * `diffuseWeight`, the skin: `ior` (1.5), `reflectance` ('absolute', the
+ * default, or 'relative'), `rmsSlope` (Smith masking's [x, y] rms slopes;
+ * [0, 0]: none; see maskingSlope), `lights` [{direction: [x, y, z] towards the
+ * light, intensity}], `exposure` in stops, `display`: clip and sRGB-encode
+ * (for a canvas; off for linear float targets). Uniforms can be changed later
+ * (material.uniforms; the skin through skinUniform).
  */
-export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, lights = [], exposure = 0, f0 = 0.04, display = false }) {
+export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, ior = 1.5, reflectance = 'absolute', rmsSlope = [0, 0], lights = [], exposure = 0, display = false }) {
   const g = map ? map.grid : { n_theta: 1, n_rho: 2, n_s: 2, r0: 1 };
   const lightVecs = [];
   for (let i = 0; i < MAX_LIGHTS; i++) {
@@ -162,9 +199,10 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
       _group_0_binding_1_fs: { value: map ? map.texture : placeholder },
       _group_0_binding_0_fs: {
         value: {
-          grid: new THREE.Vector4(g.n_theta, g.n_rho, g.n_s, f0),
+          grid: new THREE.Vector4(g.n_theta, g.n_rho, g.n_s, 0),
           warp: new THREE.Vector4(g.r0, Math.asinh(2 / g.r0), map ? diffuseWeight : 1, 0),
           base: new THREE.Vector4(baseColor[0], baseColor[1], baseColor[2], 0),
+          skin: skinUniform({ ior, reflectance, rmsSlope }),
         },
       },
     },
@@ -204,8 +242,10 @@ export function addOrientation(geometry) {
  * GLTFLoader plugin for the vendor extension SUNBEAM_materials_diffraction
  * (written by `sunbeam-bake --pack`, docs/ENGINES.md): every mesh whose glTF
  * material carries it gets `userData.sunbeam` = the extension's object
- * (`responseMap.uri` relative to the GLB, `grid`, `f0`, `diffuseWeight`,
- * `baseColor`). Register with `loader.register((p) => new SunbeamDiffractionPlugin(p))`.
+ * (`responseMap.uri` relative to the GLB, `grid`, `diffuseWeight`,
+ * `baseColor`, and the skin where given: `ior`, `reflectance`, `masking`,
+ * `rmsSlope`; see extensionSkin). Register with
+ * `loader.register((p) => new SunbeamDiffractionPlugin(p))`.
  */
 export class SunbeamDiffractionPlugin {
   constructor(parser) {
@@ -223,6 +263,25 @@ export class SunbeamDiffractionPlugin {
     });
     return null;
   }
+}
+
+/**
+ * The skin options of sunbeamMaterial from an extension object (the
+ * plugin's userData.sunbeam) and its parsed map: `ior` (else from an older
+ * extension's `f0`, else 1.5), `reflectance` (else 'absolute'), and the rms
+ * slopes when its `masking` is 'smith' (its `rmsSlope`, else the pack's).
+ */
+export function extensionSkin(ext, map, what = 'SUNBEAM_materials_diffraction') {
+  let ior = ext.ior;
+  if (ior === undefined && typeof ext.f0 === 'number' && ext.f0 > 0 && ext.f0 < 1) {
+    const r = Math.sqrt(ext.f0);
+    ior = (1 + r) / (1 - r);
+  }
+  return {
+    ior: ior ?? 1.5,
+    reflectance: ext.reflectance ?? 'absolute',
+    rmsSlope: maskingSlope(ext.masking, ext.rmsSlope, map, what),
+  };
 }
 
 /** sunbeam-scene's built-in meshes (crates/sunbeam-scene/src/geometry.rs), same vertices and tangents. */

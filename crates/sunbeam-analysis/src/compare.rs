@@ -88,7 +88,12 @@ pub fn truth_colours(truth: &Truth, pack: &Pack, light: [f64; 3], views: usize) 
         (pack.manifest.lambda_max_m * 1e9).round() as u32,
     );
     par_map(dirs.len(), |i| {
-        truth.colour_xyz_with(light, dirs[i], range, sunbeam_optics::gain::Material::RELATIVE)
+        truth.colour_xyz_with(
+            light,
+            dirs[i],
+            range,
+            sunbeam_optics::gain::Material::RELATIVE,
+        )
     })
 }
 

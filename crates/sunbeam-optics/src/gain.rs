@@ -15,7 +15,7 @@
 //!
 //! This module is the only float64 implementation of `F` and `G`: the
 //! reference, the response maps' environment paths and the tests call it; the
-//! GPU's is `shaders/material/gain.wgsl`, checked against this one.
+//! GPU's is `shaders/material.wgsl` (`sb_fresnel`, `sb_gain`), checked against this one.
 
 /// Default index of refraction (PHYSICS.md 2).
 pub const DEFAULT_IOR: f64 = 1.5;
@@ -186,7 +186,10 @@ mod tests {
 
     #[test]
     fn below_horizon_is_zero() {
-        assert_eq!(g([0.0, 0.0, -1.0], [0.0, 0.0, 1.0], Material::default()), 0.0);
+        assert_eq!(
+            g([0.0, 0.0, -1.0], [0.0, 0.0, 1.0], Material::default()),
+            0.0
+        );
     }
 
     #[test]

@@ -62,14 +62,24 @@ mod tests {
             let q2 = u * u + v * v + uvw[2] * uvw[2];
             let want = (uvw[2] * uvw[2] / q2).powi(2) * pa * pa;
             let got = window_reflectance(uvw, p, du, dv, k, [sx, sy]);
-            assert!((got - want).abs() <= 1e-12 * want.max(1e-300), "{uvw:?}: {got} vs {want}");
+            assert!(
+                (got - want).abs() <= 1e-12 * want.max(1e-300),
+                "{uvw:?}: {got} vs {want}"
+            );
         }
     }
 
     /// With no derivative (an order's centre) `R_U = |P|^2`.
     #[test]
     fn stationary_point_is_beckmann() {
-        let got = window_reflectance([0.3, 0.1, -1.0], [0.3, 0.4], [0.0; 2], [0.0; 2], 1e7, [1e-6; 2]);
+        let got = window_reflectance(
+            [0.3, 0.1, -1.0],
+            [0.3, 0.4],
+            [0.0; 2],
+            [0.0; 2],
+            1e7,
+            [1e-6; 2],
+        );
         assert!((got - 0.25).abs() < 1e-15);
     }
 }

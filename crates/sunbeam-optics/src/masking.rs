@@ -101,7 +101,7 @@ fn lambda(w: [f64; 3], rms_slope: [f64; 2]) -> f64 {
 }
 
 /// The error function (Abramowitz & Stegun 7.1.26, |error| < 1.5e-7): the
-/// same few operations as the shader's, which has no `erf` (shaders/response_map.wgsl).
+/// same few operations as the shader's, which has no `erf` (`sb_masking` in shaders/material.wgsl).
 pub fn erf(x: f64) -> f64 {
     let t = 1.0 / (1.0 + 0.327_591_1 * x.abs());
     let p = ((((1.061_405_429 * t - 1.453_152_027) * t + 1.421_413_741) * t - 0.284_496_736) * t
@@ -231,7 +231,14 @@ mod tests {
                     let r = if exact {
                         let du = -k * k * sg * sg * uvw[0] * pa;
                         let dv = -k * k * sg * sg * uvw[1] * pa;
-                        crate::grazing::window_reflectance(uvw, [pa, 0.0], [du, 0.0], [dv, 0.0], k, [sg, sg])
+                        crate::grazing::window_reflectance(
+                            uvw,
+                            [pa, 0.0],
+                            [du, 0.0],
+                            [dv, 0.0],
+                            k,
+                            [sg, sg],
+                        )
                     } else {
                         pa * pa
                     };
@@ -242,8 +249,14 @@ mod tests {
         };
         let (a, b) = (band(1e-2, true, m), band(1e-4, true, m));
         assert!(b < 1.3 * a, "masked: {a} at cos 1e-2, {b} at 1e-4");
-        let (a, b) = (band(1e-2, true, Masking::Off), band(1e-4, true, Masking::Off));
-        assert!(b > 10.0 * a, "unmasked, exact term: {a} at cos 1e-2, {b} at 1e-4");
+        let (a, b) = (
+            band(1e-2, true, Masking::Off),
+            band(1e-4, true, Masking::Off),
+        );
+        assert!(
+            b > 10.0 * a,
+            "unmasked, exact term: {a} at cos 1e-2, {b} at 1e-4"
+        );
         // The exact term is below Beckmann's obliquity everywhere in the band.
         assert!(band(1e-3, true, Masking::Off) < band(1e-3, false, Masking::Off));
     }

@@ -429,7 +429,12 @@ impl Truth {
     /// of `R S cmf / sum S ybar`, times `G` (the thesis' relative
     /// normalisation: a flat patch head-on gives Y = 1, so `R` reads directly).
     pub fn colour_xyz(&self, wi_local: [f64; 3], wr_local: [f64; 3]) -> [f64; 3] {
-        self.colour_xyz_with(wi_local, wr_local, cie::DEFAULT_RANGE_NM, gain::Material::RELATIVE)
+        self.colour_xyz_with(
+            wi_local,
+            wr_local,
+            cie::DEFAULT_RANGE_NM,
+            gain::Material::RELATIVE,
+        )
     }
 
     /// [`Truth::colour_xyz`] with an explicit wavelength range (nm, inclusive, 1 nm

@@ -143,7 +143,10 @@ mod tests {
                 let h = 1e-5;
                 let fd = (kb(x + h, taps, beta) - kb(x - h, taps, beta)) / (2.0 * h);
                 let d = kb_derivative(x, taps, beta);
-                assert!((d - fd).abs() < 1e-7 * (1.0 + fd.abs()), "{taps} {x}: {d} vs {fd}");
+                assert!(
+                    (d - fd).abs() < 1e-7 * (1.0 + fd.abs()),
+                    "{taps} {x}: {d} vs {fd}"
+                );
             }
         }
     }

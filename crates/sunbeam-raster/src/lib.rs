@@ -111,15 +111,17 @@ pub struct Prepared {
     pub env_cache: EnvCache,
 }
 
-/// Built [`environment::EnvShader`]s, keyed by estimator, environment and
+/// Built [`environment::EnvShader`]s, keyed by estimator, environment,
 /// packs (the same `Arc`s: a changed environment or pack builds anew; the key
-/// holds them, so their addresses cannot be reused by others while cached).
+/// holds them, so their addresses cannot be reused by others while cached)
+/// and the meshes' masking and skins.
 #[derive(Clone, Default)]
 pub struct EnvCache(Arc<std::sync::Mutex<Vec<EnvEntry>>>);
 
 struct EnvEntry {
     estimator: environment::EnvEstimator,
     masking: Vec<Masking>,
+    skins: Vec<sunbeam_optics::gain::Material>,
     env: Arc<sunbeam_light::Environment>,
     packs: Vec<Option<Arc<Pack>>>,
     shader: Arc<environment::EnvShader>,
@@ -133,12 +135,14 @@ impl std::fmt::Debug for EnvCache {
 }
 
 impl EnvCache {
-    /// The shader for `env`, `packs` and `estimator`, built on first use.
+    /// The shader for `env`, `packs` (with their meshes' `masking` and
+    /// `skins`) and `estimator`, built on first use.
     fn get(
         &self,
         env: Arc<sunbeam_light::Environment>,
         packs: &[Option<Arc<Pack>>],
         masking: &[Masking],
+        skins: &[sunbeam_optics::gain::Material],
         estimator: environment::EnvEstimator,
     ) -> Arc<environment::EnvShader> {
         let same_packs = |a: &[Option<Arc<Pack>>]| {
@@ -153,6 +157,7 @@ impl EnvCache {
         if let Some(e) = v.iter().find(|e| {
             e.estimator == estimator
                 && e.masking == masking
+                && e.skins == skins
                 && Arc::ptr_eq(&e.env, &env)
                 && same_packs(&e.packs)
         }) {
@@ -160,11 +165,13 @@ impl EnvCache {
         }
         let shader = Arc::new(
             environment::EnvShader::with_estimator(env.clone(), packs, estimator)
-                .with_masking(masking),
+                .with_masking(masking)
+                .with_skin(skins),
         );
         v.push(EnvEntry {
             estimator,
             masking: masking.to_vec(),
+            skins: skins.to_vec(),
             env,
             packs: packs.to_vec(),
             shader: shader.clone(),
@@ -270,8 +277,12 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
         let skin = sunbeam_optics::gain::Material {
             ior: mi.ior,
             reflectance: match mi.reflectance {
-                sunbeam_scene::ReflectanceMode::Absolute => sunbeam_optics::gain::Reflectance::Absolute,
-                sunbeam_scene::ReflectanceMode::Relative => sunbeam_optics::gain::Reflectance::Relative,
+                sunbeam_scene::ReflectanceMode::Absolute => {
+                    sunbeam_optics::gain::Reflectance::Absolute
+                }
+                sunbeam_scene::ReflectanceMode::Relative => {
+                    sunbeam_optics::gain::Reflectance::Relative
+                }
             },
         };
         let masking = match (&pack, &mi.pack) {
@@ -385,7 +396,10 @@ fn render_environment(
     let (sw, sh) = (w * s, h * s);
     let packs: Vec<_> = p.meshes.iter().map(|(_, m)| m.pack.clone()).collect();
     let masking: Vec<Masking> = p.meshes.iter().map(|(_, m)| m.masking).collect();
-    let es = p.env_cache.get(env, &packs, &masking, opts.estimator);
+    let skins: Vec<_> = p.meshes.iter().map(|(_, m)| m.skin).collect();
+    let es = p
+        .env_cache
+        .get(env, &packs, &masking, &skins, opts.estimator);
     let shader = shade::Shader::new(p, opts);
     let scale = p.scene.exposure.exp2();
     let eye = p.scene.camera.eye;

@@ -2,11 +2,12 @@
 //! (docs/LIGHTING.md "The reference's estimator").
 //!
 //! The integrand of the environment integral in spatial frequency is
-//! `L G R A / lambda^2 dw = L R (G / cos(theta_i)) A d^2f`: the pack's `R`, whose
+//! `L G R A / lambda^2 dw = L R (G / cos(theta_i)) A d^2f`: the pack's `R`
+//! (`R_U` with the window's grazing term, PHYSICS.md 2b), whose
 //! orders change strength with the phase depth `t = 2 pi H w / lambda`
 //! (`w = -(cos(theta_i) + cos(theta_r))` changes with the direction), times a
 //! factor that grows without bound towards the horizon (`1 / cos(theta_i)`) and
-//! with Fresnel at grazing forward scattering (`(F / F0)^2` up to 625). A
+//! with Fresnel at grazing forward scattering (`F / F(0)` up to 25). A
 //! proposal that follows `R` at fixed depths only leaves both to the weights,
 //! which then have heavy tails.
 //!
@@ -21,11 +22,12 @@
 //! - the child's stored energy interpolated linearly in `|t|` between the depth
 //!   tables at the actual `t` of the direction of its energy centroid (for this
 //!   view and wavelength), times
-//! - `(F / F0)^2 (1 + wi.wr)^2 / (cos(theta_i) + cos(theta_r))^2` at the
-//!   centroid, times the mean of `1 / cos(theta_i)` over the child's radial
+//! - `F(theta_d) (1 + wi.wr)^2 / (cos(theta_i) + cos(theta_r))^2` at the
+//!   centroid (`F` the skin's, by `gain::fresnel` at `gain::cos_half`),
+//!   times the mean of `1 / cos(theta_i)` over the child's radial
 //!   extent (near the horizon `(asin rho_1 - asin rho_0) / (2 ext)`, the part
 //!   beyond the horizon counting 0), i.e. `G / cos(theta_i)` up to the view's
-//!   constant, times
+//!   constant (and without the masking, a shape), times
 //! - zero when the child lies wholly outside the disc of propagating
 //!   directions (`|wi_xy| < 1`), so no sample is spent on evanescent frequencies.
 //!
@@ -42,12 +44,13 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 use sunbeam_optics::gain;
+use sunbeam_optics::masking::Masking;
 use sunbeam_pack::{manifest::Model, series, Pack};
 
 /// Bins summed on each side for the tiled model's density, in sigmas.
 const TILED_REACH: f64 = 5.0;
 /// Leaves per bin along each axis for the window model (R at the leaves'
-/// centres by `Pack::reflectance` when above 1). R varies inside a bin (one
+/// centres by `Pack::shading_reflectance` when above 1). R varies inside a bin (one
 /// sample's relative spread 0.3 with one leaf per bin), but 2 leaves per bin
 /// measured no better on frames at 4 times the preparation, so 1.
 const SUB_BINS: usize = 1;
@@ -66,6 +69,8 @@ const TOP_NODE_COS: f64 = 1.0;
 /// cumulative table). Prepare once, use for any number of draws and densities.
 pub struct LobeQuery {
     wr: [f64; 3],
+    /// The skin's refractive index (the proposal's Fresnel factor).
+    ior: f64,
     /// `lambda / bin_scale`: direction cosines per bin, per axis.
     du: [f64; 2],
     /// `2 pi H / lambda`.
@@ -150,7 +155,7 @@ impl LobeSampler {
                             let ky = (iy as f64 + 0.5) / sub as f64 - 0.5 - m.crop.ky as f64;
                             let u = -kx * l / m.bin_scale_m[0];
                             let v = -ky * l / m.bin_scale_m[1];
-                            e[iy * side + ix] = pack.reflectance(u, v, wz, l) as f32;
+                            e[iy * side + ix] = pack.shading_reflectance(u, v, wz, l) as f32;
                         }
                     }
                 } else {
@@ -220,11 +225,12 @@ impl LobeSampler {
         }
     }
 
-    /// Prepare view `wr` (local, unit) at `lambda_m` ([`LobeQuery`]). The top
+    /// Prepare view `wr` (local, unit) at `lambda_m` for a mesh with skin
+    /// `skin` ([`LobeQuery`]). The top
     /// level's nodes are about `TOP_NODE_COS` wide in direction cosines, so
     /// that the weights, taken at one point per node, are accurate where the
     /// descent starts (a few hundred nodes over the disc of directions).
-    pub fn query(&self, wr: [f64; 3], lambda_m: f64) -> LobeQuery {
+    pub fn query(&self, wr: [f64; 3], lambda_m: f64, skin: gain::Material) -> LobeQuery {
         let m = &self.pack.manifest;
         // Direction cosines per leaf.
         let sub = self.sub as f64;
@@ -239,6 +245,7 @@ impl LobeSampler {
         let top = levels - 1 - shift;
         let mut q = LobeQuery {
             wr,
+            ior: skin.ior,
             du,
             k_h: 2.0 * PI * m.height_half_range_m / lambda_m,
             top,
@@ -360,7 +367,7 @@ impl LobeSampler {
             let (r0, r1) = ((r - ext).clamp(0.0, 1.0), (r + ext).min(1.0));
             (r1.asin() - r0.asin()) / (2.0 * ext)
         };
-        e * mean_inv_cos * gain_over_cos(wi, q.wr, 1.0)
+        e * mean_inv_cos * gain_over_cos(wi, q.wr, q.ior, 1.0)
     }
 
     /// Probability of bin `(ix, iy)` (crop texel indices; 0 outside): the
@@ -451,9 +458,10 @@ impl LobeSampler {
         (m.model == Model::Tiled).then(|| m.kernel.sigma_bins.map(|s| s.clamp(1e-3, 8.0)))
     }
 
-    /// Solid-angle density (1/sr) of drawing local `wi` for view `wr` at `lambda_m`.
-    pub fn pdf(&self, wi: [f64; 3], wr: [f64; 3], lambda_m: f64) -> f64 {
-        self.pdf_in(&self.query(wr, lambda_m), wi)
+    /// Solid-angle density (1/sr) of drawing local `wi` for view `wr` at
+    /// `lambda_m` and skin `skin`.
+    pub fn pdf(&self, wi: [f64; 3], wr: [f64; 3], lambda_m: f64, skin: gain::Material) -> f64 {
+        self.pdf_in(&self.query(wr, lambda_m, skin), wi)
     }
 
     /// [`LobeSampler::pdf`] for a prepared view and wavelength.
@@ -467,11 +475,18 @@ impl LobeSampler {
         self.pdf_kappa(q, kx, ky) / (q.du[0] * q.du[1]) * wi[2]
     }
 
-    /// A local incoming direction for view `wr` at `lambda_m` (its density is
-    /// [`LobeSampler::pdf`]); None when the drawn frequency is evanescent.
-    /// `u[0]` drives the descent, `u[1]` and `u[2]` the point in the bin.
-    pub fn sample(&self, u: [f64; 3], wr: [f64; 3], lambda_m: f64) -> Option<[f64; 3]> {
-        self.sample_in(&self.query(wr, lambda_m), u)
+    /// A local incoming direction for view `wr` at `lambda_m` and skin
+    /// `skin` (its density is [`LobeSampler::pdf`]); None when the drawn
+    /// frequency is evanescent. `u[0]` drives the descent, `u[1]` and `u[2]`
+    /// the point in the bin.
+    pub fn sample(
+        &self,
+        u: [f64; 3],
+        wr: [f64; 3],
+        lambda_m: f64,
+        skin: gain::Material,
+    ) -> Option<[f64; 3]> {
+        self.sample_in(&self.query(wr, lambda_m, skin), u)
             .map(|(wi, _)| wi)
     }
 
@@ -545,15 +560,32 @@ impl LobeSampler {
         Some((wi, pdf))
     }
 
-    /// `f_r cos(theta_i) = G R A / lambda^2` (1/sr) for local directions.
-    pub fn brdf_cos(&self, wi: [f64; 3], wr: [f64; 3], lambda_m: f64) -> f64 {
+    /// `f_r cos(theta_i) = G G2 R_U A / lambda^2` (1/sr) for local directions
+    /// on a mesh with skin `skin` and `masking` (`G G2 = masking.gain(wi, wr,
+    /// skin)`, [`LobeSampler::response`]).
+    pub fn brdf_cos(
+        &self,
+        wi: [f64; 3],
+        wr: [f64; 3],
+        lambda_m: f64,
+        masking: Masking,
+        skin: gain::Material,
+    ) -> f64 {
         if !(wi[2] > 0.0 && wr[2] > 0.0) {
             return 0.0;
         }
-        let r = self
-            .pack
-            .reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], lambda_m);
-        gain::g(wi, wr, gain::Material::default()) * r * self.area_m2 / (lambda_m * lambda_m)
+        masking.gain(wi, wr, skin) * self.response(wi, wr, lambda_m)
+    }
+
+    /// `R A / lambda^2` (1/sr) for local directions, `R` the reflectance
+    /// shading uses (`Pack::shading_reflectance`: `R_U` for the window model):
+    /// [`LobeSampler::brdf_cos`] without the gain, which does not depend on
+    /// the wavelength.
+    pub fn response(&self, wi: [f64; 3], wr: [f64; 3], lambda_m: f64) -> f64 {
+        let r =
+            self.pack
+                .shading_reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], lambda_m);
+        r * self.area_m2 / (lambda_m * lambda_m)
     }
 }
 
@@ -642,12 +674,25 @@ fn direction_of(c: [f64; 2]) -> [f64; 3] {
     }
 }
 
-/// `G(wi, wr) cos(theta_r) / max(cos(theta_i), min_cos)`: the factor of the
-/// integrand in frequency space that does not depend on the pack, up to the
-/// view's constant `1 / cos(theta_r)`; defined (finite, positive) at the horizon.
-fn gain_over_cos(wi: [f64; 3], wr: [f64; 3], min_cos: f64) -> f64 {
-    let f = gain::fresnel(gain::cos_half(wi, wr), gain::DEFAULT_IOR);
-    let dot = wi[0] * wr[0] + wi[1] * wr[1] + wi[2] * wr[2];
-    let den = wi[2] + wr[2];
-    f * (1.0 + dot) * (1.0 + dot) / (den * den) / wi[2].max(min_cos)
+/// `G(wi, wr) cos(theta_r) / max(cos(theta_i), min_cos)` for a skin of index
+/// `ior`: the factor of the integrand in frequency space that does not
+/// depend on the pack, up to the view's constant `1 / cos(theta_r)`, the
+/// normalisation (absolute here) and the masking (a shape for the proposal:
+/// the factors it drops are constant or smooth); `G` itself from `gain::g`
+/// (its Fresnel factor at `gain::cos_half`, its obliquity), with `wi` lifted
+/// to `cos(theta_i) >= 1e-6` so that the shape is finite and positive at the
+/// horizon, where `g` is 0.
+fn gain_over_cos(wi: [f64; 3], wr: [f64; 3], ior: f64, min_cos: f64) -> f64 {
+    const LIFT: f64 = 1e-6;
+    let wi_g = if wi[2] >= LIFT {
+        wi
+    } else {
+        let s = ((1.0 - LIFT * LIFT) / (wi[0] * wi[0] + wi[1] * wi[1]).max(1e-300)).sqrt();
+        [wi[0] * s, wi[1] * s, LIFT]
+    };
+    let skin = gain::Material {
+        ior,
+        reflectance: gain::Reflectance::Absolute,
+    };
+    gain::g(wi_g, wr, skin) * wr[2] / wi[2].max(min_cos)
 }

@@ -137,7 +137,8 @@ impl<'a> Shader<'a> {
                 [0.0; 3]
             };
             for k in 0..3 {
-                rgb[k] += light.intensity * (dw * mat.base_color[k] * base_in + (1.0 - dw) * diff[k]);
+                rgb[k] +=
+                    light.intensity * (dw * mat.base_color[k] * base_in + (1.0 - dw) * diff[k]);
             }
         }
         rgb

@@ -119,6 +119,7 @@ fn lobe_technique_alone() {
         Err(_) => ridge_pack(),
     };
     let ls = sunbeam_raster::lobe_sampler::LobeSampler::new(pack.clone());
+    let skin = sunbeam_optics::gain::Material::default();
     for th in [0.0f64, 40.0, 65.0, 80.0] {
         for nm in [450.0, 550.0, 650.0] {
             let th = th.to_radians();
@@ -130,9 +131,10 @@ fn lobe_technique_alone() {
             for k in 0..m {
                 let mut rng = EnvShader::rng(5, 0, k);
                 let u = [rng.unit(), rng.unit(), rng.unit()];
-                w.push(match ls.sample(u, wr, l) {
+                w.push(match ls.sample(u, wr, l, skin) {
                     Some(wi) => {
-                        let v = ls.brdf_cos(wi, wr, l) / ls.pdf(wi, wr, l);
+                        let v =
+                            ls.brdf_cos(wi, wr, l, Masking::Off, skin) / ls.pdf(wi, wr, l, skin);
                         if v > worst.0 {
                             worst = (v, wi);
                         }
@@ -143,12 +145,12 @@ fn lobe_technique_alone() {
             }
             if std::env::var("WORST").is_ok() {
                 let wi = worst.1;
-                let r = pack.reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], l);
+                let r = pack.shading_reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], l);
                 eprintln!(
-                    "  worst {:.2}: wi {wi:.3?} R {r:.3e} G {:.3} pdf {:.3e}",
+                    "  worst {:.2}: wi {wi:.3?} R_U {r:.3e} G {:.3} pdf {:.3e}",
                     worst.0,
-                    sunbeam_optics::gain::g(wi, wr, sunbeam_optics::gain::Material::default()),
-                    ls.pdf(wi, wr, l)
+                    sunbeam_optics::gain::g(wi, wr, skin),
+                    ls.pdf(wi, wr, l, skin)
                 );
             }
             let mean = w.iter().sum::<f64>() / m as f64;
@@ -368,6 +370,7 @@ fn grazing_views() {
                     wr: wl,
                     sun_u: [0.5, 0.5],
                     masking: mask,
+                    skin: sunbeam_optics::gain::Material::default(),
                 }],
                 (0, 1),
             )[0][1];
@@ -389,8 +392,8 @@ fn grazing_views() {
 }
 
 /// The same at one wavelength (550 nm) under a white environment of radiance
-/// 1, as a direct sum of `G G2 R A / lambda^2` over the hemisphere with `R`
-/// from the pack (`NC` x `NPHI` cells, cubic in `cos(theta_i)`), split by
+/// 1, as a direct sum of `G G2 R_U A / lambda^2` over the hemisphere with `R_U`
+/// from the pack (`Pack::shading_reflectance`) (`NC` x `NPHI` cells, cubic in `cos(theta_i)`), split by
 /// `cos(theta_i)` bands: which directions hold a grazing view's light.
 #[test]
 fn grazing_band_sum() {
@@ -429,7 +432,12 @@ fn grazing_band_sum() {
                     if g == 0.0 {
                         continue;
                     }
-                    let r = pack.reflectance(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2], lam);
+                    let r = pack.shading_reflectance(
+                        -wi[0] - wr[0],
+                        -wi[1] - wr[1],
+                        -wi[2] - wr[2],
+                        lam,
+                    );
                     let v = g * r * a;
                     if v * (c1 - c0) > top.0 {
                         top = (v * (c1 - c0), ci, p.to_degrees(), r);

@@ -1,10 +1,14 @@
 //! Environment lighting in the reference renderer (docs/LIGHTING.md): the
-//! furnace through the whole renderer (both estimators), the Monte Carlo
-//! estimator against a deterministic quadrature with the float64 truth (no
-//! pack code, no sampling), the maps' quadrature against Monte Carlo over a
-//! whole frame, seed-to-seed noise, and rotation of the environment against
-//! rotation of the scene.
+//! oblique furnace (`F(theta)`, PHYSICS.md 5 item 11) at a point and through
+//! the whole renderer (both estimators), the diffuse base's transmission, the
+//! Monte Carlo estimator against a deterministic quadrature with a direct
+//! float64 Kirchhoff sum (no pack code, no sampling), the maps' quadrature
+//! against Monte Carlo over a whole frame, seed-to-seed noise, and rotation
+//! of the environment against rotation of the scene.
 
+mod common;
+
+use common::Kirchhoff;
 use std::f64::consts::PI;
 use std::sync::Arc;
 use sunbeam_light::{sky::Sky, EnvMap, Environment};
@@ -72,12 +76,123 @@ fn mean_y(img: &LinearImage, x0: u32, x1: u32) -> f64 {
     s / n
 }
 
-/// Furnace: a flat patch seen head-on under a constant white environment of
-/// radiance 1 shows radiance 1 (the specular gain at normal incidence, PHYSICS.md 2),
-/// within 1 %, for a small and a large patch and both models: the Monte Carlo
-/// estimator at the patch's centre (200 000 samples), then a whole frame by
-/// the quadrature (within 1 %) and by Monte Carlo (within 3 %: fewer samples
-/// per pixel).
+/// A flat patch whose lobe is narrow (`sigma_u` about 0.0015 at 550 nm): the
+/// furnace's `F(theta)` is the narrow-lobe limit of `int G R A / l^2 dw`;
+/// a lobe `sigma_u` wide adds about `(G / cos(theta_i))'' sigma_u^2 / 2`,
+/// which at 80 degrees is large (+1.2 / +2.8 / +3.3 % for `sigma_u` 0.004 /
+/// 0.0054 / 0.007, a Gaussian average of `G / cos(theta_i)`): a 6.4 um
+/// tiled patch at the default coherence (65 um) gives 0.3983 there.
+/// Window: 256 um at 1 um (a flat field needs no finer sampling), coherence
+/// 400 um (`sigma` = 42.7 um), frequencies stored up to 0.1 / 380 nm; tiled:
+/// 6.4 um, coherence 400 um.
+fn narrow_flat_pack(model: Model) -> Arc<Pack> {
+    let (n, dx) = match model {
+        Model::Window => (256usize, 1e-6),
+        Model::Tiled => (64, 100e-9),
+    };
+    let data = vec![0.0; n * n];
+    let f = FieldRef {
+        width: n,
+        height: n,
+        dx,
+        dy: dx,
+        data: &data,
+    };
+    let opts = BuildOptions {
+        model,
+        coherence_m: 400e-6,
+        freq_limit_per_m: (model == Model::Window).then_some([0.1 / 380e-9; 2]),
+        ..BuildOptions::default()
+    };
+    Arc::new(sunbeam_pack::build(f, &opts, &mut |_, _| {}).unwrap())
+}
+
+/// The oblique furnace (PHYSICS.md 5 item 11): a flat patch under a constant
+/// white environment of radiance 1, seen at 0, 60 and 80 degrees, returns
+/// `F(theta)` (absolute, n = 1.5: 0.0400, 0.0892, 0.3877) within 1 %, at the
+/// patch's centre through both of the reference's estimators: Monte Carlo
+/// (200 000 samples) and the quadrature over the extended-light maps (every
+/// texel); and the relative normalisation `F(theta) / F(0)` (1, 2.23, 9.69)
+/// through the quadrature. Narrow lobes, both models ([`narrow_flat_pack`]),
+/// and a 4 um window patch head-on (its lobe, 0.12 wide in `u`, is cut by
+/// the horizon at oblique views).
+#[test]
+fn oblique_furnace_gives_fresnel() {
+    use sunbeam_response::quadrature::EnvQuadrature;
+    let env = Arc::new(Environment::Map(EnvMap::constant([1.0; 3])));
+    let f = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+    let fresnel = [(0.0f64, 0.0400), (60.0, 0.0892), (80.0, 0.3877)];
+    for (name, pack, views) in [
+        (
+            "4 um window",
+            pack_of(40, 100e-9, &[0.0; 1600], Model::Window),
+            1,
+        ),
+        ("256 um window", narrow_flat_pack(Model::Window), 3),
+        ("6.4 um tiled", narrow_flat_pack(Model::Tiled), 3),
+    ] {
+        let es = EnvShader::new(env.clone(), &[Some(pack.clone())]);
+        let quad = EnvQuadrature::build(&pack, &env, &EnvQuadrature::reference_options());
+        for &(deg, want) in &fresnel[..views] {
+            let th = deg.to_radians();
+            assert!((gain::fresnel(th.cos(), 1.5) - want).abs() < 5e-5);
+            let wr = [th.sin(), 0.0, th.cos()];
+            let mc = estimate_xyz(&es, f, wr, 200_000, 11)[1];
+            let q = |skin| quad.integrate(&env, f, wr, [0.5, 0.5], skin, (0, 1))[1];
+            let (qa, qr) = (q(gain::Material::default()), q(gain::Material::RELATIVE));
+            eprintln!(
+                "furnace {name} at {deg} deg: Monte Carlo {mc:.5}, quadrature {qa:.5} (relative {qr:.4}), F {want}"
+            );
+            for (est, y) in [("Monte Carlo", mc), ("quadrature", qa)] {
+                assert!(
+                    (y / want - 1.0).abs() < 0.01,
+                    "{name} {deg} deg {est}: Y = {y}, F = {want}"
+                );
+            }
+            let rel = want / 0.04;
+            assert!(
+                (qr / rel - 1.0).abs() < 0.01,
+                "{name} {deg} deg relative: {qr} vs {rel}"
+            );
+        }
+    }
+}
+
+/// The extended-light maps hold `R_U` (PHYSICS.md 2b), whose window lobe
+/// falls to 0 as `w -> 0`: with too few `s` layers the quadrature over them
+/// dimmed oblique views (a flat 40 um window patch under the white furnace at
+/// 80 degrees: 3 % below Monte Carlo on the pack with 8 layers, 0.2 % with
+/// `sunbeam_response::build::MIN_S_GRAZING` = 16). The two estimators agree
+/// within 1 % at 60 and 80 degrees; both lie above `F(theta)` by what the
+/// lobe's width adds (about +1.7 % at 80 degrees, [`narrow_flat_pack`]).
+#[test]
+fn furnace_maps_follow_the_grazing_term() {
+    use sunbeam_response::quadrature::EnvQuadrature;
+    let env = Arc::new(Environment::Map(EnvMap::constant([1.0; 3])));
+    let f = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+    let pack = pack_of(400, 100e-9, &vec![0.0; 400 * 400], Model::Window);
+    let es = EnvShader::new(env.clone(), &[Some(pack.clone())]);
+    let quad = EnvQuadrature::build(&pack, &env, &EnvQuadrature::reference_options());
+    assert!(quad.grid().n_s >= sunbeam_response::build::MIN_S_GRAZING);
+    for deg in [60.0f64, 80.0] {
+        let th = deg.to_radians();
+        let wr = [th.sin(), 0.0, th.cos()];
+        let mc = estimate_xyz(&es, f, wr, 200_000, 11)[1];
+        let q = quad.integrate(&env, f, wr, [0.5, 0.5], gain::Material::default(), (0, 1))[1];
+        let fr = gain::fresnel(th.cos(), 1.5);
+        eprintln!(
+            "40 um window at {deg} deg: Monte Carlo {mc:.5}, quadrature {q:.5} (ratio {:.4}), F {fr:.5}",
+            q / mc
+        );
+        assert!((q / mc - 1.0).abs() < 0.01, "{deg} deg: {q} vs {mc}");
+    }
+}
+
+/// Furnace through the whole renderer: a flat patch seen head-on under a
+/// constant white environment of radiance 1 shows `F(0) = 0.04` (the
+/// absolute specular gain at normal incidence, PHYSICS.md 2) over the frame,
+/// for a small and a large patch and both models: by the quadrature (within
+/// 1 %) and by Monte Carlo (within 3 %: fewer samples per pixel).
 #[test]
 fn furnace_through_the_renderer() {
     for (n, dx, model) in [
@@ -87,17 +202,13 @@ fn furnace_through_the_renderer() {
     ] {
         let pack = pack_of(n, dx, &vec![0.0; n * n], model);
         let env = Arc::new(Environment::Map(EnvMap::constant([1.0; 3])));
-        let es = EnvShader::new(env.clone(), &[Some(pack.clone())]);
-        let f = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
-        let y = estimate_xyz(&es, f, [0.0, 0.0, 1.0], 200_000, 11)[1];
-        eprintln!("furnace {n} x {dx:e} {model:?}: Y = {y:.5} at the centre");
-        assert!((y - 1.0).abs() < 0.01, "{n} px {model:?}: Y = {y}");
         let (mut scene, mesh) = fixtures::quad_scene([16, 16]);
         scene.lights.clear();
         scene.meshes[0].diffuse_weight = 0.0;
         scene.camera.eye = [0.0, 0.0, 3.0];
         let mut p = fixtures::prepared(scene, mesh, Some(pack));
         p.environment = Some(env);
+        let f0 = 0.04;
         // 4096 samples: 1024 interleaved classes of 4 samples each.
         for (estimator, tol, samples) in [
             (EnvEstimator::MonteCarlo, 0.03, 256),
@@ -115,12 +226,12 @@ fn furnace_through_the_renderer() {
             )
             .unwrap();
             // Every pixel that sees the patch (within 10 degrees of head-on, where
-            // the gain's Fresnel factor stays within 1e-4 of its normal value).
+            // the Fresnel factor stays within 1e-3 of its normal value).
             let ys: Vec<f64> = img
                 .rgb
                 .iter()
                 .map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64)
-                .filter(|&y| y > 0.3)
+                .filter(|&y| y > 0.3 * f0)
                 .collect();
             assert!(ys.len() > 30, "{} lit pixels", ys.len());
             let y = ys.iter().sum::<f64>() / ys.len() as f64;
@@ -128,23 +239,76 @@ fn furnace_through_the_renderer() {
                 "furnace {n} x {dx:e} {model:?}: Y = {y:.5} over the frame ({estimator:?}, {samples} samples)"
             );
             assert!(
-                (y - 1.0).abs() < tol,
+                (y / f0 - 1.0).abs() < tol,
                 "{n} px {model:?} {estimator:?}: Y = {y}"
             );
         }
     }
 }
 
+/// The diffuse base under the skin gets `1 - F(theta_i)` of the light
+/// (PHYSICS.md 2): a white Lambertian base (diffuse weight 1) under a white
+/// furnace of radiance 1 has radiance `2 int_0^1 c (1 - F(c)) dc` (0.908 for
+/// n = 1.5) with a pack, 1 without, over the frame (the quad fills it):
+/// within 0.3 % by the quadrature (the tabulated irradiance), 2 % by Monte
+/// Carlo (256 samples per pixel: 0.5 % noise over the frame).
+#[test]
+fn furnace_diffuse_base_gets_the_transmission() {
+    let m = 100_000;
+    let want_skin: f64 = (0..m)
+        .map(|i| {
+            let c = (i as f64 + 0.5) / m as f64;
+            2.0 * c * (1.0 - gain::fresnel(c, 1.5)) / m as f64
+        })
+        .sum();
+    for with_pack in [true, false] {
+        let pack = with_pack.then(|| pack_of(16, 100e-9, &[0.0; 256], Model::Window));
+        let (mut scene, mesh) = fixtures::quad_scene([16, 16]);
+        scene.lights.clear();
+        scene.meshes[0].diffuse_weight = 1.0;
+        scene.meshes[0].base_color = [1.0; 3];
+        let mut p = fixtures::prepared(scene, mesh, pack);
+        p.environment = Some(Arc::new(Environment::Map(EnvMap::constant([1.0; 3]))));
+        let want = if with_pack { want_skin } else { 1.0 };
+        for (estimator, tol) in [
+            (EnvEstimator::MonteCarlo, 0.02),
+            (EnvEstimator::Quadrature, 0.003),
+        ] {
+            let img = render_prepared_linear(
+                &p,
+                &Options {
+                    samples: 256,
+                    seed: 5,
+                    estimator,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let y = mean_y(&img, 0, 16);
+            eprintln!("diffuse base, pack {with_pack} ({estimator:?}): Y = {y:.4}, want {want:.4}");
+            assert!(
+                (y / want - 1.0).abs() < tol,
+                "pack {with_pack} {estimator:?}: {y} vs {want}"
+            );
+        }
+    }
+}
+
 /// The estimator at one shading point against a deterministic quadrature of
-/// `integral L(wi, l) G R A / l^2 cmf(l) dw dl / sum D65 ybar` with the float64
-/// truth's R on a fine grid of wi (and 10 nm wavelengths), under the sky.
+/// `integral L(wi, l) G R_U A / l^2 cmf(l) dw dl / sum D65 ybar` with `R_U`
+/// from a direct float64 sum over the height field ([`Kirchhoff`], no pack
+/// code; `A` the float64 truth's) on a fine grid of wi (and 10 nm
+/// wavelengths), under the sky.
 #[test]
 fn estimator_matches_quadrature_under_the_sky() {
+    use rayon::prelude::*;
     let (n, dx) = (32usize, 50e-9);
     let data = ridges(n, dx, 0.8e-6, 300e-9);
     let pack = pack_of(n, dx, &data, Model::Window);
+    let kirchhoff = Kirchhoff::new(n, n, dx, dx, &data, Params::default().coherence_m);
     let field = sunbeam_field::HeightField::new(n, n, dx, dx, data).unwrap();
     let truth = Truth::new(&field, &Params::default()).unwrap();
+    assert!((kirchhoff.sigma / truth.window_sigma_m() - 1.0).abs() < 1e-12);
     let sky = Sky::new(40.0, 30.0, 3.0, 1.0);
     let env = Arc::new(Environment::Sky(Box::new(sky.clone())));
     let es = EnvShader::new(env.clone(), &[Some(pack)]);
@@ -169,32 +333,48 @@ fn estimator_matches_quadrature_under_the_sky() {
     let (nt, np) = (110usize, 240usize);
     let (dth, dph) = (PI / 2.0 / nt as f64, 2.0 * PI / np as f64);
     let norm = cie::d65_y_norm(cie::DEFAULT_RANGE_NM);
-    let mut q = [0.0; 3];
-    for it in 0..nt {
-        let th = (it as f64 + 0.5) * dth;
-        for ip in 0..np {
-            let ph = (ip as f64 + 0.5) * dph;
-            let wi = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
-            let cell = th.sin() * dth * dph;
-            let gg = gain::g(wi, wr_l, gain::Material::default());
-            let d = world(wi);
-            for nm in (380..=780).step_by(10) {
+    let nms: Vec<u32> = (380..=780).step_by(10).collect();
+    // Per theta row (w fixed per wavelength along it), in parallel.
+    let rows: Vec<[f64; 3]> = (0..nt)
+        .into_par_iter()
+        .map(|it| {
+            let th = (it as f64 + 0.5) * dth;
+            let mut q = [0.0; 3];
+            let w = -th.cos() - wr_l[2];
+            for &nm in &nms {
                 let l = nm as f64 * 1e-9;
-                let r = truth.reflectance(-wi[0] - wr_l[0], -wi[1] - wr_l[1], -wi[2] - wr_l[2], l);
+                let p = kirchhoff.phasors(w, l);
                 let wgt = if nm == 380 || nm == 780 { 5.0 } else { 10.0 };
-                // The sun's disc is far smaller than a grid cell: added below.
-                let sky_only = env.spectral(d, l)
-                    - if sky.in_sun(d) {
-                        sky.sun_spectral(l)
-                    } else {
-                        0.0
-                    };
-                let v = sky_only * gg * r * a / (l * l) * cell * wgt / norm;
                 let c = cie::cmf_at(l);
-                for i in 0..3 {
-                    q[i] += v * c[i];
+                for ip in 0..np {
+                    let ph = (ip as f64 + 0.5) * dph;
+                    let wi = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
+                    let cell = th.sin() * dth * dph;
+                    let gg = gain::g(wi, wr_l, gain::Material::default());
+                    let d = world(wi);
+                    let r = kirchhoff
+                        .r_u(&p, -wi[0] - wr_l[0], -wi[1] - wr_l[1], w, l)
+                        .1;
+                    // The sun's disc is far smaller than a grid cell: added below.
+                    let sky_only = env.spectral(d, l)
+                        - if sky.in_sun(d) {
+                            sky.sun_spectral(l)
+                        } else {
+                            0.0
+                        };
+                    let v = sky_only * gg * r * a / (l * l) * cell * wgt / norm;
+                    for i in 0..3 {
+                        q[i] += v * c[i];
+                    }
                 }
             }
+            q
+        })
+        .collect();
+    let mut q = [0.0; 3];
+    for r in &rows {
+        for i in 0..3 {
+            q[i] += r[i];
         }
     }
     // The sun: its disc's radiance times its solid angle, at its centre.
@@ -203,9 +383,13 @@ fn estimator_matches_quadrature_under_the_sky() {
         .map(|k| s[0] * [t, b, nrm][k][0] + s[1] * [t, b, nrm][k][1] + s[2] * [t, b, nrm][k][2]);
     if wi[2] > 0.0 {
         let gg = gain::g(wi, wr_l, gain::Material::default());
-        for nm in (380..=780).step_by(10) {
+        let w = -wi[2] - wr_l[2];
+        for &nm in &nms {
             let l = nm as f64 * 1e-9;
-            let r = truth.reflectance(-wi[0] - wr_l[0], -wi[1] - wr_l[1], -wi[2] - wr_l[2], l);
+            let p = kirchhoff.phasors(w, l);
+            let r = kirchhoff
+                .r_u(&p, -wi[0] - wr_l[0], -wi[1] - wr_l[1], w, l)
+                .1;
             let wgt = if nm == 380 || nm == 780 { 5.0 } else { 10.0 };
             let v = sky.sun_spectral(l) * sky.sun_solid_angle() * gg * r * a / (l * l) * wgt / norm;
             let c = cie::cmf_at(l);
@@ -296,8 +480,10 @@ fn seeds_agree(estimator: EnvEstimator) {
     let (ya, yb) = (mean_y(&a, 0, 12), mean_y(&b, 0, 12));
     eprintln!("{estimator:?}: seed 1 vs 2: {d}; mean Y {ya:.4} vs {yb:.4}");
     assert!(d.pixels > 50, "{d}");
+    // Lit: 0.002 is 0.05 in the relative units this bound was set in (the
+    // absolute gain is F(0) = 0.04 of the relative one); measured 0.0127.
     assert!(
-        ya > 0.05 && (ya / yb - 1.0).abs() < 0.03,
+        ya > 0.002 && (ya / yb - 1.0).abs() < 0.03,
         "mean Y {ya} vs {yb}"
     );
 }
@@ -369,7 +555,7 @@ fn lobe_sampler_pdf_is_the_density_of_its_samples() {
             let (th, ph) = (th.to_radians(), ph.to_radians());
             let wr = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
             let l = nm * 1e-9;
-            let q = ls.query(wr, l);
+            let q = ls.query(wr, l, gain::Material::default());
             let (nc, np) = (8usize, 16usize);
             let cell = |wi: [f64; 3]| {
                 let c = ((wi[2] * nc as f64) as usize).min(nc - 1);
@@ -445,10 +631,12 @@ fn seed_to_seed_noise_of_a_sky_lit_sphere() {
     assert!(d.mean < MEAN_BOUND && d.p99 < P99_BOUND, "{d}");
 }
 
-/// Bounds of [`seed_to_seed_noise_of_a_sky_lit_sphere`]: measured 10.3 and 54.4
-/// (2026-11-25), with a margin of 25 %.
-const MEAN_BOUND: f64 = 13.0;
-const P99_BOUND: f64 = 68.0;
+/// Bounds of [`seed_to_seed_noise_of_a_sky_lit_sphere`]: measured 2.84 and
+/// 14.7 with the absolute gain, exact Fresnel once and `R_U` (10.3 and 54.4
+/// before, 2026-11-25: the same estimator's noise is smaller in CIEDE2000 at
+/// 1/25 of the luminance), with a margin of 25 %.
+const MEAN_BOUND: f64 = 3.6;
+const P99_BOUND: f64 = 18.4;
 
 /// The quadrature on the sphere of [`seed_to_seed_noise_of_a_sky_lit_sphere`]:
 /// two seeds at 64 samples per pixel and the same sub-pixel positions (their
@@ -526,7 +714,8 @@ fn quadrature_is_quiet_and_agrees_with_monte_carlo() {
 }
 
 /// Bounds of [`quadrature_is_quiet_and_agrees_with_monte_carlo`]'s seed-to-seed
-/// noise at held sub-pixel positions: measured 0.49 and 2.28 (2026-11-25), with
-/// a margin of 25 %.
-const Q_MEAN_BOUND: f64 = 0.61;
-const Q_P99_BOUND: f64 = 2.85;
+/// noise at held sub-pixel positions: measured 0.120 and 0.435 with the
+/// absolute gain, exact Fresnel once and `R_U` (0.49 and 2.28 before,
+/// 2026-11-25, at 25 times the luminance), with a margin of 25 %.
+const Q_MEAN_BOUND: f64 = 0.15;
+const Q_P99_BOUND: f64 = 0.55;

@@ -1,7 +1,9 @@
 //! `sunbeam-play --export-shader`: the response-map material for other
 //! engines, translated by naga from the same WGSL the player draws with
-//! (shaders/response_map.wgsl, plus the engine interface in shaders/export.wgsl:
-//! one uniform block, the map, its sampler, `sunbeam_shade(t, b, n, wi, wr)`).
+//! (shaders/material.wgsl: Fresnel, G, Smith masking, the diffuse base's share
+//! and the frame; shaders/response_map.wgsl; plus the engine interface in
+//! shaders/export.wgsl: one uniform block, the map, its sampler,
+//! `sunbeam_shade(t, b, n, wi, wr)`).
 //! docs/ENGINES.md documents the interface and how each engine takes it.
 //! naga does the translation (it is already in the tree through wgpu) rather
 //! than hand-kept copies per language, so the languages cannot drift apart.
@@ -10,6 +12,7 @@ use sunbeam_common::{Error, Result};
 
 /// The exported module's WGSL source.
 pub const SOURCE: &str = concat!(
+    include_str!("../../../shaders/material.wgsl"),
     include_str!("../../../shaders/response_map.wgsl"),
     include_str!("../../../shaders/export.wgsl")
 );

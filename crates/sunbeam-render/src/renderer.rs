@@ -4,23 +4,31 @@
 use crate::gpu::Gpu;
 use std::sync::Arc;
 use sunbeam_common::{Error, Result};
+use sunbeam_optics::cie;
 use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
-use sunbeam_optics::{cie, gain};
 use sunbeam_pack::{Basis, Model, Pack};
 use sunbeam_raster::spectral::Samples;
 use sunbeam_raster::{Image, LinearImage, Prepared};
 use sunbeam_scene::{camera, Camera, Light};
 use wgpu::util::DeviceExt;
 
-/// The WGSL source: the response-map material (shaders/response_map.wgsl, also
-/// what `--export-shader` translates) and the player's shading
-/// (shaders/diffraction.wgsl), and the environment's estimator
-/// (shaders/environment.wgsl).
+/// The WGSL source: the skin's material functions (shaders/material.wgsl:
+/// Fresnel, G, masking, the diffuse base's share, the frame), the response-map
+/// material (shaders/response_map.wgsl; both also what `--export-shader`
+/// translates), the player's shading (shaders/diffraction.wgsl) and the
+/// environment's estimator (shaders/environment.wgsl).
 pub const SHADER: &str = concat!(
+    include_str!("../../../shaders/material.wgsl"),
     include_str!("../../../shaders/response_map.wgsl"),
     include_str!("../../../shaders/diffraction.wgsl"),
     include_str!("../../../shaders/environment.wgsl")
 );
+
+/// shaders/material.wgsl alone: the skin's functions every shader calls
+/// (`sb_fresnel`, `sb_gain`, `sb_masking`, `sb_base_transmission`, `sb_frame`);
+/// [`SHADER`] and [`crate::export::SOURCE`] begin with it, and
+/// tests/material.rs runs it in a compute pass.
+pub const MATERIAL_WGSL: &str = include_str!("../../../shaders/material.wgsl");
 
 /// Most lights a frame shades with.
 pub const MAX_LIGHTS: usize = 4;
@@ -151,9 +159,9 @@ struct Globals {
     output: u32,
     exposure_scale: f32,
     n_lambda: u32,
-    f0: f32,
     /// Samples per pixel of the colour target (the shader tells covered pixels from silhouettes).
     msaa: u32,
+    _g0: u32,
 }
 
 #[repr(C)]
@@ -189,7 +197,8 @@ struct MaterialU {
     tab_dw: f32,
     mask_sx: f32,
     mask_sy: f32,
-    _q: f32,
+    /// The skin's refractive index (scene `meshes[].ior`).
+    ior: f32,
     resp_on: u32,
     resp_n_theta: f32,
     resp_n_rho: f32,
@@ -197,7 +206,12 @@ struct MaterialU {
     resp_r0: f32,
     resp_rho_scale: f32,
     resp_footprint: u32,
-    _r: f32,
+    /// What G is divided by: `sunbeam_optics::gain::Material::norm` (1
+    /// absolute, F(0) relative).
+    norm: f32,
+    /// The window's sigma in um (window model: R_U in the direct mode), 0 = R.
+    window_sigma_um: f32,
+    _s: [f32; 3],
 }
 
 struct GpuMesh {
@@ -343,6 +357,8 @@ impl Renderer {
                 table_dt: 1.0,
                 mask_sx: mat.masking.rms_slope()[0] as f32,
                 mask_sy: mat.masking.rms_slope()[1] as f32,
+                ior: mat.skin.ior as f32,
+                norm: mat.skin.norm() as f32,
                 ..Default::default()
             };
             let mut response: Option<Vec<[f32; 4]>> = None;
@@ -678,8 +694,8 @@ impl Renderer {
             },
             exposure_scale: state.exposure.exp2() as f32,
             n_lambda: self.n_lambda,
-            f0: gain::f0(gain::DEFAULT_IOR) as f32,
             msaa: self.msaa(),
+            _g0: 0,
         };
         gpu.queue
             .write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
@@ -819,6 +835,13 @@ fn pack_uniforms(
         0.0
     };
     mu.table_dt = dt as f32;
+    // PHYSICS.md 2b's exact grazing term (Pack::shading_reflectance) in the
+    // direct mode; the thesis mode keeps the thesis' R.
+    mu.window_sigma_um = if m.model == Model::Window && settings.mode == Mode::Direct {
+        (m.window_sigma_m * 1e6) as f32
+    } else {
+        0.0
+    };
     (table, dt)
 }
 
@@ -1350,7 +1373,6 @@ mod layout_tests {
                 output,
                 exposure_scale,
                 n_lambda,
-                f0,
                 msaa
             ),
         );
@@ -1394,13 +1416,16 @@ mod layout_tests {
                 tab_dw,
                 mask_sx,
                 mask_sy,
+                ior,
                 resp_on,
                 resp_n_theta,
                 resp_n_rho,
                 resp_n_s,
                 resp_r0,
                 resp_rho_scale,
-                resp_footprint
+                resp_footprint,
+                norm,
+                window_sigma_um
             ),
         );
     }

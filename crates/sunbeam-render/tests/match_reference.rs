@@ -82,11 +82,22 @@ fn check_with(name: &str, gpu: &Gpu, p: &Prepared, st: &Settings, mean_max: f64,
     );
 }
 
+/// Stops added to the fixtures' exposure: they were set for the relative
+/// normalisation (a flat patch head-on reflects 1); the default absolute
+/// reflectance is `F(0)` = 0.04 of that head-on (PHYSICS.md 2), so
+/// `log2(1 / F(0))` = 4.64 stops keeps the frames about as bright, and the
+/// CIEDE2000 comparisons as sensitive, as they were.
+fn absolute_exposure() -> f64 {
+    use sunbeam_optics::gain;
+    -gain::f0(gain::DEFAULT_IOR).log2()
+}
+
 fn with_pack(
     patch: &fixtures::Patch,
-    scene: (sunbeam_scene::Scene, sunbeam_raster::Mesh),
+    mut scene: (sunbeam_scene::Scene, sunbeam_raster::Mesh),
 ) -> Option<Prepared> {
     let dir = data_dir()?;
+    scene.0.exposure += absolute_exposure();
     let pack = fixtures::pack(patch, &dir, &Default::default()).unwrap();
     eprintln!(
         "{}: {} terms, crop {}x{}",
@@ -170,6 +181,30 @@ fn masked_snake_matches_reference() {
     check("snake-xeno-masked", &gpu, &p, 0.5, 2.0);
 }
 
+/// The skin's uniforms (sunbeam_optics::gain::Material: scene `ior` and
+/// `reflectance`): another index in the relative normalisation, in the
+/// player's shader against the reference, on the sphere, whose limbs show the
+/// Fresnel curve; the reference must differ from the default skin's.
+#[test]
+fn relative_reflectance_and_index_match_reference() {
+    let Some(mut p) = with_pack(&fixtures::ELAPHE, fixtures::sphere_scene(SIZE)) else {
+        return;
+    };
+    let Some(gpu) = gpu() else { return };
+    let default = sunbeam_raster::render_prepared(&p, &Options::default());
+    p.meshes[0].1.skin = sunbeam_optics::gain::Material {
+        ior: 1.33,
+        reflectance: sunbeam_optics::gain::Reflectance::Relative,
+    };
+    // relative: back to the fixture's own exposure
+    p.scene.exposure -= absolute_exposure();
+    let other = sunbeam_raster::render_prepared(&p, &Options::default());
+    let d = sunbeam_raster::compare(&other, &default).unwrap();
+    eprintln!("ior 1.33 relative vs the default skin (reference): {d}");
+    assert!(d.max > 2.0, "the skin changed nothing visible: {d}");
+    check("sphere-elaphe-relative", &gpu, &p, 0.5, 2.0);
+}
+
 #[test]
 fn lambert_mode_is_the_closed_form() {
     let Some(gpu) = gpu() else { return };
@@ -215,6 +250,14 @@ fn response_map_at_scale(name: &str, n: usize, pixel: f64) {
     scene.lights[0].direction = [0.15, 0.1, 1.0];
     scene.meshes[0].diffuse_weight = 0.1;
     scene.size = [48, 48];
+    // The frame as this test had it in the relative normalisation: the
+    // diffraction as bright (the exposure) and the grey base as faint beside
+    // it (its colour times F(0)). Brightened 25 times, the base's silhouette
+    // alone (4x MSAA coverage against 16 samples per pixel) gave the 1x frame
+    // p99 2.35, with p99 0.25 inside the silhouette.
+    scene.exposure += absolute_exposure();
+    let f0 = sunbeam_optics::gain::f0(sunbeam_optics::gain::DEFAULT_IOR);
+    scene.meshes[0].base_color = scene.meshes[0].base_color.map(|c| c * f0);
     let p = fixtures::prepared(scene, mesh, Some(Arc::new(pack)));
     let t = std::time::Instant::now();
     let reference = sunbeam_raster::render_prepared_linear(

@@ -1,6 +1,10 @@
 //! Building a response map from a term pack: for every texel and wavelength
-//! sample, `R` exactly as `sunbeam_pack::Pack::reflectance` defines it (same
-//! coefficients, kernel taps and model), summed with the colour weights.
+//! sample, the reflectance that shading uses exactly as
+//! `sunbeam_pack::Pack::shading_reflectance` defines it (same coefficients,
+//! kernel taps and model), summed with the colour weights: for the window
+//! model `R_U` (PHYSICS.md 2b, `sunbeam_optics::grazing::window_reflectance`:
+//! the amplitude plus its derivatives along the frequency, through the
+//! derivative of the same Kaiser-Bessel kernel), for the tiled model `R`.
 //!
 //! Arranged so that each (texel column, wavelength) interpolates the N terms
 //! once (Kaiser-Bessel or Gaussian taps, PACK_FORMAT.md), for the column half
@@ -69,9 +73,21 @@ const RHO_PER_UNIT: f64 = 50.0;
 /// The radial density below which the budget takes angle texels first.
 const RHO_PER_UNIT_MIN: f64 = 25.0;
 
+/// Fewest `s` layers of a window pack's map (its grazing term): `R_U` of the
+/// window's own lobe falls to 0 as `w -> 0` (a flat patch's is `(w^2 /
+/// |q|^2)^2 R`, a notch `|w| ~ r` wide), and every pack is flat there (`t ->
+/// 0`), so the layer `s = 0` holds about 0 under the specular lobe and
+/// linear interpolation towards it dims every direction pair with `s` below
+/// the next layer. Measured on a flat 40 um patch under a white furnace at a
+/// view of 80 degrees (the quadrature over the maps against Monte Carlo on
+/// the pack): -3 % with 8 layers, -0.2 % with 16
+/// (`furnace_maps_follow_the_grazing_term` in crates/sunbeam-raster/tests/environment.rs).
+pub const MIN_S_GRAZING: usize = 16;
+
 /// The grid for a pack: two texels per lobe width across `(u, v)` at radius 1
 /// (angle), [`RHO_PER_UNIT`] steps per unit of `asinh(r / r0)` along the
-/// radius, about three per unit of `|t|` along `w`; then shrunk to the budget:
+/// radius, about three per unit of `|t|` along `w` (at least 8, or
+/// [`MIN_S_GRAZING`] for a window pack); then shrunk to the budget:
 /// `s` to 16, the radius to [`RHO_PER_UNIT_MIN`], the angle to 128, the radius
 /// to 64, in that order.
 pub fn auto_grid(pack: &Pack, budget_bytes: usize) -> Grid {
@@ -89,7 +105,12 @@ pub fn auto_grid(pack: &Pack, budget_bytes: usize) -> Grid {
     g.n_rho = rho_at(RHO_PER_UNIT);
     let rho_floor = rho_at(RHO_PER_UNIT_MIN);
     let t_max = 4.0 * std::f64::consts::PI * m.height_half_range_m / LAMBDA_MIN;
-    g.n_s = ((3.0 * t_max).ceil() as usize + 2).clamp(8, 40);
+    let min_s = if grazing_sigma(pack).is_some() {
+        MIN_S_GRAZING
+    } else {
+        8
+    };
+    g.n_s = ((3.0 * t_max).ceil() as usize + 2).clamp(min_s, 40);
     let max_texels = (budget_bytes / 8).max(128 * 32 * 8);
     while g.texels() > max_texels {
         if g.n_s > 16 {
@@ -129,13 +150,16 @@ pub fn wavelength_weights(n: usize) -> Vec<(f64, [f64; 3])> {
         .collect()
 }
 
-/// The Kaiser-Bessel kernel tabulated over `|d| in [0, taps / 2]` (linear
-/// interpolation; the kernel's second derivative is O(1), so the table's error
-/// is about 1e-8): `kernel::kb` sums a Bessel series per call, which dominated
-/// the build.
+/// The Kaiser-Bessel kernel and its derivative tabulated over `|d| in [0,
+/// taps / 2]` (linear interpolation; the kernel's second and third
+/// derivatives are O(1), so the tables' error is about 1e-8): `kernel::kb` and
+/// `kernel::kb_derivative` sum a Bessel series per call, which dominated the
+/// build.
 struct KbTable {
     step: f64,
     v: Vec<f64>,
+    /// `kernel::kb_derivative` at `|d|` (the derivative is odd in `d`).
+    dv: Vec<f64>,
 }
 
 const KB_TABLE: usize = 8192;
@@ -147,20 +171,36 @@ impl KbTable {
         let v = (0..=KB_TABLE + 1)
             .map(|i| kernel::kb(i as f64 * step, taps, beta))
             .collect();
-        KbTable { step, v }
+        let dv = (0..=KB_TABLE + 1)
+            .map(|i| kernel::kb_derivative(i as f64 * step, taps, beta))
+            .collect();
+        KbTable { step, v, dv }
     }
-    fn at(&self, d: f64) -> f64 {
+    fn lerp(&self, t: &[f64], d: f64) -> f64 {
         let x = d.abs() / self.step;
         let i = x.floor() as usize;
         if i >= KB_TABLE {
             return 0.0;
         }
         let f = x - i as f64;
-        self.v[i] * (1.0 - f) + self.v[i + 1] * f
+        t[i] * (1.0 - f) + t[i + 1] * f
+    }
+    fn at(&self, d: f64) -> f64 {
+        self.lerp(&self.v, d)
+    }
+    /// `d kb / dd` at `d`.
+    fn deriv(&self, d: f64) -> f64 {
+        let v = self.lerp(&self.dv, d);
+        if d < 0.0 {
+            -v
+        } else {
+            v
+        }
     }
 }
 
-/// One axis' taps at `kappa`: crop indices and weights (weights 0 outside the crop).
+/// One axis' taps at `kappa`: crop indices and weights (weights 0 outside the
+/// crop), and with `dw` the weights' derivatives along `kappa` (window model).
 fn taps(
     pack: &Pack,
     kb: &KbTable,
@@ -168,6 +208,7 @@ fn taps(
     axis: usize,
     idx: &mut [usize],
     w: &mut [f32],
+    mut dw: Option<&mut [f32]>,
 ) -> bool {
     let m = &pack.manifest;
     let (half, n) = (if axis == 0 { m.crop.kx } else { m.crop.ky }, m.kernel.taps);
@@ -178,6 +219,9 @@ fn taps(
         if k < -half || k > half {
             w[j] = 0.0;
             idx[j] = 0;
+            if let Some(dw) = dw.as_deref_mut() {
+                dw[j] = 0.0;
+            }
             continue;
         }
         let d = kappa - k as f64;
@@ -185,6 +229,10 @@ fn taps(
             Model::Window => kb.at(d),
             Model::Tiled => kernel::gauss(d, m.kernel.sigma_bins[axis]),
         } as f32;
+        if let Some(dw) = dw.as_deref_mut() {
+            dw[j] = kb.deriv(d) as f32;
+            any |= dw[j] != 0.0;
+        }
         idx[j] = (k + half) as usize;
         any |= w[j] != 0.0;
     }
@@ -202,12 +250,18 @@ fn axpy(y: &mut [f32], a: f32, x: &[f32]) {
 /// `|A(f)|^2` (into `p`) and `|A(-f)|^2` (into `q`) for every `s` of a
 /// column at once: `cl` holds the coefficients term-major (`cl[n ns + k]`),
 /// so each term is one `axpy` over the column, which vectorises. The four
-/// half sums are explained at [`build`].
+/// half sums are explained at [`build`]. With the window's grazing term, the
+/// same four sums of the amplitude's derivative along the ray (`d*`) give
+/// `A_U = A + beta D` per `s` ([`Powers::at_u`]).
 struct Powers {
     ge: Vec<f32>,
     go: Vec<f32>,
     he: Vec<f32>,
     ho: Vec<f32>,
+    dge: Vec<f32>,
+    dgo: Vec<f32>,
+    dhe: Vec<f32>,
+    dho: Vec<f32>,
 }
 
 impl Powers {
@@ -217,23 +271,32 @@ impl Powers {
             go: vec![0.0; ns],
             he: vec![0.0; ns],
             ho: vec![0.0; ns],
+            dge: vec![0.0; ns],
+            dgo: vec![0.0; ns],
+            dhe: vec![0.0; ns],
+            dho: vec![0.0; ns],
         }
     }
 
     fn eval(&mut self, cl: &[f32], g: &[f32], h: &[f32], ne: usize) {
-        let ns = self.ge.len();
-        for v in [&mut self.ge, &mut self.go, &mut self.he, &mut self.ho] {
-            v.iter_mut().for_each(|x| *x = 0.0);
-        }
-        for (n, c) in cl.chunks_exact(ns).enumerate() {
-            let (gs, hs) = if n < ne {
-                (&mut self.ge, &mut self.he)
-            } else {
-                (&mut self.go, &mut self.ho)
-            };
-            axpy(gs, g[n], c);
-            axpy(hs, h[n], c);
-        }
+        half_sums(
+            [&mut self.ge, &mut self.go, &mut self.he, &mut self.ho],
+            cl,
+            g,
+            h,
+            ne,
+        );
+    }
+
+    /// The half sums of the derivative terms `dg`, `dh` (as [`Powers::eval`]).
+    fn eval_d(&mut self, cl: &[f32], dg: &[f32], dh: &[f32], ne: usize) {
+        half_sums(
+            [&mut self.dge, &mut self.dgo, &mut self.dhe, &mut self.dho],
+            cl,
+            dg,
+            dh,
+            ne,
+        );
     }
 
     /// `(|A(f)|^2, |A(-f)|^2)` of row `k` after [`Powers::eval`].
@@ -243,6 +306,40 @@ impl Powers {
         let (a, b) = (ge + go, he + ho);
         let (am, bm) = (ge - go, ho - he);
         (a * a + b * b, am * am + bm * bm)
+    }
+
+    /// `(|A(f) + beta D(f)|^2, |A(-f) + beta D(-f)|^2)` of row `k` after
+    /// [`Powers::eval`] and [`Powers::eval_d`]: the derivative terms along
+    /// the mirrored ray are the conjugates of those along the ray (module
+    /// [`build`]), so the same half sums give both.
+    #[inline]
+    fn at_u(&self, k: usize, beta: f32) -> (f32, f32) {
+        let ge = self.ge[k] + beta * self.dge[k];
+        let go = self.go[k] + beta * self.dgo[k];
+        let he = self.he[k] + beta * self.dhe[k];
+        let ho = self.ho[k] + beta * self.dho[k];
+        let (a, b) = (ge + go, he + ho);
+        let (am, bm) = (ge - go, ho - he);
+        (a * a + b * b, am * am + bm * bm)
+    }
+}
+
+/// The four half sums `[G_e, G_o, H_e, H_o]` of coefficients `cl` (term-major)
+/// with the terms `g`, `h` (even terms first, `ne` of them).
+fn half_sums(out: [&mut Vec<f32>; 4], cl: &[f32], g: &[f32], h: &[f32], ne: usize) {
+    let [ge, go, he, ho] = out;
+    let ns = ge.len();
+    for v in [&mut *ge, &mut *go, &mut *he, &mut *ho] {
+        v.iter_mut().for_each(|x| *x = 0.0);
+    }
+    for (n, c) in cl.chunks_exact(ns).enumerate() {
+        let (gs, hs) = if n < ne {
+            (&mut *ge, &mut *he)
+        } else {
+            (&mut *go, &mut *ho)
+        };
+        axpy(gs, g[n], c);
+        axpy(hs, h[n], c);
     }
 }
 
@@ -254,6 +351,17 @@ impl Powers {
 /// sums split by the parity of `n` (`G_e, G_o, H_e, H_o` below), `A(f) =
 /// (G_e + G_o) + i (H_e + H_o)` and `A(-f) = (G_e - G_o) + i (H_o - H_e)`: one
 /// interpolation and one set of dot products give both texels, half the work.
+///
+/// The window model's grazing term (PHYSICS.md 2b) needs the amplitude's
+/// derivatives along `u` and `v`. On the ray of angle `theta`, `kappa = a q`
+/// with `a = -(cos theta bin_scale_x, sin theta bin_scale_y)` and `q = r /
+/// lambda`, and `window_reflectance`'s correction is exactly
+/// `beta D` with `D = a . grad_kappa A = dA/dq` (the derivative along the
+/// ray) and `beta = r lambda / (4 pi^2 sigma^2 (r^2 + w^2))`: one derivative
+/// per ray, not two. The kernel's derivative is odd, so the interpolated
+/// terms' gradient at `-kappa` is `-conj` of that at `kappa`; along the
+/// mirrored ray (`a -> -a`) the two signs cancel and `D_n(-f) = conj D_n(f)`,
+/// the same symmetry as the terms': the half sums above serve `D` too.
 pub fn build(pack: &Pack, o: &Options) -> Response {
     let g = o.grid.unwrap_or_else(|| auto_grid(pack, o.budget_bytes));
     let lw = wavelength_weights(o.lambda_samples);
@@ -262,14 +370,27 @@ pub fn build(pack: &Pack, o: &Options) -> Response {
         sets: vec![lw.iter().map(|l| l.1).collect()],
     };
     let xyz = build_sets(pack, &g, &ws).pop().expect("one weight set");
-    to_response(
-        pack,
-        g,
-        lw.len(),
-        &xyz,
-        true,
-        "XYZ without G: sum_l R(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)",
-    )
+    let quantity = format!(
+        "XYZ without G: sum_l {}(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)",
+        reflectance_name(pack)
+    );
+    to_response(pack, g, lw.len(), &xyz, true, &quantity)
+}
+
+/// What the maps of `pack` hold per wavelength: `R_U` (the window model with
+/// its grazing term, PHYSICS.md 2b) or `R` (the tiled model).
+pub fn reflectance_name(pack: &Pack) -> &'static str {
+    if grazing_sigma(pack).is_some() {
+        "R_U"
+    } else {
+        "R"
+    }
+}
+
+/// The window's `sigma` (metres) when the maps carry its grazing term.
+fn grazing_sigma(pack: &Pack) -> Option<f64> {
+    let m = &pack.manifest;
+    (m.model == Model::Window && m.window_sigma_m > 0.0).then_some(m.window_sigma_m)
 }
 
 /// Several colour integrals of the same `R`: wavelengths (metres) and, per
@@ -281,12 +402,24 @@ pub struct WeightSets {
 }
 
 /// The texels (XYZ, `f32`, response-map order) of every weight set of `ws` on
-/// grid `g`, in one pass over the pack's `R`: the interpolation of the terms
-/// and the powers `|A|^2`, the expensive part, are shared; each set only adds
-/// its own multiply-add per (texel, wavelength). Set `s`'s texels do not
+/// grid `g`, in one pass over the pack's reflectance (`R_U` for the window
+/// model, `R` for the tiled model: [`reflectance_name`]): the interpolation
+/// of the terms and the powers, the expensive part, are shared; each set only
+/// adds its own multiply-add per (texel, wavelength). Set `s`'s texels do not
 /// depend on the other sets (same operations in the same order), so
 /// [`build`] through here gives the same bytes as a set of its own.
 pub fn build_sets(pack: &Pack, g: &Grid, ws: &WeightSets) -> Vec<Vec<f32>> {
+    sets_of(pack, g, ws, grazing_sigma(pack))
+}
+
+/// [`build_sets`] with `R` (Beckmann's obliquity, no grazing term) for the
+/// window model too: the maps before PHYSICS.md 2b, for plots of `R` itself
+/// and for measuring what the grazing term costs (tests/bench_build.rs).
+pub fn build_sets_r(pack: &Pack, g: &Grid, ws: &WeightSets) -> Vec<Vec<f32>> {
+    sets_of(pack, g, ws, None)
+}
+
+fn sets_of(pack: &Pack, g: &Grid, ws: &WeightSets, sigma: Option<f64>) -> Vec<Vec<f32>> {
     let terms = Terms::new(pack);
     let coef = coefficients(pack, g, &ws.lambdas, &terms);
     let wt: Vec<Vec<[f32; 3]>> = ws
@@ -295,7 +428,7 @@ pub fn build_sets(pack: &Pack, g: &Grid, ws: &WeightSets) -> Vec<Vec<f32>> {
         .map(|s| s.iter().map(|w| w.map(|v| v as f32)).collect())
         .collect();
     match pack.manifest.model {
-        Model::Window => window_by_rays(pack, g, &ws.lambdas, &wt, &terms, &coef),
+        Model::Window => window_by_rays(pack, g, &ws.lambdas, &wt, &terms, &coef, sigma),
         Model::Tiled => tiled_by_rows(pack, g, &ws.lambdas, &wt, &terms, &coef),
     }
 }
@@ -378,7 +511,10 @@ impl Terms {
         }
     }
 
-    /// `G` and `H` interpolated at bin coordinates `(kx, ky)` (zero outside the crop).
+    /// `G` and `H` interpolated at bin coordinates `(kx, ky)` (zero outside
+    /// the crop), and with `deriv = Some((a, dg, dh))` their derivative along
+    /// the direction `a` in bin coordinates, `a . grad_kappa`, from the
+    /// kernel's derivative (window model).
     #[allow(clippy::too_many_arguments)]
     fn interpolate(
         &self,
@@ -388,25 +524,49 @@ impl Terms {
         t: &mut TapBuf,
         gr: &mut [f32],
         hi: &mut [f32],
+        mut deriv: Option<RayDerivative>,
     ) {
         gr.iter_mut().for_each(|v| *v = 0.0);
         hi.iter_mut().for_each(|v| *v = 0.0);
-        if !taps(pack, kb, kx, 0, &mut t.ix, &mut t.wx)
-            || !taps(pack, kb, ky, 1, &mut t.iy, &mut t.wy)
-        {
+        if let Some((_, dg, dh)) = deriv.as_mut() {
+            dg.iter_mut().for_each(|v| *v = 0.0);
+            dh.iter_mut().for_each(|v| *v = 0.0);
+        }
+        let with_d = deriv.is_some();
+        if !taps(
+            pack,
+            kb,
+            kx,
+            0,
+            &mut t.ix,
+            &mut t.wx,
+            with_d.then_some(&mut t.dx[..]),
+        ) || !taps(
+            pack,
+            kb,
+            ky,
+            1,
+            &mut t.iy,
+            &mut t.wy,
+            with_d.then_some(&mut t.dy[..]),
+        ) {
             return;
         }
         let (nt, cw) = (self.nt, pack.manifest.crop.width);
         for (a, &yy) in t.iy.iter().enumerate() {
-            if t.wy[a] == 0.0 {
-                continue;
-            }
             for (b, &xx) in t.ix.iter().enumerate() {
                 let wgt = t.wy[a] * t.wx[b];
+                let o = (yy * cw + xx) * nt;
+                if let Some(((ax, ay), dg, dh)) = deriv.as_mut() {
+                    let dw = *ax * t.dx[b] * t.wy[a] + *ay * t.wx[b] * t.dy[a];
+                    if dw != 0.0 {
+                        axpy(dg, dw, &self.g[o..o + nt]);
+                        axpy(dh, dw, &self.h[o..o + nt]);
+                    }
+                }
                 if wgt == 0.0 {
                     continue;
                 }
-                let o = (yy * cw + xx) * nt;
                 axpy(gr, wgt, &self.g[o..o + nt]);
                 axpy(hi, wgt, &self.h[o..o + nt]);
             }
@@ -414,12 +574,19 @@ impl Terms {
     }
 }
 
+/// Where [`Terms::interpolate`] puts the terms' derivative along a direction:
+/// the direction in bin coordinates and the `G`, `H` outputs.
+type RayDerivative<'a> = ((f32, f32), &'a mut [f32], &'a mut [f32]);
+
 /// Scratch for one point's taps.
 struct TapBuf {
     ix: Vec<usize>,
     iy: Vec<usize>,
     wx: Vec<f32>,
     wy: Vec<f32>,
+    /// The weights' derivatives (window model's grazing term).
+    dx: Vec<f32>,
+    dy: Vec<f32>,
 }
 
 impl TapBuf {
@@ -429,6 +596,8 @@ impl TapBuf {
             iy: vec![0; n],
             wx: vec![0.0; n],
             wy: vec![0.0; n],
+            dx: vec![0.0; n],
+            dy: vec![0.0; n],
         }
     }
 }
@@ -465,13 +634,21 @@ fn coefficients(pack: &Pack, g: &Grid, lambdas: &[f64], terms: &Terms) -> Vec<f3
 /// the map's f16 rounding (tests/build.rs checks the map against the pack's
 /// own evaluator at texel centres).
 const RAY_SAMPLES_PER_BIN: f64 = 8.0;
+/// The same with the window's grazing term: where `R_U` is the small
+/// difference of the amplitude and its correction (a lobe seen with both
+/// directions at the horizon: `R_U ~ 1e-3 R`), the ray's interpolation error
+/// is amplified by `|A| / |A_U|`; at 1/8 bin the map was 4e-3 off there
+/// (relative to 1e-3), at 1/16 bin 8e-4 (tests/build.rs).
+const RAY_SAMPLES_PER_BIN_GRAZING: f64 = 16.0;
 
 /// The window model, one angle pair at a time. Every texel of angle `theta`
 /// samples the terms at `f = -q (cos theta, sin theta)` with `q = r / lambda`:
 /// one ray of the frequency plane. So the terms are interpolated (Kaiser-Bessel,
 /// as the pack defines them) once at fine steps along the ray, and every
 /// (radius, wavelength) pair reads that ray with a four-point Lagrange
-/// interpolation: 36 taps per point become 4.
+/// interpolation: 36 taps per point become 4. With the grazing term (`sigma`,
+/// the window's width), the terms' derivative along the ray is interpolated
+/// alongside (the kernel's derivative taps) and read the same way ([`build`]).
 fn window_by_rays(
     pack: &Pack,
     g: &Grid,
@@ -479,6 +656,7 @@ fn window_by_rays(
     wts: &[Vec<[f32; 3]>],
     terms: &Terms,
     coef: &[f32],
+    sigma: Option<f64>,
 ) -> Vec<Vec<f32>> {
     let m = &pack.manifest;
     let (nt, ne, ns, nl) = (terms.nt, terms.ne, g.n_s, lambdas.len());
@@ -488,6 +666,11 @@ fn window_by_rays(
     let paired = g.n_theta.is_multiple_of(2);
     let n_direct = if paired { g.n_theta / 2 } else { g.n_theta };
     let lambda_min = lambdas.iter().copied().fold(f64::INFINITY, f64::min);
+    let grazing = sigma.is_some();
+    // beta = r lambda / (4 pi^2 sigma^2 (r^2 + w^2)) = kr / (r^2 + w^2).
+    let beta_scale = sigma.map_or(0.0, |sg| {
+        1.0 / (4.0 * std::f64::consts::PI * std::f64::consts::PI * sg * sg)
+    });
     let cols: Vec<(Vec<f32>, Vec<f32>)> = (0..n_direct)
         .into_par_iter()
         .map(|i| {
@@ -495,26 +678,45 @@ fn window_by_rays(
             // Bin coordinates per unit of q along this ray.
             let a = (-th.cos() * m.bin_scale_m[0], -th.sin() * m.bin_scale_m[1]);
             let len = a.0.hypot(a.1).max(1e-30);
-            let dq = 1.0 / (RAY_SAMPLES_PER_BIN * len);
+            let per_bin = if grazing {
+                RAY_SAMPLES_PER_BIN_GRAZING
+            } else {
+                RAY_SAMPLES_PER_BIN
+            };
+            let dq = 1.0 / (per_bin * len);
             let n_q = (2.0 / lambda_min / dq).ceil() as usize + 4;
             // Samples at q = (p - 1) dq, p = 0..n_q (one before zero for the stencil).
             let mut ray_g = vec![0.0f32; n_q * nt];
             let mut ray_h = vec![0.0f32; n_q * nt];
+            // The derivative along the ray, dA/dq = a . grad_kappa A (grazing term only).
+            let nd = if grazing { n_q * nt } else { 0 };
+            let (mut ray_dg, mut ray_dh) = (vec![0.0f32; nd], vec![0.0f32; nd]);
             let mut tb = TapBuf::new(m.kernel.taps);
+            let a32 = (a.0 as f32, a.1 as f32);
             for p in 0..n_q {
                 let q = (p as f64 - 1.0) * dq;
                 let (gs, hs) = (
                     &mut ray_g[p * nt..(p + 1) * nt],
                     &mut ray_h[p * nt..(p + 1) * nt],
                 );
-                terms.interpolate(pack, &kb, (a.0 * q, a.1 * q), &mut tb, gs, hs);
+                let deriv = grazing.then(|| {
+                    (
+                        a32,
+                        &mut ray_dg[p * nt..(p + 1) * nt],
+                        &mut ray_dh[p * nt..(p + 1) * nt],
+                    )
+                });
+                terms.interpolate(pack, &kb, (a.0 * q, a.1 * q), &mut tb, gs, hs, deriv);
             }
             let mut col = vec![0.0f32; nsets * stride];
             let mut col_m = vec![0.0f32; if paired { nsets * stride } else { 0 }];
             let (mut gr, mut hi) = (vec![0.0f32; nt], vec![0.0f32; nt]);
+            let (mut dgr, mut dhi) = (vec![0.0f32; nt], vec![0.0f32; nt]);
+            let mut beta = vec![0.0f32; ns];
             let mut pw = Powers::new(ns);
             for j in 0..g.n_rho {
                 let r = g.r_at(j);
+                let wmax = (4.0 - r * r).max(0.0).sqrt();
                 for (l, lambda) in lambdas.iter().enumerate() {
                     let x = r / lambda / dq + 1.0;
                     let p0 = (x.floor() as usize).max(1);
@@ -537,8 +739,24 @@ fn window_by_rays(
                     }
                     let cl = &coef[(j * nl + l) * ns * nt..(j * nl + l + 1) * ns * nt];
                     pw.eval(cl, &gr, &hi, ne);
-                    for k in 0..ns {
-                        let (p, q) = pw.at(k);
+                    if grazing {
+                        dgr.iter_mut().for_each(|v| *v = 0.0);
+                        dhi.iter_mut().for_each(|v| *v = 0.0);
+                        for (d, &wv) in lag.iter().enumerate() {
+                            let o = (p0 - 1 + d) * nt;
+                            axpy(&mut dgr, wv, &ray_dg[o..o + nt]);
+                            axpy(&mut dhi, wv, &ray_dh[o..o + nt]);
+                        }
+                        pw.eval_d(cl, &dgr, &dhi, ne);
+                        let kr = r * lambda * beta_scale;
+                        for (k, b) in beta.iter_mut().enumerate() {
+                            let w = g.s_at(k) * wmax;
+                            let q2 = r * r + w * w;
+                            *b = if q2 > 0.0 { (kr / q2) as f32 } else { 0.0 };
+                        }
+                    }
+                    for (k, &bk) in beta.iter().enumerate() {
+                        let (p, q) = if grazing { pw.at_u(k, bk) } else { pw.at(k) };
                         for (si, wt) in wts.iter().enumerate() {
                             let (wt, o) = (wt[l], si * stride + (j * ns + k) * 3);
                             for c in 0..3 {
@@ -608,8 +826,8 @@ fn tiled_by_rows(
                 for (l, lambda) in lambdas.iter().enumerate() {
                     let kx = -cu / lambda * m.bin_scale_m[0];
                     let ky = -su / lambda * m.bin_scale_m[1];
-                    if !taps(pack, &kb, kx, 0, &mut tb.ix, &mut tb.wx)
-                        || !taps(pack, &kb, ky, 1, &mut tb.iy, &mut tb.wy)
+                    if !taps(pack, &kb, kx, 0, &mut tb.ix, &mut tb.wx, None)
+                        || !taps(pack, &kb, ky, 1, &mut tb.iy, &mut tb.wy, None)
                     {
                         continue;
                     }

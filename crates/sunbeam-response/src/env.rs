@@ -12,7 +12,9 @@
 //!
 //! becomes `int d(u,v) [G / cos(theta_i)] sum_k c_k(wi) E_k(u, v, w)` with
 //! `E_k = sum_l R (A / l^2) B_k cmf dl / sum_l D65 ybar dl` precomputed on the
-//! response map's polar grid. The integral over `(u, v)` is left to Monte
+//! response map's polar grid (`R` is what shading uses: `R_U` with the
+//! window's grazing term for the window model, PHYSICS.md 2b; `G` the mesh's
+//! skin's, times its masking, per direction). The integral over `(u, v)` is left to Monte
 //! Carlo with a proposal that follows the maps' energy ([`Proposal`]). The sun
 //! (sky only) is outside the basis: a fourth map `E_sun` with `B = sun_spectral`
 //! and a sample on its disc per estimate.
@@ -21,6 +23,7 @@ use crate::build::{self, Options};
 use crate::grid::Grid;
 use crate::Response;
 use sunbeam_light::Environment;
+use sunbeam_optics::masking::Masking;
 use sunbeam_optics::{cie, colour, gain};
 use sunbeam_pack::Pack;
 
@@ -65,7 +68,7 @@ pub fn build_env(pack: &Pack, env: &Environment, opts: &Options) -> EnvResponse 
             nl,
             &e,
             false,
-            &quantity("the sun's spectral radiance times its solid angle"),
+            &quantity(pack, "the sun's spectral radiance times its solid angle"),
         )
     });
     let names = match env {
@@ -75,7 +78,7 @@ pub fn build_env(pack: &Pack, env: &Environment, opts: &Options) -> EnvResponse 
     let basis: Vec<Response> = xyz
         .iter()
         .zip(names)
-        .map(|(e, n)| build::to_response(pack, g, nl, e, false, &quantity(n)))
+        .map(|(e, n)| build::to_response(pack, g, nl, e, false, &quantity(pack, n)))
         .collect();
     let proposal = Proposal::from_maps(g, proposal_maps(env, &basis));
     EnvResponse {
@@ -86,10 +89,11 @@ pub fn build_env(pack: &Pack, env: &Environment, opts: &Options) -> EnvResponse 
     }
 }
 
-/// `Info::quantity` of an extended-light map for basis spectrum `b`.
-fn quantity(b: &str) -> String {
+/// `Info::quantity` of an extended-light map of `pack` for basis spectrum `b`.
+fn quantity(pack: &Pack, b: &str) -> String {
     format!(
-        "XYZ without G: sum_l R(u, v, w, l) (A / l^2) B(l) cmf(l) / sum_l D65(l) ybar(l), B = {b}"
+        "XYZ without G: sum_l {}(u, v, w, l) (A / l^2) B(l) cmf(l) / sum_l D65(l) ybar(l), B = {b}",
+        build::reflectance_name(pack)
     )
 }
 
@@ -148,11 +152,21 @@ pub fn env_weights(pack: &Pack, env: &Environment, n: usize) -> build::WeightSet
 impl EnvResponse {
     /// CPU twin of the player's estimator: one sample of the diffraction part
     /// (linear sRGB) at local view `wr_l` (unit, z > 0), with `frame` turning
-    /// local `wi` to world for the coefficients. Uniforms: `u[0..3]` the
+    /// local `wi` to world for the coefficients, for a mesh whose skin is
+    /// `skin` with `masking` on its `G` (every direction's gain is
+    /// `masking.gain(wi, wr, skin)`, as the shader's). Uniforms: `u[0..3]` the
     /// proposal's descent and position, `u[3..5]` the sun's disc. Its
     /// expectation is the reference's (`sunbeam_raster::environment`) specular
-    /// part for the same pack and environment.
-    pub fn sample(&self, env: &Environment, frame: Frame, wr_l: [f64; 3], u: [f64; 5]) -> [f64; 3] {
+    /// part for the same pack, environment, skin and masking.
+    pub fn sample(
+        &self,
+        env: &Environment,
+        frame: Frame,
+        wr_l: [f64; 3],
+        masking: Masking,
+        skin: gain::Material,
+        u: [f64; 5],
+    ) -> [f64; 3] {
         let (t, b, n) = frame;
         let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
         let mut xyz = [0.0; 3];
@@ -162,14 +176,14 @@ impl EnvResponse {
         // The sky and the map (everything but the sun): one sample, from the
         // proposal or (with probability DEFENSIVE) uniform over the
         // hemisphere, weighed by the mixture's density (one-sample MIS).
-        if let Some((uv, pdf)) = self.draw(wr_l, [u[0], u[1], u[2]]) {
+        if let Some((uv, pdf)) = self.draw(wr_l, skin, [u[0], u[1], u[2]]) {
             let (wx, wy) = (-uv[0] - wr_l[0], -uv[1] - wr_l[1]);
             let r2 = wx * wx + wy * wy;
             if r2 < 1.0 && pdf > 0.0 {
                 let wi = [wx, wy, (1.0 - r2).sqrt()];
                 let w = -(wi[2] + wr_l[2]);
                 let c = env.coefficients(world(wi));
-                let f = gain::g(wi, wr_l, gain::Material::default()) / (wi[2] * pdf);
+                let f = masking.gain(wi, wr_l, skin) / (wi[2] * pdf);
                 for (ck, ek) in c.iter().zip(&self.basis) {
                     let e = ek.lookup(uv[0], uv[1], w);
                     for a in 0..3 {
@@ -186,7 +200,7 @@ impl EnvResponse {
                 if wi[2] > 0.0 {
                     let (uu, vv, w) = (-wi[0] - wr_l[0], -wi[1] - wr_l[1], -wi[2] - wr_l[2]);
                     // The map holds Omega_sun E_sun.
-                    let f = gain::g(wi, wr_l, gain::Material::default());
+                    let f = masking.gain(wi, wr_l, skin);
                     let e = e_sun.lookup(uu, vv, w);
                     for a in 0..3 {
                         xyz[a] += f * e[a];
@@ -211,20 +225,21 @@ pub const DEFENSIVE: f64 = 0.25;
 impl EnvResponse {
     /// One `(u, v)` for local view `wr` from three uniforms, with the density
     /// per unit `(u, v)` of the mixture (`DEFENSIVE` uniform over the
-    /// hemisphere, the rest from the proposal): `u[0] < DEFENSIVE` picks the
+    /// hemisphere, the rest from the proposal weighed with `skin`'s gain):
+    /// `u[0] < DEFENSIVE` picks the
     /// hemisphere (`cos(theta_i) = u[1]`, azimuth `2 pi u[2]`), else the
     /// proposal with `u[0]` rescaled.
-    pub fn draw(&self, wr: [f64; 3], u: [f64; 3]) -> Option<([f64; 2], f64)> {
+    pub fn draw(&self, wr: [f64; 3], skin: gain::Material, u: [f64; 3]) -> Option<([f64; 2], f64)> {
         let (uv, p) = if u[0] < DEFENSIVE {
             let z = u[1];
             let (s, c) = (2.0 * std::f64::consts::PI * u[2]).sin_cos();
             let sr = (1.0 - z * z).max(0.0).sqrt();
             let uv = [-sr * c - wr[0], -sr * s - wr[1]];
-            (uv, self.density(wr, uv))
+            (uv, self.density(wr, skin, uv))
         } else {
             // The proposal's density comes with its draw: no second descent.
             let u0 = ((u[0] - DEFENSIVE) / (1.0 - DEFENSIVE)).min(1.0 - f64::EPSILON);
-            let (uv, p) = self.proposal.sample(wr, [u0, u[1], u[2]])?;
+            let (uv, p) = self.proposal.sample(wr, skin, [u0, u[1], u[2]])?;
             (
                 uv,
                 DEFENSIVE * hemisphere_density(wr, uv) + (1.0 - DEFENSIVE) * p,
@@ -234,8 +249,8 @@ impl EnvResponse {
     }
 
     /// Density per unit `(u, v)` with which [`EnvResponse::draw`] draws `uv`.
-    pub fn density(&self, wr: [f64; 3], uv: [f64; 2]) -> f64 {
-        DEFENSIVE * hemisphere_density(wr, uv) + (1.0 - DEFENSIVE) * self.proposal.pdf(wr, uv)
+    pub fn density(&self, wr: [f64; 3], skin: gain::Material, uv: [f64; 2]) -> f64 {
+        DEFENSIVE * hemisphere_density(wr, uv) + (1.0 - DEFENSIVE) * self.proposal.pdf(wr, skin, uv)
     }
 }
 

@@ -3,7 +3,10 @@
 //!
 //! It stores, after the spectral integral,
 //! `T(u, v, w) = sum_l R(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)` (XYZ,
-//! without the gain `G`, which a shader computes per light) on the polar grid of
+//! without the gain `G`, which a shader computes per light; `R` the
+//! reflectance shading uses, `sunbeam_pack::Pack::shading_reflectance`: for
+//! the window model `R_U`, with the window's exact grazing term of
+//! PHYSICS.md 2b) on the polar grid of
 //! [`grid`], as one RGBA16F 3D texture (XYZ in RGB). A shader then reads it with
 //! one trilinear sample per light (more when a pixel's footprint spans several
 //! texels), times `G`. It is built once, offline, by `sunbeam-pack --response`

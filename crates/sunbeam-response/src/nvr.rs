@@ -26,6 +26,9 @@
 //!   `G(wi', n) / cos(theta_i') sum_k c_k(frame(Q wi')) E_k(u, v, -wi'_z - 1) / pdf`;
 //! - the sun: its local direction `d` taken back to the head-on lobe,
 //!   `wi' = Q^T d`, adds `G(wi', n) (Omega E_sun)(-wi'_x, -wi'_y, -wi'_z - 1)`
+//!
+//! (`G` the mesh's skin's gain times its masking, `masking.gain(wi', n, skin)`,
+//! as in the twin)
 //!   when `wi'_z > 0` (the hemisphere the prefilter integrates over, not the
 //!   surface's: a prefiltered map indexed by `r` alone cannot know where the
 //!   surface's horizon is, so neither does this estimator's sky part).
@@ -35,6 +38,7 @@
 
 use crate::env::{EnvResponse, Frame};
 use sunbeam_light::Environment;
+use sunbeam_optics::masking::Masking;
 use sunbeam_optics::{colour, gain};
 
 /// The normal, which is also the view and the mirror direction of the
@@ -61,15 +65,18 @@ pub fn rotate_from_normal(r: [f64; 3], v: [f64; 3], inverse: bool) -> [f64; 3] {
 
 /// One sample of the `n = v = r` prefilter approximation (linear sRGB) at
 /// local view `wr_l` (unit, z > 0), with the same arguments and uniforms as
-/// [`EnvResponse::sample`] (`u[0..3]` the draw at the head-on view, `u[3..5]`
-/// the sun's disc). Its expectation is what a renderer that prefilters the
-/// environment with the head-on lobe and looks it up by the mirror direction
-/// shows, computed from the same maps (module docs).
+/// [`EnvResponse::sample`] (the skin and masking of the mesh, `u[0..3]` the
+/// draw at the head-on view, `u[3..5]` the sun's disc). Its expectation is
+/// what a renderer that prefilters the environment with the head-on lobe and
+/// looks it up by the mirror direction shows, computed from the same maps
+/// (module docs).
 pub fn prefilter_nvr_sample(
     e: &EnvResponse,
     env: &Environment,
     frame: Frame,
     wr_l: [f64; 3],
+    masking: Masking,
+    skin: gain::Material,
     u: [f64; 5],
 ) -> [f64; 3] {
     let (t, b, n) = frame;
@@ -80,14 +87,14 @@ pub fn prefilter_nvr_sample(
     }
     let r = [-wr_l[0], -wr_l[1], wr_l[2]];
     // The sky and the map: the head-on lobe, rotated onto r for the lookup.
-    if let Some((uv, pdf)) = e.draw(N, [u[0], u[1], u[2]]) {
+    if let Some((uv, pdf)) = e.draw(N, skin, [u[0], u[1], u[2]]) {
         let (wx, wy) = (-uv[0] - N[0], -uv[1] - N[1]);
         let r2 = wx * wx + wy * wy;
         if r2 < 1.0 && pdf > 0.0 {
             let wi = [wx, wy, (1.0 - r2).sqrt()];
             let w = -(wi[2] + N[2]);
             let c = env.coefficients(world(rotate_from_normal(r, wi, false)));
-            let f = gain::g(wi, N, gain::Material::default()) / (wi[2] * pdf);
+            let f = masking.gain(wi, N, skin) / (wi[2] * pdf);
             for (ck, ek) in c.iter().zip(&e.basis) {
                 let v = ek.lookup(uv[0], uv[1], w);
                 for a in 0..3 {
@@ -103,7 +110,7 @@ pub fn prefilter_nvr_sample(
             let wi = rotate_from_normal(r, [dot(t), dot(b), dot(n)], true);
             if wi[2] > 0.0 {
                 let (uu, vv, w) = (-wi[0] - N[0], -wi[1] - N[1], -wi[2] - N[2]);
-                let f = gain::g(wi, N, gain::Material::default());
+                let f = masking.gain(wi, N, skin);
                 let v = e_sun.lookup(uu, vv, w);
                 for a in 0..3 {
                     xyz[a] += f * v[a];

@@ -10,8 +10,10 @@
 //! small floor so that no reachable cell has probability 0), padded to
 //! power-of-two sides; each coarser level sums its children. A descent for a
 //! view weighs each child by its stored value (interpolated in `s`) times the
-//! view's gain factor `G / max(cos(theta_i), 0.05)` at the child's centre, so
-//! the proposal follows the integrand's energy, not just the map's.
+//! view's gain factor `G / max(cos(theta_i), 0.05)` at the child's sub-points
+//! (`sunbeam_optics::gain::g` with the mesh's skin, so its Fresnel factor is
+//! the skin's; masking is left out of this shape), so the proposal follows
+//! the integrand's energy, not just the map's.
 
 use crate::grid::Grid;
 use crate::Response;
@@ -121,7 +123,8 @@ impl Proposal {
         self.offsets.len()
     }
 
-    /// The weight of cell `(x, y)` at level `l` for view `wr`: 0 when the
+    /// The weight of cell `(x, y)` at level `l` for view `wr` and the skin
+    /// `skin`: 0 when the
     /// cell does not meet the view's disc ([`Proposal::reaches_disc`]) or holds
     /// no real cell; else the mean, over the [`SUB_POINTS`] of the cell that
     /// lie inside the disc, of the stored value interpolated in `s` at that
@@ -129,7 +132,7 @@ impl Proposal {
     /// does). Sub-points rather than the centre: at coarse levels `G / cos`,
     /// `s` and the disc's rim change across a cell, and the centre alone
     /// starved cells by factors of 30-400 (docs/PACK_FORMAT.md).
-    pub fn weight(&self, wr: [f64; 3], l: usize, x: usize, y: usize) -> f64 {
+    pub fn weight(&self, wr: [f64; 3], skin: gain::Material, l: usize, x: usize, y: usize) -> f64 {
         let g = &self.grid;
         let Some([x0, x1, y0, y1]) = self.extent(l, x, y) else {
             return 0.0;
@@ -156,7 +159,7 @@ impl Proposal {
             } else {
                 at(0)
             };
-            let gain = gain::g(wi, wr, gain::Material::default());
+            let gain = gain::g(wi, wr, skin);
             if inside {
                 sum += v * gain / wi[2].max(0.05);
                 n_in += 1;
@@ -226,6 +229,7 @@ impl Proposal {
     fn descend(
         &self,
         wr: [f64; 3],
+        skin: gain::Material,
         mut pick: impl FnMut(usize, &[(usize, usize)], &[f64]) -> Option<usize>,
     ) -> Option<(usize, usize, f64)> {
         let top = self.levels() - 1;
@@ -239,7 +243,7 @@ impl Proposal {
             for cy in children(y, self.heights[l + 1], h) {
                 for cx in children(x, self.widths[l + 1], w) {
                     cells.push((cx, cy));
-                    wts.push(self.weight(wr, l, cx, cy));
+                    wts.push(self.weight(wr, skin, l, cx, cy));
                 }
             }
             let sum: f64 = wts.iter().sum();
@@ -256,15 +260,20 @@ impl Proposal {
         Some((x, y, prob))
     }
 
-    /// Draw `(u, v)` for local view `wr` (unit, z > 0) from three uniforms in
+    /// Draw `(u, v)` for local view `wr` (unit, z > 0) and skin `skin` from three uniforms in
     /// [0, 1): `u[0]` the descent (rescaled within the chosen interval at
     /// each level), `u[1]`, `u[2]` the position in the level-0 cell (uniform
     /// in angle and in `r^2`). Returns the point and its density per unit
     /// `(u, v)` area (equal to [`Proposal::pdf`] there); None when every cell
     /// weighs 0.
-    pub fn sample(&self, wr: [f64; 3], u: [f64; 3]) -> Option<([f64; 2], f64)> {
+    pub fn sample(
+        &self,
+        wr: [f64; 3],
+        skin: gain::Material,
+        u: [f64; 3],
+    ) -> Option<([f64; 2], f64)> {
         let mut u0 = u[0];
-        let (i, j, prob) = self.descend(wr, |_, _, wts| {
+        let (i, j, prob) = self.descend(wr, skin, |_, _, wts| {
             let sum: f64 = wts.iter().sum();
             let target = u0 * sum;
             let mut acc = 0.0;
@@ -291,12 +300,12 @@ impl Proposal {
     }
 
     /// Density per unit `(u, v)` area with which [`Proposal::sample`] draws
-    /// `uv` for view `wr` (repeats the descent along the point's cell).
-    pub fn pdf(&self, wr: [f64; 3], uv: [f64; 2]) -> f64 {
+    /// `uv` for view `wr` and skin `skin` (repeats the descent along the point's cell).
+    pub fn pdf(&self, wr: [f64; 3], skin: gain::Material, uv: [f64; 2]) -> f64 {
         let Some((i, j)) = self.cell_of(uv) else {
             return 0.0;
         };
-        let found = self.descend(wr, |l, cells, _| {
+        let found = self.descend(wr, skin, |l, cells, _| {
             let want = (
                 i / (self.pw / self.widths[l]),
                 j / (self.ph / self.heights[l]),

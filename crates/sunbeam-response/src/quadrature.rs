@@ -44,6 +44,7 @@ use crate::build::{self, Options};
 use crate::env::env_weights;
 use crate::grid::Grid;
 use sunbeam_light::Environment;
+use sunbeam_optics::gain;
 use sunbeam_optics::masking::Masking;
 use sunbeam_pack::Pack;
 
@@ -205,15 +206,16 @@ impl EnvQuadrature {
     }
 
     /// The diffraction part (XYZ) towards local view `wr` (unit, `z > 0`) of
-    /// an unmasked surface with frame `frame`, lit by `env`: the sum over class
-    /// `part.0` of `part.1` (1, 4, 16, .. a square) times `part.1`, plus the
-    /// sun at the point `sun_u` of its disc.
+    /// an unmasked surface with skin `skin` and frame `frame`, lit by `env`:
+    /// the sum over class `part.0` of `part.1` (1, 4, 16, .. a square) times
+    /// `part.1`, plus the sun at the point `sun_u` of its disc.
     pub fn integrate(
         &self,
         env: &Environment,
         frame: Frame,
         wr: [f64; 3],
         sun_u: [f64; 2],
+        skin: gain::Material,
         part: (usize, usize),
     ) -> [f64; 3] {
         self.integrate_many(
@@ -223,6 +225,7 @@ impl EnvQuadrature {
                 wr,
                 sun_u,
                 masking: Masking::Off,
+                skin,
             }],
             part,
         )[0]
@@ -315,7 +318,7 @@ impl EnvQuadrature {
                 let wi = [dot(t), dot(b), dot(n)];
                 let wr = q.wr;
                 if wi[2] > 0.0 {
-                    let gain = q.masking.gain(wi, wr, sunbeam_optics::gain::Material::default());
+                    let gain = q.masking.gain(wi, wr, q.skin);
                     let e = self.lookup_sun(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
                     for a in 0..3 {
                         xyz[a] += gain * e[a];
@@ -436,6 +439,8 @@ pub struct Query {
     pub sun_u: [f64; 2],
     /// Shadowing-masking on `G` (sunbeam_optics::masking).
     pub masking: Masking,
+    /// The skin's interface: index and normalisation of `G` (sunbeam_optics::gain).
+    pub skin: gain::Material,
 }
 
 /// A query prepared for the sum.
@@ -443,6 +448,7 @@ struct View<'a> {
     frame: Frame,
     wr: [f64; 3],
     masking: Masking,
+    skin: gain::Material,
     rho_v: f64,
     phi_v: f64,
     table: Option<&'a OctTable>,
@@ -459,6 +465,7 @@ impl<'a> View<'a> {
             frame: q.frame,
             wr,
             masking: q.masking,
+            skin: q.skin,
             rho_v: wr[0].hypot(wr[1]),
             phi_v: wr[1].atan2(wr[0]),
             table: quad.table.as_ref(),
@@ -593,7 +600,7 @@ impl<'a> View<'a> {
         }
         let ci = (1.0 - d2).sqrt();
         let wi = [x, y, ci];
-        let gain = self.masking.gain(wi, self.wr, sunbeam_optics::gain::Material::default()) / ci;
+        let gain = self.masking.gain(wi, self.wr, self.skin) / ci;
         if gain > 0.0 && gain.is_finite() {
             let c = self.coefficients([x, y, ci]);
             self.add(quad, ci, r, area * gain, c, e, xyz);
@@ -656,7 +663,7 @@ impl<'a> View<'a> {
                 }
                 let dm = (1.0 - ci * ci).max(0.0).sqrt().max(1e-9);
                 let wi = [x * dm / d, y * dm / d, ci];
-                let gs = self.masking.gain(wi, self.wr, sunbeam_optics::gain::Material::default()) * (ci + cr) * (ci + cr);
+                let gs = self.masking.gain(wi, self.wr, self.skin) * (ci + cr) * (ci + cr);
                 let f = wgt * half.abs() * density(dm) / dm * gs;
                 if f > 0.0 && f.is_finite() {
                     self.add(quad, ci, r, area * f, c, e, xyz);

@@ -17,6 +17,8 @@ use std::sync::Arc;
 use sunbeam_common::rng::SplitMix64;
 use sunbeam_light::{sky::Sky, EnvMap, Environment};
 use sunbeam_optics::colour;
+use sunbeam_optics::gain::Material;
+use sunbeam_optics::masking::Masking;
 use sunbeam_pack::build::{BuildOptions, FieldRef};
 use sunbeam_pack::Pack;
 use sunbeam_response::env::{build_env, EnvResponse, Frame};
@@ -57,6 +59,12 @@ pub(crate) fn white() -> Environment {
     Environment::Map(EnvMap::constant([1.0; 3]))
 }
 
+/// The skin of the comparison: the relative normalisation (a head-on mirror
+/// gives 1), so that CIEDE2000 is taken at the luminance of
+/// docs/bench/prefilter.md's figures; what is measured is the approximation's
+/// geometry, the same for either normalisation up to that scale.
+pub(crate) const SKIN: Material = Material::RELATIVE;
+
 /// Which estimator a pixel runs.
 #[derive(Clone, Copy)]
 pub(crate) enum Est {
@@ -72,9 +80,10 @@ pub(crate) fn one(
     wr: [f64; 3],
     u: [f64; 5],
 ) -> [f64; 3] {
+    let (m, skin) = (Masking::Off, SKIN);
     match est {
-        Est::Exact => e.sample(env, f, wr, u),
-        Est::Nvr => prefilter_nvr_sample(e, env, f, wr, u),
+        Est::Exact => e.sample(env, f, wr, m, skin, u),
+        Est::Nvr => prefilter_nvr_sample(e, env, f, wr, m, skin, u),
     }
 }
 
@@ -109,13 +118,16 @@ pub(crate) const UP: Frame = ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]
 /// Head-on (`wr = n`) the approximation is the exact twin: the same numbers
 /// for the same uniforms, to 1e-9 relative (2000 uniforms, sky with the sun
 /// and white map). At 60 degrees across the ridges the converged means
-/// differ: measured with 40 000 samples each (seed-to-seed 1.6 % in Y,
-/// CIEDE2000 0.45), Y n=v=r / exact = 0.214 under the sky and 0.337 under the
+/// differ: measured with 40 000 samples each (seed-to-seed 0.2 % in Y,
+/// CIEDE2000 0.3), Y n=v=r / exact = 0.367 under the sky and 0.657 under the
 /// white map (the exact twin has `G` growing towards grazing and the orders
 /// moved by `wr_xy`; the head-on lobe keeps the head-on value), CIEDE2000
-/// between the means 37.8 and 28.7. The test (8000 samples each, about 1 %
-/// noise in Y) demands a Y ratio under 0.5 and CIEDE2000 over 14, half the
-/// smaller measured difference and far above the noise.
+/// between the means 27.5 and 14.4 ([`SKIN`]: relative). Before `F` was
+/// taken once (Schlick's factor squared made the exact twin's `G` grow far
+/// faster towards grazing) they were 0.214 / 0.337 and 37.8 / 28.7. The test
+/// (8000 samples each, about 1 % noise in Y) demands a Y ratio under 0.8 and
+/// CIEDE2000 over 7, half the smaller measured difference and far above the
+/// noise.
 #[test]
 fn nvr_is_exact_head_on_and_biased_oblique() {
     let pack = ridge_pack(32);
@@ -126,8 +138,8 @@ fn nvr_is_exact_head_on_and_biased_oblique() {
         let mut nonzero = 0;
         for _ in 0..2000 {
             let u = [0; 5].map(|_| rng.unit());
-            let a = e.sample(&env, UP, head_on, u);
-            let b = prefilter_nvr_sample(&e, &env, UP, head_on, u);
+            let a = one(&e, &env, Est::Exact, UP, head_on, u);
+            let b = one(&e, &env, Est::Nvr, UP, head_on, u);
             let scale = a.iter().chain(&b).fold(0.0f64, |m, v| m.max(v.abs()));
             for c in 0..3 {
                 assert!(
@@ -156,7 +168,7 @@ fn nvr_is_exact_head_on_and_biased_oblique() {
             "{name} 60 deg: exact Y {:.4} nvr Y {:.4} (ratio {ratio:.4}, seed-to-seed {ratio_noise:.4}), CIEDE2000 {de:.2} (seed-to-seed {floor:.2})",
             ex[1], nv[1]
         );
-        assert!(ratio < 0.5, "{name}: Y n=v=r / exact {ratio} at 60 degrees");
-        assert!(de > 14.0, "{name}: CIEDE2000 {de} at 60 degrees");
+        assert!(ratio < 0.8, "{name}: Y n=v=r / exact {ratio} at 60 degrees");
+        assert!(de > 7.0, "{name}: CIEDE2000 {de} at 60 degrees");
     }
 }

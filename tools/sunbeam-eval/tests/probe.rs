@@ -23,7 +23,8 @@ fn reference(
     let pos = |r: usize, c: usize| (c as f64 * dx, (h - 1 - r) as f64 * dy);
     let (xc, yc) = ((w as f64 - 1.0) * dx / 2.0, (h as f64 - 1.0) * dy / 2.0);
     if !tiled {
-        let sigma = (coherence / (4.0 * std::f64::consts::SQRT_2)).min((w as f64 * dx).min(h as f64 * dy) / 6.0);
+        let sigma = (coherence / (4.0 * std::f64::consts::SQRT_2))
+            .min((w as f64 * dx).min(h as f64 * dy) / 6.0);
         let (mut re, mut im, mut gs) = (0.0, 0.0, 0.0);
         for r in 0..h {
             for c in 0..w {

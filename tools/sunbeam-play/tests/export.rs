@@ -2,7 +2,8 @@
 //! validators accept what they can read (glslangValidator for GLSL 4.50 and
 //! GLSL ES 3.00, spirv-val for SPIR-V; HLSL and MSL are checked by naga's own
 //! validator before they are written); the interface docs/ENGINES.md promises
-//! is in the output; usage errors exit 1 and write nothing.
+//! is in the output (the map, the skin's exact Fresnel, G and Smith masking,
+//! the frame); usage errors exit 1 and write nothing.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -43,6 +44,11 @@ fn glsl_passes_glslang() {
         let text = std::fs::read_to_string(&f).unwrap();
         assert!(text.contains("sunbeam_shade("), "{lang}: no sunbeam_shade");
         assert!(text.contains("sampler3D"), "{lang}: no 3D texture");
+        // The material's skin (docs/ENGINES.md): index, normalisation and
+        // masking slopes in the uniform block, Smith masking in the shading.
+        for m in ["vec4 skin;", "sb_fresnel(", "sb_masking(", "sb_frame("] {
+            assert!(text.contains(m), "{lang}: missing {m}");
+        }
         if have_command("glslangValidator", &["--version"]) {
             let o = Command::new("glslangValidator").arg(&f).output().unwrap();
             assert!(
@@ -97,12 +103,29 @@ fn hlsl_msl_wgsl_are_written_with_the_interface() {
     for (lang, marks) in [
         (
             "hlsl",
-            &["sunbeam_shade(", "Texture3D", "cbuffer sunbeam"][..],
+            &[
+                "sunbeam_shade(",
+                "Texture3D",
+                "cbuffer sunbeam",
+                "float4 skin",
+                "sb_masking(",
+            ][..],
         ),
-        ("msl", &["sunbeam_shade(", "texture3d<float"][..]),
+        (
+            "msl",
+            &["sunbeam_shade(", "texture3d<float", "sb_masking("][..],
+        ),
         (
             "wgsl",
-            &["fn sunbeam_shade(", "texture_3d<f32>", "fn sb_gain("][..],
+            &[
+                "fn sunbeam_shade(",
+                "texture_3d<f32>",
+                "fn sb_gain(",
+                "fn sb_fresnel(",
+                "fn sb_masking(",
+                "fn sb_frame(",
+                "skin: vec4<f32>",
+            ][..],
         ),
     ] {
         let f = export(lang, &d, &format!("sunbeam.{lang}"));
