@@ -19,9 +19,15 @@ const DIRS_W: usize = 512;
 /// Normals of the table (width; height is half).
 const NORMALS_W: usize = 96;
 
+/// Intervals of a weight other than the clamped cosine, tabulated over `c`
+/// in [0, 1] and read linearly ([`Irradiance::transmitted`]: error below 1e-7).
+const WEIGHT_TABLE: usize = 4096;
+
 /// Irradiance (linear sRGB) per normal of one environment.
 #[derive(Debug, Clone)]
 pub struct Irradiance {
+    /// The weight `w(c)` of `c = n . d` tabulated (none: `c` itself).
+    weight: Option<Vec<f64>>,
     /// Rows from `n_y = 1` to `-1` (angle `theta` from +y at row centres
     /// `pi (j + 0.5) / H`), columns `phi = atan2(z, x)` at `2 pi (i + 0.5) / W`.
     table: Vec<[f64; 3]>,
@@ -31,6 +37,38 @@ pub struct Irradiance {
 
 impl Irradiance {
     pub fn new(env: &Environment) -> Irradiance {
+        Self::build(env, None)
+    }
+
+    /// The irradiance a diffuse base under a dielectric skin of index `ior`
+    /// receives: `int L(d) max(n . d, 0) (1 - F(n . d)) dw` (PHYSICS.md 2: the
+    /// base gets what the interface does not reflect; `F` the exact Fresnel
+    /// reflectance, `sunbeam_optics::gain::fresnel`), the same tabulation with
+    /// the weight `c (1 - F(c))` in place of `c`.
+    pub fn transmitted(env: &Environment, ior: f64) -> Irradiance {
+        let w = (0..=WEIGHT_TABLE + 1)
+            .map(|i| {
+                let c = (i as f64 / WEIGHT_TABLE as f64).min(1.0);
+                c * (1.0 - sunbeam_optics::gain::fresnel(c, ior))
+            })
+            .collect();
+        Self::build(env, Some(w))
+    }
+
+    /// The weight at `c` in (0, 1].
+    fn weight_at(weight: &Option<Vec<f64>>, c: f64) -> f64 {
+        match weight {
+            None => c,
+            Some(w) => {
+                let x = c.min(1.0) * WEIGHT_TABLE as f64;
+                let i = (x as usize).min(WEIGHT_TABLE - 1);
+                let f = x - i as f64;
+                w[i] * (1.0 - f) + w[i + 1] * f
+            }
+        }
+    }
+
+    fn build(env: &Environment, weight: Option<Vec<f64>>) -> Irradiance {
         let sun = env.sun();
         // The radiance without the sun, on directions of equal solid angle.
         let (dw, dh) = (DIRS_W, DIRS_W / 2);
@@ -66,8 +104,9 @@ impl Irradiance {
                 for (d, rgb) in &dirs {
                     let c = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
                     if c > 0.0 {
+                        let wc = Self::weight_at(&weight, c);
                         for a in 0..3 {
-                            e[a] += rgb[a] * c;
+                            e[a] += rgb[a] * wc;
                         }
                     }
                 }
@@ -78,7 +117,7 @@ impl Irradiance {
             let rgb = colour::xyz_to_linear_srgb(s.sun_xyz());
             (s.sun_direction(), rgb.map(|v| v * s.sun_solid_angle()))
         });
-        Irradiance { table, sun }
+        Irradiance { weight, table, sun }
     }
 
     /// Irradiance at world normal `n` (unit).
@@ -103,8 +142,9 @@ impl Irradiance {
         if let Some((s, rgb)) = self.sun {
             let c = n[0] * s[0] + n[1] * s[1] + n[2] * s[2];
             if c > 0.0 {
+                let wc = Self::weight_at(&self.weight, c);
                 for a in 0..3 {
-                    e[a] += rgb[a] * c;
+                    e[a] += rgb[a] * wc;
                 }
             }
         }
@@ -142,5 +182,33 @@ mod tests {
             (y / PI - 1.0).abs() < 0.01,
             "horizontal irradiance {y} vs pi"
         );
+    }
+
+    /// Under a white furnace of radiance 1, the transmitted irradiance is
+    /// `2 pi int_0^1 c (1 - F(c)) dc` at every normal (a fine midpoint rule
+    /// here): about 0.908 pi for n = 1.5 (a dielectric's hemispherical
+    /// transmission).
+    #[test]
+    fn furnace_transmission() {
+        let white = Environment::Map(EnvMap::constant([1.0; 3]));
+        for ior in [1.5, 1.33] {
+            let t = Irradiance::transmitted(&white, ior);
+            let m = 200_000;
+            let want: f64 = (0..m)
+                .map(|i| {
+                    let c = (i as f64 + 0.5) / m as f64;
+                    c * (1.0 - sunbeam_optics::gain::fresnel(c, ior)) / m as f64
+                })
+                .sum::<f64>()
+                * 2.0
+                * PI;
+            for n in [[0.0, 1.0, 0.0], [0.6, 0.0, 0.8], [0.3f64, -0.5, 0.81]] {
+                let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                let e = t.at(n.map(|v| v / l));
+                for v in e {
+                    assert!((v / want - 1.0).abs() < 1e-3, "{ior}: {e:?} vs {want}");
+                }
+            }
+        }
     }
 }

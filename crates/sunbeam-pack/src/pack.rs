@@ -103,9 +103,9 @@ impl Pack {
         t
     }
 
-    /// Relative reflectance R at `(u, v, w) = -wi - wr` and wavelength `lambda_m`
-    /// (PHYSICS.md 2), with the interpolation the player uses.
-    pub fn reflectance(&self, u: f64, v: f64, w: f64, lambda_m: f64) -> f64 {
+    /// The series' coefficients and both axes' taps at a point (None for a
+    /// non-finite point or one far outside any crop): what both evaluators need.
+    fn point(&self, u: f64, v: f64, w: f64, lambda_m: f64) -> Option<(Vec<[f64; 2]>, Taps, Taps)> {
         let m = &self.manifest;
         if !(u.is_finite()
             && v.is_finite()
@@ -113,16 +113,28 @@ impl Pack {
             && lambda_m.is_finite()
             && lambda_m > 0.0)
         {
-            return 0.0;
+            return None;
         }
-        let c = series::coefficients_f64(m.basis, self.t(w, lambda_m), m.terms);
         let kappa_x = -u / lambda_m * m.bin_scale_m[0];
         let kappa_y = -v / lambda_m * m.bin_scale_m[1];
         if kappa_x.abs() > 1e9 || kappa_y.abs() > 1e9 {
-            return 0.0;
+            return None;
         }
-        let tx = self.taps(kappa_x, m.crop.kx, 0);
-        let ty = self.taps(kappa_y, m.crop.ky, 1);
+        let c = series::coefficients_f64(m.basis, self.t(w, lambda_m), m.terms);
+        Some((
+            c,
+            self.taps(kappa_x, m.crop.kx, 0),
+            self.taps(kappa_y, m.crop.ky, 1),
+        ))
+    }
+
+    /// Relative reflectance R at `(u, v, w) = -wi - wr` and wavelength `lambda_m`
+    /// (PHYSICS.md 2), with the interpolation the player uses.
+    pub fn reflectance(&self, u: f64, v: f64, w: f64, lambda_m: f64) -> f64 {
+        let m = &self.manifest;
+        let Some((c, tx, ty)) = self.point(u, v, w, lambda_m) else {
+            return 0.0;
+        };
         let layer = m.layer_texels();
         let mut amp = [0.0f64; 2];
         let mut power = 0.0f64;
@@ -163,22 +175,9 @@ impl Pack {
         if m.model == Model::Tiled || m.window_sigma_m <= 0.0 {
             return self.reflectance(u, v, w, lambda_m);
         }
-        if !(u.is_finite()
-            && v.is_finite()
-            && w.is_finite()
-            && lambda_m.is_finite()
-            && lambda_m > 0.0)
-        {
+        let Some((c, tx, ty)) = self.point(u, v, w, lambda_m) else {
             return 0.0;
-        }
-        let c = series::coefficients_f64(m.basis, self.t(w, lambda_m), m.terms);
-        let kappa_x = -u / lambda_m * m.bin_scale_m[0];
-        let kappa_y = -v / lambda_m * m.bin_scale_m[1];
-        if kappa_x.abs() > 1e9 || kappa_y.abs() > 1e9 {
-            return 0.0;
-        }
-        let tx = self.taps(kappa_x, m.crop.kx, 0);
-        let ty = self.taps(kappa_y, m.crop.ky, 1);
+        };
         let layer = m.layer_texels();
         // amplitude, d/dkappa_x, d/dkappa_y
         let mut acc = [[0.0f64; 2]; 3];

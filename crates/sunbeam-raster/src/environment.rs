@@ -8,7 +8,7 @@
 //!   ([`EnvShader::shade_pixel`]), the sun at a point of its disc, the diffuse
 //!   part from the environment's tabulated irradiance at the normal, with
 //!   the skin's transmission `1 - F(theta_i)` inside the integral
-//!   ([`TransmittedIrradiance`]; [`sunbeam_light::irradiance`] for a mesh
+//!   ([`Irradiance::transmitted`]; [`sunbeam_light::irradiance`] for a mesh
 //!   without a pack): no noise but the sub-pixel positions';
 //! - **Monte Carlo** ([`EnvShader::sample`]), which evaluates the pack's `R`
 //!   per wavelength and direction and shares no code with the maps: the check
@@ -154,7 +154,8 @@ pub struct EnvShader {
     irradiance: Option<Irradiance>,
     /// The irradiance a diffuse base under a skin receives, per refractive
     /// index of the meshes' skins (quadrature only).
-    transmitted: Vec<Arc<TransmittedIrradiance>>,
+    /// Per skin index, the base's irradiance through the interface.
+    transmitted: Vec<(f64, Arc<Irradiance>)>,
     /// Per mesh: whether it has a pack (a skin over its base).
     has_pack: Vec<bool>,
     /// Per mesh: the masking on its `G` (none: off for every mesh).
@@ -202,10 +203,8 @@ impl EnvShader {
             irradiance = Some(Irradiance::new(&env));
         }
         let transmitted = if irradiance.is_some() {
-            vec![Arc::new(TransmittedIrradiance::new(
-                &env,
-                gain::Material::default().ior,
-            ))]
+            let ior = gain::Material::default().ior;
+            vec![(ior, Arc::new(Irradiance::transmitted(&env, ior)))]
         } else {
             Vec::new()
         };
@@ -245,9 +244,9 @@ impl EnvShader {
         self.skins = skins.to_vec();
         if self.irradiance.is_some() {
             for s in skins {
-                if !self.transmitted.iter().any(|t| t.ior == s.ior) {
+                if !self.transmitted.iter().any(|t| t.0 == s.ior) {
                     self.transmitted
-                        .push(Arc::new(TransmittedIrradiance::new(&self.env, s.ior)));
+                        .push((s.ior, Arc::new(Irradiance::transmitted(&self.env, s.ior))));
                 }
             }
         }
@@ -302,8 +301,8 @@ impl EnvShader {
         for (f, o) in frags.iter().zip(out.iter_mut()) {
             if f.dw > 0.0 && local(f)[2] > 0.0 {
                 let ior = self.skin(f.mesh).ior;
-                let e = match self.transmitted.iter().find(|t| t.ior == ior) {
-                    Some(t) if self.has_pack(f.mesh) => t.at(f.frame.2),
+                let e = match self.transmitted.iter().find(|t| t.0 == ior) {
+                    Some(t) if self.has_pack(f.mesh) => t.1.at(f.frame.2),
                     _ => irr.at(f.frame.2),
                 };
                 for c in 0..3 {
@@ -495,203 +494,5 @@ impl EnvShader {
             rgb[c] += (1.0 - dw) * spec[c];
         }
         rgb
-    }
-}
-
-/// Directions of [`TransmittedIrradiance`]'s quadrature (width; height is
-/// half), as `sunbeam_light::irradiance`'s.
-const DIRS_W: usize = 512;
-/// Normals of its table (width; height is half).
-const NORMALS_W: usize = 96;
-/// Intervals of the weight `c (1 - F(c))` tabulated over `c` in [0, 1].
-const WEIGHT_TABLE: usize = 4096;
-
-/// The irradiance a diffuse base under the skin receives, per normal:
-/// `E_T(n) = int L(d) max(n . d, 0) (1 - F(n . d)) dw` (PHYSICS.md 2: the base
-/// gets what the interface does not reflect), `F` the exact Fresnel
-/// reflectance of index `ior`. The same tabulation as
-/// [`sunbeam_light::irradiance::Irradiance`] (the radiance without the sun
-/// on 512 x 256 directions of equal solid angle, 96 x 48 normals read
-/// bilinearly, the sun's disc added exactly as a point), with the weight
-/// `c (1 - F(c))` in place of the clamped cosine `c` (tabulated at 4096
-/// steps of `c`, read linearly: error below 1e-7). With the weight `c` it is
-/// that table (a test checks it).
-#[derive(Debug, Clone)]
-pub struct TransmittedIrradiance {
-    /// The skin's refractive index.
-    pub ior: f64,
-    table: Vec<[f64; 3]>,
-    sun: Option<([f64; 3], [f64; 3])>,
-    weight: Vec<f64>,
-}
-
-impl TransmittedIrradiance {
-    /// The table of `env` for a skin of index `ior`.
-    pub fn new(env: &Environment, ior: f64) -> TransmittedIrradiance {
-        Self::weighted(env, ior, |c| c * (1.0 - gain::fresnel(c, ior)))
-    }
-
-    /// The table with weight `w(c)` for `c = n . d > 0` (`w(0)` must be 0).
-    fn weighted(env: &Environment, ior: f64, w: impl Fn(f64) -> f64) -> TransmittedIrradiance {
-        use rayon::prelude::*;
-        let weight: Vec<f64> = (0..=WEIGHT_TABLE + 1)
-            .map(|i| w((i as f64 / WEIGHT_TABLE as f64).min(1.0)))
-            .collect();
-        let sun = env.sun();
-        let (dw, dh) = (DIRS_W, DIRS_W / 2);
-        let dirs: Vec<([f64; 3], [f64; 3])> = (0..dw * dh)
-            .map(|k| {
-                let (i, j) = (k % dw, k / dw);
-                let y = 1.0 - 2.0 * (j as f64 + 0.5) / dh as f64;
-                let phi = 2.0 * PI * (i as f64 + 0.5) / dw as f64;
-                let d = sunbeam_light::direction(y, phi);
-                let rgb = match sun {
-                    // Inside the sun's disc, the sky behind it (the sun is added below).
-                    Some(s) if s.in_sun(d) => {
-                        let c = s.coefficients(d);
-                        let b = sunbeam_light::daylight::basis_xyz();
-                        colour::xyz_to_linear_srgb(std::array::from_fn(|a| {
-                            (0..3).map(|k| c[k] * b[k][a]).sum()
-                        }))
-                    }
-                    _ => env.rgb(d),
-                };
-                (d, rgb)
-            })
-            .collect();
-        let d_omega = 4.0 * PI / (dw * dh) as f64;
-        let (nw, nh) = (NORMALS_W, NORMALS_W / 2);
-        let mut t = TransmittedIrradiance {
-            ior,
-            table: Vec::new(),
-            sun: None,
-            weight,
-        };
-        t.table = (0..nw * nh)
-            .into_par_iter()
-            .map(|k| {
-                let (i, j) = (k % nw, k / nw);
-                let theta = PI * (j as f64 + 0.5) / nh as f64;
-                let phi = 2.0 * PI * (i as f64 + 0.5) / nw as f64;
-                let n = sunbeam_light::direction(theta.cos(), phi);
-                let mut e = [0.0; 3];
-                for (d, rgb) in &dirs {
-                    let c = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
-                    if c > 0.0 {
-                        let wc = t.weight_at(c);
-                        for a in 0..3 {
-                            e[a] += rgb[a] * wc;
-                        }
-                    }
-                }
-                e.map(|v| v * d_omega)
-            })
-            .collect();
-        t.sun = sun.map(|s| {
-            let rgb = colour::xyz_to_linear_srgb(s.sun_xyz());
-            (s.sun_direction(), rgb.map(|v| v * s.sun_solid_angle()))
-        });
-        t
-    }
-
-    /// The weight at `c` in (0, 1] (linear in the table).
-    fn weight_at(&self, c: f64) -> f64 {
-        let x = c.min(1.0) * WEIGHT_TABLE as f64;
-        let i = (x as usize).min(WEIGHT_TABLE - 1);
-        let f = x - i as f64;
-        self.weight[i] * (1.0 - f) + self.weight[i + 1] * f
-    }
-
-    /// `E_T` at world normal `n` (unit), linear sRGB.
-    pub fn at(&self, n: [f64; 3]) -> [f64; 3] {
-        let (nw, nh) = (NORMALS_W, NORMALS_W / 2);
-        let theta = n[1].clamp(-1.0, 1.0).acos();
-        let phi = n[2].atan2(n[0]).rem_euclid(2.0 * PI);
-        let fx = phi / (2.0 * PI) * nw as f64 - 0.5;
-        let fy = (theta / PI * nh as f64 - 0.5).clamp(0.0, (nh - 1) as f64);
-        let x0 = fx.floor();
-        let tx = fx - x0;
-        let i0 = (x0 as i64).rem_euclid(nw as i64) as usize;
-        let i1 = (i0 + 1) % nw;
-        let j0 = (fy as usize).min(nh - 2);
-        let ty = fy - j0 as f64;
-        let at = |i: usize, j: usize| self.table[j * nw + i];
-        let mut e: [f64; 3] = std::array::from_fn(|a| {
-            let top = at(i0, j0)[a] * (1.0 - tx) + at(i1, j0)[a] * tx;
-            let bot = at(i0, j0 + 1)[a] * (1.0 - tx) + at(i1, j0 + 1)[a] * tx;
-            top * (1.0 - ty) + bot * ty
-        });
-        if let Some((s, rgb)) = self.sun {
-            let c = n[0] * s[0] + n[1] * s[1] + n[2] * s[2];
-            if c > 0.0 {
-                let wc = self.weight_at(c);
-                for a in 0..3 {
-                    e[a] += rgb[a] * wc;
-                }
-            }
-        }
-        e
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use sunbeam_light::{sky::Sky, EnvMap};
-
-    fn unit(v: [f64; 3]) -> [f64; 3] {
-        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        v.map(|x| x / l)
-    }
-
-    /// With the weight `c` the table is `sunbeam_light`'s irradiance (same
-    /// directions, normals and sun): the tabulation is the same code's.
-    #[test]
-    fn plain_weight_is_the_irradiance() {
-        let sky = Environment::Sky(Box::new(Sky::new(35.0, 70.0, 3.0, 1.0)));
-        let a = TransmittedIrradiance::weighted(&sky, 1.5, |c| c);
-        let b = Irradiance::new(&sky);
-        for n in [
-            [0.0, 1.0, 0.0],
-            [0.6, 0.0, 0.8],
-            [0.3, -0.5, 0.81],
-            [-0.2, 0.4, -0.7],
-        ] {
-            let n = unit(n);
-            let (x, y) = (a.at(n), b.at(n));
-            for c in 0..3 {
-                assert!(
-                    (x[c] - y[c]).abs() <= 1e-9 * y[c].abs().max(1e-3),
-                    "{x:?} vs {y:?} at {n:?}"
-                );
-            }
-        }
-    }
-
-    /// Under a white furnace of radiance 1, `E_T = 2 pi int_0^1 c (1 - F(c)) dc`
-    /// at every normal (a fine midpoint rule here): about 0.908 pi for n = 1.5
-    /// (the hemispherical transmission of a dielectric).
-    #[test]
-    fn furnace_transmission() {
-        let white = Environment::Map(EnvMap::constant([1.0; 3]));
-        for ior in [1.5, 1.33] {
-            let t = TransmittedIrradiance::new(&white, ior);
-            let m = 200_000;
-            let want: f64 = (0..m)
-                .map(|i| {
-                    let c = (i as f64 + 0.5) / m as f64;
-                    c * (1.0 - gain::fresnel(c, ior)) / m as f64
-                })
-                .sum::<f64>()
-                * 2.0
-                * PI;
-            for n in [[0.0, 1.0, 0.0], [0.6, 0.0, 0.8], [0.3, -0.5, 0.81]] {
-                let e = t.at(unit(n));
-                for v in e {
-                    assert!((v / want - 1.0).abs() < 1e-3, "{ior}: {e:?} vs {want}");
-                }
-            }
-            eprintln!("n = {ior}: E_T / pi = {:.4}", want / PI);
-        }
     }
 }
