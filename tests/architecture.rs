@@ -6,7 +6,12 @@
 //! - inside a crate, no cycle of `crate::` references between its top modules;
 //! - every tool's `main.rs` stays under 150 lines;
 //! - no hand-made thread pools (`std::thread::spawn`/`scope`/`Builder`) in the
-//!   crates' and tools' sources: parallel work goes through rayon.
+//!   crates' and tools' sources: parallel work goes through rayon;
+//! - the player (`sunbeam-render`) does not depend on the reference
+//!   (`sunbeam-raster`) in any way, not even for its tests;
+//! - no dev-dependency cycle: no crate's tests depend on a crate that depends
+//!   on it;
+//! - the crate graph of docs/dev/ARCHITECTURE.md is the workspace's, both ways.
 //!
 //! The crate graph comes from `cargo metadata`. `SUNBEAM_ARCH_ROOT=DIR` checks
 //! another checkout instead of this one (that is how the check was shown to fail
@@ -22,11 +27,13 @@ fn root() -> PathBuf {
 }
 
 /// The workspace's packages: name -> (manifest dir, dependency names of every kind,
-/// normal dependency names).
+/// normal dependency names, normal and build dependency names, dev-dependency names).
 struct Package {
     dir: PathBuf,
     deps_all: BTreeSet<String>,
     deps_normal: BTreeSet<String>,
+    deps_linked: BTreeSet<String>,
+    deps_dev: BTreeSet<String>,
 }
 
 fn workspace() -> BTreeMap<String, Package> {
@@ -55,10 +62,21 @@ fn workspace() -> BTreeMap<String, Package> {
         let manifest = PathBuf::from(p["manifest_path"].as_str().unwrap());
         let mut deps_all = BTreeSet::new();
         let mut deps_normal = BTreeSet::new();
+        let mut deps_linked = BTreeSet::new();
+        let mut deps_dev = BTreeSet::new();
         for d in p["dependencies"].as_array().unwrap() {
             let dn = d["name"].as_str().unwrap().to_string();
-            if d["kind"].is_null() {
-                deps_normal.insert(dn.clone());
+            match d["kind"].as_str() {
+                None => {
+                    deps_normal.insert(dn.clone());
+                    deps_linked.insert(dn.clone());
+                }
+                Some("build") => {
+                    deps_linked.insert(dn.clone());
+                }
+                _ => {
+                    deps_dev.insert(dn.clone());
+                }
             }
             deps_all.insert(dn);
         }
@@ -68,6 +86,8 @@ fn workspace() -> BTreeMap<String, Package> {
                 dir: manifest.parent().unwrap().to_path_buf(),
                 deps_all,
                 deps_normal,
+                deps_linked,
+                deps_dev,
             },
         );
     }
@@ -76,11 +96,25 @@ fn workspace() -> BTreeMap<String, Package> {
 
 /// Normal dependencies of `name` inside the workspace, transitively.
 fn closure(ws: &BTreeMap<String, Package>, name: &str) -> BTreeSet<String> {
+    closure_by(ws, name, |p| &p.deps_normal)
+}
+
+/// What `name` links inside the workspace (normal and build dependencies,
+/// transitively): what `cargo tree -p NAME` shows without the dev-dependencies.
+fn linked(ws: &BTreeMap<String, Package>, name: &str) -> BTreeSet<String> {
+    closure_by(ws, name, |p| &p.deps_linked)
+}
+
+fn closure_by(
+    ws: &BTreeMap<String, Package>,
+    name: &str,
+    deps: impl Fn(&Package) -> &BTreeSet<String>,
+) -> BTreeSet<String> {
     let mut seen = BTreeSet::new();
     let mut todo = vec![name.to_string()];
     while let Some(n) = todo.pop() {
         if let Some(p) = ws.get(&n) {
-            for d in &p.deps_normal {
+            for d in deps(p) {
                 if ws.contains_key(d) && seen.insert(d.clone()) {
                     todo.push(d.clone());
                 }
@@ -376,4 +410,204 @@ fn the_thread_finder_finds_threads() {
     assert!(!spawns_threads(
         "let n = std::thread::available_parallelism();"
     ));
+}
+
+/// The player draws what the reference draws, but from the shared scene and
+/// images (`sunbeam-frame`), never through the reference: `cargo tree -p
+/// sunbeam-render` (its dev-dependencies included) has no `sunbeam-raster`.
+/// The tests that compare the two live above both (the root package's tests/).
+#[test]
+fn the_player_does_not_depend_on_the_reference() {
+    let ws = workspace();
+    let render = ws.get("sunbeam-render").expect("sunbeam-render");
+    let mut tree = linked(&ws, "sunbeam-render");
+    for d in &render.deps_dev {
+        tree.insert(d.clone());
+        tree.extend(linked(&ws, d));
+    }
+    assert!(
+        !tree.contains("sunbeam-raster"),
+        "sunbeam-render depends on sunbeam-raster (through {:?})",
+        render
+            .deps_all
+            .iter()
+            .filter(|d| *d == "sunbeam-raster" || linked(&ws, d).contains("sunbeam-raster"))
+            .collect::<Vec<_>>()
+    );
+}
+
+/// The dev-dependency cycles of `ws`: `A` dev-depends on `B` while `B` links `A`.
+fn dev_cycles(ws: &BTreeMap<String, Package>) -> Vec<String> {
+    let mut bad = vec![];
+    for (n, p) in ws {
+        for d in &p.deps_dev {
+            if ws.contains_key(d) && linked(ws, d).contains(n) {
+                bad.push(format!("{n} dev-depends on {d}, which depends on {n}"));
+            }
+        }
+    }
+    bad
+}
+
+/// A crate's tests may use crates below it only: a test that needs a crate
+/// above goes to that crate's tests (or the root package's).
+#[test]
+fn no_dev_dependency_cycle() {
+    let bad = dev_cycles(&workspace());
+    assert!(bad.is_empty(), "dev-dependency cycles: {bad:?}");
+}
+
+/// The crate graph of docs/dev/ARCHITECTURE.md ("The crate graph"): the lines
+/// `NAME -> A, B, C   (external)` of its indented block, with continuation
+/// lines; `tools/NAME` is the package in that folder. Parenthesised parts
+/// (external crates, remarks) are left out. name -> workspace dependencies.
+fn doc_graph(text: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let section = text
+        .split("## The crate graph")
+        .nth(1)
+        .expect("a section \"## The crate graph\"");
+    let section = section.split("\n## ").next().unwrap_or(section);
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    let mut current: Option<String> = None;
+    for line in section.lines() {
+        if !line.starts_with("    ") {
+            current = None;
+            continue;
+        }
+        let mut plain = String::new();
+        let mut depth = 0usize;
+        for c in line.chars() {
+            match c {
+                '(' => depth += 1,
+                ')' => depth = depth.saturating_sub(1),
+                _ if depth == 0 => plain.push(c),
+                _ => {}
+            }
+        }
+        let deps = match plain.split_once("->") {
+            Some((name, deps)) => {
+                let name = name.trim().to_string();
+                graph.entry(name.clone()).or_default();
+                current = Some(name);
+                deps.to_string()
+            }
+            None => plain,
+        };
+        let Some(name) = &current else { continue };
+        let set = graph.get_mut(name).unwrap();
+        set.extend(
+            deps.split(',')
+                .map(str::trim)
+                .filter(|d| !d.is_empty())
+                .map(String::from),
+        );
+    }
+    graph
+}
+
+/// Where the doc's graph and the workspace's differ (`common` is left out of
+/// both: "each crate also depends on `sunbeam-common`").
+fn graph_drift(
+    ws: &BTreeMap<String, Package>,
+    doc: &BTreeMap<String, BTreeSet<String>>,
+) -> Vec<String> {
+    let common = "sunbeam-common";
+    // The doc's names: `tools/NAME` for the packages under tools/, the package
+    // name for the others; the root package (tests only) is not in the graph.
+    let doc_name = |n: &str, p: &Package| -> String {
+        match p.dir.parent() {
+            Some(d) if d.ends_with("tools") => {
+                format!("tools/{}", p.dir.file_name().unwrap().to_string_lossy())
+            }
+            _ => n.to_string(),
+        }
+    };
+    let mut drift = vec![];
+    let mut seen = BTreeSet::new();
+    for (n, p) in ws {
+        if p.dir == root() {
+            continue;
+        }
+        let name = doc_name(n, p);
+        seen.insert(name.clone());
+        let meta: BTreeSet<String> = p
+            .deps_normal
+            .iter()
+            .filter(|d| ws.contains_key(*d) && *d != common)
+            .cloned()
+            .collect();
+        let Some(listed) = doc.get(&name) else {
+            drift.push(format!("{name} is not in the graph"));
+            continue;
+        };
+        let listed: BTreeSet<String> = listed.iter().filter(|d| *d != common).cloned().collect();
+        let missing: Vec<_> = meta.difference(&listed).collect();
+        let extra: Vec<_> = listed.difference(&meta).collect();
+        if !missing.is_empty() {
+            drift.push(format!("{name} also depends on {missing:?}"));
+        }
+        if !extra.is_empty() {
+            drift.push(format!("{name} does not depend on {extra:?}"));
+        }
+    }
+    for name in doc.keys() {
+        if !seen.contains(name) {
+            drift.push(format!("{name} is not a package of the workspace"));
+        }
+    }
+    drift
+}
+
+/// docs/dev/ARCHITECTURE.md's crate graph is the workspace's (`cargo
+/// metadata`'s normal dependencies), both ways: a dependency added or removed
+/// in a Cargo.toml fails here until the doc says so.
+#[test]
+fn the_documented_crate_graph_is_the_workspace_graph() {
+    let text = std::fs::read_to_string(root().join("docs/dev/ARCHITECTURE.md"))
+        .expect("docs/dev/ARCHITECTURE.md");
+    let drift = graph_drift(&workspace(), &doc_graph(&text));
+    assert!(
+        drift.is_empty(),
+        "docs/dev/ARCHITECTURE.md's crate graph differs from Cargo.toml's: {drift:#?}"
+    );
+}
+
+#[test]
+fn the_graph_checks_find_drift() {
+    let doc = doc_graph(
+        "## The crate graph\n\ntext\n\n    tools/t -> a, b,\n               c   (ext, x)\n    \
+         a -> (clap)\n    b -> a\n\nRules:\n\n## Next\n\n    z -> y\n",
+    );
+    let set = |v: &[&str]| -> BTreeSet<String> { v.iter().map(|s| s.to_string()).collect() };
+    assert_eq!(doc["tools/t"], set(&["a", "b", "c"]));
+    assert_eq!(doc["a"], set(&[]));
+    assert_eq!(doc["b"], set(&["a"]));
+    assert!(!doc.contains_key("z"));
+    let pkg = |dir: &str, normal: &[&str], dev: &[&str]| Package {
+        dir: PathBuf::from(dir),
+        deps_all: set(normal).union(&set(dev)).cloned().collect(),
+        deps_normal: set(normal),
+        deps_linked: set(normal),
+        deps_dev: set(dev),
+    };
+    let mut ws = BTreeMap::new();
+    ws.insert("t-cli".to_string(), pkg("/w/tools/t", &["a", "b"], &[]));
+    ws.insert("a".to_string(), pkg("/w/crates/a", &[], &["b"]));
+    ws.insert("b".to_string(), pkg("/w/crates/b", &["a", "d"], &[]));
+    ws.insert("d".to_string(), pkg("/w/crates/d", &[], &[]));
+    assert_eq!(
+        graph_drift(&ws, &doc),
+        [
+            "b also depends on [\"d\"]",
+            "d is not in the graph",
+            "tools/t does not depend on [\"c\"]",
+        ]
+    );
+    let mut doc = doc;
+    doc.insert("e".to_string(), BTreeSet::new());
+    assert!(graph_drift(&ws, &doc).contains(&"e is not a package of the workspace".to_string()));
+    assert_eq!(
+        dev_cycles(&ws),
+        vec!["a dev-depends on b, which depends on a"]
+    );
 }

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use sunbeam::{run_ok, scratch, tool, workspace_root};
 use sunbeam_common::testdata;
-use sunbeam_raster::{compare_linear, LinearImage};
+use sunbeam_frame::{compare_linear, LinearImage};
 
 /// The example next to a node_modules with three and playwright-core, as a user runs it.
 fn example(d: &Path) -> Option<PathBuf> {

@@ -16,29 +16,27 @@
 //!   Carlo with multiple importance sampling, spectral ([`environment`],
 //!   docs/LIGHTING.md).
 //!
-//! `render(&Scene)` is what `sunbeam-eval render` calls.
+//! `render(&Scene)` is what `sunbeam-eval render` calls. The scene it draws
+//! (`Prepared`, `prepare`) and the images it draws into (`Image`,
+//! `LinearImage`, their comparison) are `sunbeam_frame`'s, shared with the
+//! player; they are re-exported here.
 
-pub mod diff;
+mod env_cache;
 pub mod environment;
-pub mod fixtures;
-pub mod image;
-pub mod linear;
 pub mod lobe_sampler;
 pub mod raster;
 pub mod shade;
-pub mod spectral;
 
-pub use diff::ColourDiff;
-pub use image::{compare, Image};
-pub use linear::{compare_linear, LinearImage};
-pub use sunbeam_scene::geometry::Mesh;
+pub use sunbeam_frame::{
+    compare, compare_linear, default_scene, load_environment, load_mesh, mesh_bounds, prepare,
+    prepare_with, ColourDiff, Image, LinearImage, Material, Mesh, Prepared,
+};
+pub use sunbeam_frame::{diff, fixtures, image, linear, spectral};
 
-use std::path::Path;
 use std::sync::Arc;
 use sunbeam_common::{Error, Result};
 use sunbeam_optics::colour::ToneCurve;
 use sunbeam_optics::masking::Masking;
-use sunbeam_pack::Pack;
 use sunbeam_scene::Scene;
 
 /// How the reference renders (all defaults are the documented reference).
@@ -84,254 +82,6 @@ pub fn samples_side(samples: u32) -> Result<u32> {
         )));
     }
     Ok(s)
-}
-
-/// What one mesh instance is shaded with.
-#[derive(Debug, Clone)]
-pub struct Material {
-    pub pack: Option<Arc<Pack>>,
-    /// Linear sRGB.
-    pub base_color: [f64; 3],
-    pub diffuse_weight: f64,
-    /// Shadowing-masking on the diffraction's `G` (scene `masking`, `rms_slope`).
-    pub masking: Masking,
-    /// The skin's interface: index and normalisation of `G` (scene `ior`, `reflectance`).
-    pub skin: sunbeam_optics::gain::Material,
-}
-
-/// A scene with its meshes and packs loaded (shared by both renderers).
-#[derive(Debug, Clone)]
-pub struct Prepared {
-    pub scene: Scene,
-    pub meshes: Vec<(Arc<Mesh>, Material)>,
-    /// The scene's environment, loaded (None: point lights only).
-    pub environment: Option<Arc<sunbeam_light::Environment>>,
-    /// The environment's shaders already built for this scene (shared by
-    /// clones: a turntable's frames build the quadrature's maps once).
-    pub env_cache: EnvCache,
-}
-
-/// Built [`environment::EnvShader`]s, keyed by estimator, environment,
-/// packs (the same `Arc`s: a changed environment or pack builds anew; the key
-/// holds them, so their addresses cannot be reused by others while cached)
-/// and the meshes' masking and skins.
-#[derive(Clone, Default)]
-pub struct EnvCache(Arc<std::sync::Mutex<Vec<EnvEntry>>>);
-
-struct EnvEntry {
-    estimator: environment::EnvEstimator,
-    masking: Vec<Masking>,
-    skins: Vec<sunbeam_optics::gain::Material>,
-    env: Arc<sunbeam_light::Environment>,
-    packs: Vec<Option<Arc<Pack>>>,
-    shader: Arc<environment::EnvShader>,
-}
-
-impl std::fmt::Debug for EnvCache {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let n = self.0.lock().map(|v| v.len()).unwrap_or(0);
-        write!(f, "EnvCache({n} shaders)")
-    }
-}
-
-impl EnvCache {
-    /// The shader for `env`, `packs` (with their meshes' `masking` and
-    /// `skins`) and `estimator`, built on first use.
-    fn get(
-        &self,
-        env: Arc<sunbeam_light::Environment>,
-        packs: &[Option<Arc<Pack>>],
-        masking: &[Masking],
-        skins: &[sunbeam_optics::gain::Material],
-        estimator: environment::EnvEstimator,
-    ) -> Arc<environment::EnvShader> {
-        let same_packs = |a: &[Option<Arc<Pack>>]| {
-            a.len() == packs.len()
-                && a.iter().zip(packs).all(|(x, y)| match (x, y) {
-                    (Some(x), Some(y)) => Arc::ptr_eq(x, y),
-                    (None, None) => true,
-                    _ => false,
-                })
-        };
-        let mut v = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(e) = v.iter().find(|e| {
-            e.estimator == estimator
-                && e.masking == masking
-                && e.skins == skins
-                && Arc::ptr_eq(&e.env, &env)
-                && same_packs(&e.packs)
-        }) {
-            return e.shader.clone();
-        }
-        let shader = Arc::new(
-            environment::EnvShader::with_estimator(env.clone(), packs, estimator)
-                .with_masking(masking)
-                .with_skin(skins),
-        );
-        v.push(EnvEntry {
-            estimator,
-            masking: masking.to_vec(),
-            skins: skins.to_vec(),
-            env,
-            packs: packs.to_vec(),
-            shader: shader.clone(),
-        });
-        shader
-    }
-}
-
-/// Load a mesh named by a scene: `builtin:quad`, `builtin:sphere`, or a glTF/GLB/OBJ
-/// file through `sunbeam_mesh::load_scene_mesh` (its orientation field becomes `t`).
-pub fn load_mesh(path: &Path) -> Result<Mesh> {
-    if let Some(b) = Mesh::builtin(path) {
-        return b.map_err(Error::input);
-    }
-    let tm = sunbeam_mesh::load_scene_mesh(path)?;
-    let tangents = tm
-        .orientation
-        .iter()
-        .zip(&tm.tangents)
-        .map(|(o, t)| [o[0], o[1], o[2], if t[3] < 0.0 { -1.0 } else { 1.0 }])
-        .collect();
-    let m = Mesh {
-        positions: tm.positions,
-        normals: tm.normals,
-        uvs: tm.uvs,
-        tangents,
-        indices: tm.indices,
-    };
-    m.check().map_err(|e| Error::input_file(path, e))?;
-    Ok(m)
-}
-
-/// Bounds of the mesh a `--mesh M` form names (for `Scene::default_for`).
-pub fn mesh_bounds(path: &Path) -> Result<([f64; 3], [f64; 3])> {
-    Ok(load_mesh(path)?.bounds())
-}
-
-/// The scene the `--mesh M --pack P` form of `sunbeam-play` and `sunbeam-eval
-/// render` draws under `lighting` (their `--lighting`, default sky).
-pub fn default_scene(
-    mesh: &Path,
-    pack: Option<&Path>,
-    lighting: sunbeam_scene::DefaultLighting,
-) -> Result<Scene> {
-    let b = mesh_bounds(mesh)?;
-    let mut s = Scene::default_lit(mesh.to_path_buf(), pack.map(Path::to_path_buf), b, lighting);
-    s.validate()?;
-    Ok(s)
-}
-
-/// Load every mesh and pack of a scene (each file once).
-pub fn prepare(scene: &Scene) -> Result<Prepared> {
-    prepare_with(scene, &Pack::read)
-}
-
-/// [`prepare`] with the packs read by `load_pack` (the player reads only a
-/// pack's manifest when a current response map stands beside it).
-pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) -> Result<Prepared> {
-    let environment = scene
-        .environment
-        .as_ref()
-        .map(load_environment)
-        .transpose()?;
-    let mut meshes = Vec::new();
-    let mut mesh_cache: Vec<(std::path::PathBuf, Arc<Mesh>)> = Vec::new();
-    let mut pack_cache: Vec<(std::path::PathBuf, Arc<Pack>)> = Vec::new();
-    for (i, mi) in scene.meshes.iter().enumerate() {
-        let mesh = match mesh_cache.iter().find(|(p, _)| *p == mi.mesh) {
-            Some((_, m)) => m.clone(),
-            None => {
-                let m = Arc::new(
-                    load_mesh(&mi.mesh).map_err(|e| e.context(format!("meshes[{i}].mesh")))?,
-                );
-                mesh_cache.push((mi.mesh.clone(), m.clone()));
-                m
-            }
-        };
-        let pack = match &mi.pack {
-            None => None,
-            Some(pp) => Some(match pack_cache.iter().find(|(p, _)| p == pp) {
-                Some((_, k)) => k.clone(),
-                None => {
-                    let k = Arc::new(
-                        load_pack(pp).map_err(|e| e.context(format!("meshes[{i}].pack")))?,
-                    );
-                    pack_cache.push((pp.clone(), k.clone()));
-                    k
-                }
-            }),
-        };
-        if !(mi.diffuse_weight.is_finite() && (0.0..=1.0).contains(&mi.diffuse_weight)) {
-            return Err(Error::input(format!(
-                "meshes[{i}].diffuse_weight must be in [0, 1]"
-            )));
-        }
-        let (lo, hi) = sunbeam_scene::IOR_RANGE;
-        if !(mi.ior.is_finite() && mi.ior > lo && mi.ior <= hi) {
-            return Err(Error::input(format!(
-                "meshes[{i}].ior {} must be in ({lo}, {hi}]",
-                mi.ior
-            )));
-        }
-        let skin = sunbeam_optics::gain::Material {
-            ior: mi.ior,
-            reflectance: match mi.reflectance {
-                sunbeam_scene::ReflectanceMode::Absolute => {
-                    sunbeam_optics::gain::Reflectance::Absolute
-                }
-                sunbeam_scene::ReflectanceMode::Relative => {
-                    sunbeam_optics::gain::Reflectance::Relative
-                }
-            },
-        };
-        let masking = match (&pack, &mi.pack) {
-            (Some(k), Some(path)) => mi
-                .masking_slope(i, k.manifest.rms_slope)
-                .map_err(|e| e.context(format!("meshes[{i}].pack {}", path.display())))?
-                .map_or(Masking::Off, Masking::smith),
-            _ => Masking::Off,
-        };
-        meshes.push((
-            mesh,
-            Material {
-                pack,
-                base_color: mi.base_color,
-                diffuse_weight: mi.diffuse_weight,
-                masking,
-                skin,
-            },
-        ));
-    }
-    Ok(Prepared {
-        scene: scene.clone(),
-        meshes,
-        environment,
-        env_cache: EnvCache::default(),
-    })
-}
-
-/// The scene's `environment` block as a light source (the sky built, the map read).
-pub fn load_environment(e: &sunbeam_scene::Environment) -> Result<Arc<sunbeam_light::Environment>> {
-    e.validate()?;
-    Ok(Arc::new(match (&e.sky, &e.map) {
-        (Some(s), _) => sunbeam_light::Environment::Sky(Box::new(sunbeam_light::sky::Sky::new(
-            s.sun_elevation_deg,
-            s.sun_azimuth_deg,
-            s.turbidity,
-            e.intensity,
-        ))),
-        (None, Some(m)) => sunbeam_light::Environment::Map(sunbeam_light::io::load(
-            m,
-            e.rotation_deg,
-            e.intensity,
-        )?),
-        (None, None) => {
-            return Err(Error::input(
-                "environment needs exactly one of 'sky' and 'map'",
-            ))
-        }
-    }))
 }
 
 /// Render a scene with the reference settings (`Options::default()`).
@@ -397,9 +147,7 @@ fn render_environment(
     let packs: Vec<_> = p.meshes.iter().map(|(_, m)| m.pack.clone()).collect();
     let masking: Vec<Masking> = p.meshes.iter().map(|(_, m)| m.masking).collect();
     let skins: Vec<_> = p.meshes.iter().map(|(_, m)| m.skin).collect();
-    let es = p
-        .env_cache
-        .get(env, &packs, &masking, &skins, opts.estimator);
+    let es = env_cache::of(p).get(env, &packs, &masking, &skins, opts.estimator);
     let shader = shade::Shader::new(p, opts);
     let scale = p.scene.exposure.exp2();
     let eye = p.scene.camera.eye;

@@ -9,8 +9,8 @@
 
 use crate::gpu::Gpu;
 use sunbeam_common::{Error, Result};
+use sunbeam_frame::LinearImage;
 use sunbeam_optics::colour::ToneCurve;
-use sunbeam_raster::LinearImage;
 use wgpu::util::DeviceExt;
 
 /// The accumulation shader's uniform (shaders/accumulate.wgsl `AccU`).

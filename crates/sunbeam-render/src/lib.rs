@@ -5,7 +5,7 @@
 //! ```no_run
 //! use sunbeam_render::{gpu::{Backend, Gpu}, renderer::{Settings, Renderer, Offscreen, FrameState, OFFSCREEN_FORMAT}};
 //! let scene = sunbeam_scene::Scene::load(std::path::Path::new("scene.json")).unwrap();
-//! let prepared = sunbeam_raster::prepare(&scene).unwrap();
+//! let prepared = sunbeam_frame::prepare(&scene).unwrap();
 //! let gpu = Gpu::headless(Backend::Auto).unwrap();
 //! let r = Renderer::new(&gpu, &prepared, &Settings::default(), OFFSCREEN_FORMAT).unwrap();
 //! let target = Offscreen::new(&gpu, &r, 256, 256).unwrap();
@@ -27,7 +27,7 @@ pub use renderer::{FrameState, Mode, Offscreen, Renderer, Settings, OFFSCREEN_FO
 
 use std::time::Instant;
 use sunbeam_common::Result;
-use sunbeam_raster::{Image, Prepared};
+use sunbeam_frame::{Image, Prepared};
 
 /// Render one frame of a prepared scene offscreen (`size` or the scene's size).
 pub fn render_headless(
@@ -56,7 +56,7 @@ pub fn render_headless_linear(
     size: Option<[u32; 2]>,
     frames: u32,
     supersample: u32,
-) -> Result<sunbeam_raster::LinearImage> {
+) -> Result<sunbeam_frame::LinearImage> {
     let [w, h] = size.unwrap_or(p.scene.size);
     let k = supersample.max(1);
     let r = Renderer::new(gpu, p, settings, OFFSCREEN_FORMAT)?;
@@ -110,7 +110,7 @@ pub fn bench_headless(
     settings: &Settings,
     size: [u32; 2],
     frames: u32,
-) -> Result<(FrameTimes, sunbeam_raster::LinearImage)> {
+) -> Result<(FrameTimes, sunbeam_frame::LinearImage)> {
     let t0 = Instant::now();
     let r = Renderer::new(gpu, p, settings, OFFSCREEN_FORMAT)?;
     let target = Offscreen::new(gpu, &r, size[0], size[1])?;

@@ -4,11 +4,11 @@
 use crate::gpu::Gpu;
 use std::sync::Arc;
 use sunbeam_common::{Error, Result};
+use sunbeam_frame::spectral::Samples;
+use sunbeam_frame::{Image, LinearImage, Prepared};
 use sunbeam_optics::cie;
 use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
 use sunbeam_pack::{Basis, Model, Pack};
-use sunbeam_raster::spectral::Samples;
-use sunbeam_raster::{Image, LinearImage, Prepared};
 use sunbeam_scene::{camera, Camera, Light};
 use wgpu::util::DeviceExt;
 
@@ -27,7 +27,7 @@ pub const SHADER: &str = concat!(
 /// shaders/material.wgsl alone: the skin's functions every shader calls
 /// (`sb_fresnel`, `sb_gain`, `sb_masking`, `sb_base_transmission`, `sb_frame`);
 /// [`SHADER`] and [`crate::export::SOURCE`] begin with it, and
-/// tests/material.rs runs it in a compute pass.
+/// the root package's tests/material_wgsl.rs runs it in a compute pass.
 pub const MATERIAL_WGSL: &str = include_str!("../../../shaders/material.wgsl");
 
 /// Most lights a frame shades with.
@@ -925,10 +925,7 @@ fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 2] {
 }
 
 /// Vertex and index buffers of a mesh (one dummy element when empty).
-fn mesh_buffers(
-    device: &wgpu::Device,
-    mesh: &sunbeam_raster::Mesh,
-) -> (wgpu::Buffer, wgpu::Buffer) {
+fn mesh_buffers(device: &wgpu::Device, mesh: &sunbeam_frame::Mesh) -> (wgpu::Buffer, wgpu::Buffer) {
     let mut verts: Vec<Vertex> = (0..mesh.positions.len())
         .map(|i| Vertex {
             pos: mesh.positions[i],
@@ -1082,7 +1079,7 @@ pub fn colour_view(
 
 /// An offscreen float target with readback: frames come back in linear light
 /// (exposure applied) and go through the display transform on the CPU
-/// (`sunbeam_raster::LinearImage::display`), so that MSAA resolves average
+/// (`sunbeam_frame::LinearImage::display`), so that MSAA resolves average
 /// linear values, as a camera does.
 pub struct Offscreen {
     pub width: u32,

@@ -13,8 +13,8 @@
 
 use rayon::prelude::*;
 
+use sunbeam_frame::spectral::Samples;
 use sunbeam_pack::{kernel, series, Model, Pack};
-use sunbeam_raster::spectral::Samples;
 
 /// Table resolution.
 #[derive(Debug, Clone, Copy, PartialEq)]

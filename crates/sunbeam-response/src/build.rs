@@ -414,7 +414,7 @@ pub fn build_sets(pack: &Pack, g: &Grid, ws: &WeightSets) -> Vec<Vec<f32>> {
 
 /// [`build_sets`] with `R` (Beckmann's obliquity, no grazing term) for the
 /// window model too: the maps before PHYSICS.md 2b, for plots of `R` itself
-/// and for measuring what the grazing term costs (tests/bench_build.rs).
+/// and for measuring what the grazing term costs (benches/build.rs).
 pub fn build_sets_r(pack: &Pack, g: &Grid, ws: &WeightSets) -> Vec<Vec<f32>> {
     sets_of(pack, g, ws, None)
 }

@@ -8,9 +8,8 @@
 //!   uniforms; at a 60 degree view their converged means differ by more than
 //!   a measured bound, so the approximation cannot silently turn into the
 //!   exact estimator (or the exact one into it).
-//! - the benchmark on a sphere is tests/nvr_bench.rs (not run by `cargo
-//!   test`: `cargo test --release -p sunbeam-response --test nvr_bench --
-//!   --nocapture`), which shares this file's helpers.
+//! - the benchmark on a sphere is benches/nvr.rs (`cargo bench -p
+//!   sunbeam-response --bench nvr`), which shares this file's helpers.
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -26,7 +25,7 @@ use sunbeam_response::nvr::prefilter_nvr_sample;
 use sunbeam_response::Options;
 
 /// Sinusoidal ridges of `period` along x, `amp` peak to peak, on an `n x n`
-/// grid of `dx` (as tests/env.rs and the reference's tests build them).
+/// grid of `dx` (as the reference's tests build them: sunbeam-raster's tests/env_response.rs).
 pub(crate) fn ridges(n: usize, dx: f64, period: f64, amp: f64) -> Vec<f64> {
     (0..n * n)
         .map(|k| {
@@ -37,7 +36,7 @@ pub(crate) fn ridges(n: usize, dx: f64, period: f64, amp: f64) -> Vec<f64> {
 }
 
 /// A ridge pack of `n x n` samples at 100 nm, 1.3 um period, 0.3 um deep:
-/// `n = 32` is the 3.2 um patch of tests/env.rs and docs/LIGHTING.md "Noise".
+/// `n = 32` is the 3.2 um patch of sunbeam-raster's tests/env_response.rs and docs/LIGHTING.md "Noise".
 pub(crate) fn ridge_pack(n: usize) -> Arc<Pack> {
     let dx = 0.1e-6;
     let data = ridges(n, dx, 1.3e-6, 0.3e-6);

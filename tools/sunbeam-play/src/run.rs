@@ -5,8 +5,8 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Duration;
 use sunbeam_common::{Error, Result};
+use sunbeam_frame::{Image, LinearImage, Prepared};
 use sunbeam_optics::colour::ToneCurve;
-use sunbeam_raster::{Image, LinearImage, Prepared};
 use sunbeam_render::window::{self, WindowOptions};
 use sunbeam_render::{Backend, Gpu, Mode, Settings};
 use sunbeam_scene::Scene;
@@ -26,7 +26,7 @@ fn load_scene(cli: &Cli) -> Result<Scene> {
             }
             Scene::load(s)?
         }
-        (None, Some(m)) => sunbeam_raster::default_scene(
+        (None, Some(m)) => sunbeam_frame::default_scene(
             m,
             cli.pack.as_deref(),
             cli.lighting.parse().map_err(Error::usage)?,
@@ -132,9 +132,9 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     // beside it is read as its manifest only (the CPU renderer needs the terms,
     // and so does building the environment's maps).
     let prepared = if st.mode == Mode::Default && !cli.cpu && scene.environment.is_none() {
-        sunbeam_raster::prepare_with(&scene, &sunbeam_render::response::load_pack)?
+        sunbeam_frame::prepare_with(&scene, &sunbeam_render::response::load_pack)?
     } else {
-        sunbeam_raster::prepare(&scene)?
+        sunbeam_frame::prepare(&scene)?
     };
     let headless = cli.headless || cli.bench || cli.cpu;
     if !headless {
@@ -258,13 +258,13 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     if let Some(refp) = &cli.compare {
         let d = if is_exr(refp) {
             let reference = LinearImage::read_exr(refp)?;
-            sunbeam_raster::compare_linear(&image, &reference)
+            sunbeam_frame::compare_linear(&image, &reference)
                 .map_err(|e| e.context(refp.display()))?
         } else {
             let reference = Image::read_png(refp)?;
             let disp = image.display(st.curve);
             let q = Image::from_rgba8(disp.width, disp.height, &disp.to_rgba8());
-            sunbeam_raster::compare(&q, &reference).map_err(|e| e.context(refp.display()))?
+            sunbeam_frame::compare(&q, &reference).map_err(|e| e.context(refp.display()))?
         };
         report["ciede2000"] = serde_json::json!({"mean": d.mean, "p99": d.p99, "max": d.max});
         if !cli.json && !cli.quiet {

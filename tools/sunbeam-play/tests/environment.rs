@@ -8,8 +8,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Arc;
+use sunbeam_frame::LinearImage;
 use sunbeam_pack::{build::BuildOptions, FieldRef, Model, Pack};
-use sunbeam_raster::LinearImage;
 
 const BIN: &str = env!("CARGO_BIN_EXE_sunbeam-play");
 
@@ -89,7 +89,7 @@ fn reference(scene: &Path, samples: u32, seeds: &[u64], out: &Path) -> LinearIma
             .unwrap()
         })
         .collect();
-    let a = sunbeam_raster::linear::mean_of(&frames).unwrap();
+    let a = sunbeam_frame::linear::mean_of(&frames).unwrap();
     a.write_exr(out).unwrap();
     a
 }
@@ -180,7 +180,7 @@ fn sky_lit_sphere(masking: &str) {
     let frame = LinearImage::read_exr(&dir.join("f.exr")).unwrap();
     let reference = LinearImage::read_exr(&refp).unwrap();
     let blocks =
-        sunbeam_raster::compare_linear(&frame.downsample(4), &reference.downsample(4)).unwrap();
+        sunbeam_frame::compare_linear(&frame.downsample(4), &reference.downsample(4)).unwrap();
     eprintln!("4 x 4 blocks: {blocks}");
     assert!(blocks.p99 < BLOCKS_P99, "{blocks}");
 }
@@ -387,7 +387,7 @@ fn window_shades_the_sky() {
         log.contains("built the environment's response maps"),
         "{log}"
     );
-    let img = sunbeam_raster::Image::read_png(&shot)
+    let img = sunbeam_frame::Image::read_png(&shot)
         .unwrap_or_else(|e| panic!("no screenshot ({e}): {log}"));
     let (mean, sd) = img.mean_sd();
     eprintln!(

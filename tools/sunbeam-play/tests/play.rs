@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use sunbeam_raster::{fixtures, Image};
+use sunbeam_frame::{fixtures, Image};
 
 const BIN: &str = env!("CARGO_BIN_EXE_sunbeam-play");
 

@@ -1,14 +1,16 @@
 //! Frame-time benchmark (not a timed test): the default (response table), direct,
 //! thesis and Lambert shaders in the same run, each with its colour error against
-//! the CPU reference. `cargo bench -p sunbeam-render --bench play` (release).
+//! the CPU reference. `cargo bench -p sunbeam --bench play` (release; the root package's: it
+//! needs the player and the reference).
 //! Environment: PLAY_BENCH_SIZE (512), PLAY_BENCH_ERR_SIZE (256), PLAY_BENCH_FRAMES (5),
 //! PLAY_BENCH_SCENES (sphere,snake,quad), PLAY_BENCH_MODES (default,thesis,lambert,direct).
 
 use std::sync::Arc;
 use std::time::Instant;
+use sunbeam_frame::{fixtures, Prepared};
 use sunbeam_pack::build::BuildOptions;
 use sunbeam_pack::{Basis, Model};
-use sunbeam_raster::{fixtures, Options, Prepared};
+use sunbeam_raster::Options;
 use sunbeam_render::{Gpu, Mode, Settings};
 
 fn env_u32(k: &str, d: u32) -> u32 {
@@ -83,7 +85,7 @@ fn main() {
             let small =
                 sunbeam_render::render_headless(&gpu, p, &st, Some([err_size, err_size]), 1)
                     .unwrap();
-            let d = sunbeam_raster::compare(&small, &reference).unwrap();
+            let d = sunbeam_frame::compare(&small, &reference).unwrap();
             let med = times.median_ms();
             if mode == Mode::Thesis {
                 thesis_ms = Some(med);

@@ -1,7 +1,7 @@
-//! Build time of the extended-light maps against the point map (a benchmark,
-//! not run by `cargo test`: `test = false` in Cargo.toml):
+//! Build time of the extended-light maps against the point map (a benchmark
+//! that prints):
 //!
-//!     cargo test --release -p sunbeam-response --test bench_build -- --nocapture
+//!     cargo bench -p sunbeam-response --bench build
 
 use sunbeam_light::{sky::Sky, Environment};
 use sunbeam_pack::build::{BuildOptions, FieldRef};
@@ -18,8 +18,7 @@ fn sky() -> Environment {
 /// grazing term costs: the same point map and weight sets built with `R`
 /// (`build::build_sets_r`, the maps before PHYSICS.md 2b) against `R_U`
 /// (`build::build_sets`, what the maps hold), each the best of three.
-#[test]
-fn build_time_demo_pack() {
+fn main() {
     use sunbeam_response::build::{auto_grid, build_sets, build_sets_r, wavelength_weights};
     use sunbeam_response::env::env_weights;
     let f = sunbeam_synth::preset("xenopeltis", 256, 25e-9).unwrap();

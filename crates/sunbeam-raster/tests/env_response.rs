@@ -4,7 +4,8 @@
 //! inside the disc integrates to the light's luminance), quadrature of the
 //! proposal's density and a histogram of its samples, and the reference
 //! renderer's Monte Carlo estimator (`sunbeam_raster::environment::EnvShader`,
-//! the pack's own `R`, no map) at one shading point.
+//! the pack's own `R`, no map) at one shading point. With the reference
+//! (above both crates it compares), not in sunbeam-response.
 
 use std::f64::consts::PI;
 use std::sync::{Arc, OnceLock};

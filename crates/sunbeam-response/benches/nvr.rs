@@ -2,29 +2,22 @@
 //! (docs/bench/prefilter.md): a sky-lit and a white-lit sphere, per pixel the
 //! converged exact twin, a second seed of it (the noise floor) and the
 //! converged `n = v = r` twin; CIEDE2000 as `sunbeam-eval render --compare`
-//! computes it. Prints markdown tables. A benchmark, not run by `cargo test`
-//! (`test = false` in Cargo.toml):
+//! computes it. Prints markdown tables. A benchmark:
 //!
-//!     cargo test --release -p sunbeam-response --test nvr_bench -- --nocapture
+//!     cargo bench -p sunbeam-response --bench nvr
 //!
 //! The helpers (packs, environments, the per-pixel means) are tests/nvr.rs'.
 
-#[path = "nvr.rs"]
-#[allow(dead_code)]
+#[path = "../tests/nvr.rs"]
+#[allow(dead_code, unused_imports)]
 mod nvr;
 
 use nvr::*;
 use rayon::prelude::*;
-use std::f64::consts::PI;
-use std::sync::Arc;
-use sunbeam_common::rng::SplitMix64;
-use sunbeam_light::{sky::Sky, EnvMap, Environment};
+use sunbeam_frame::linear::{compare_linear, luminance, LinearImage, LIT_Y};
+use sunbeam_light::Environment;
 use sunbeam_optics::colour;
-use sunbeam_pack::build::{BuildOptions, FieldRef};
-use sunbeam_pack::Pack;
-use sunbeam_raster::linear::{compare_linear, luminance, LinearImage, LIT_Y};
 use sunbeam_response::env::{build_env, EnvResponse, Frame};
-use sunbeam_response::nvr::prefilter_nvr_sample;
 use sunbeam_response::Options;
 
 /// One pixel's three estimates (linear sRGB, exposure applied) and its view
@@ -39,8 +32,8 @@ struct Pixel {
 /// A sphere seen by an orthographic camera along -z (`size x size` pixels
 /// over `[-1, 1]^2`, y up), normal `(x, y, sqrt(1 - x^2 - y^2))`, tangent
 /// eastwards along the latitude as `builtin:sphere` (`t = cross(+y, n)`,
-/// `sunbeam_raster::shade::frame`), view `+z`. Unlit (background) pixels are
-/// None.
+/// perpendicular to `n`, so the reference's shading frame is `(t, n x t, n)`
+/// normalised), view `+z`. Unlit (background) pixels are None.
 fn sphere(
     e: &EnvResponse,
     env: &Environment,
@@ -59,7 +52,7 @@ fn sphere(
                 return None;
             }
             let nrm = [x, y, (1.0 - r2).sqrt()];
-            let f = sunbeam_raster::shade::frame(nrm, [nrm[2], 0.0, -nrm[0]])?;
+            let f = frame(nrm);
             let v = [0.0, 0.0, 1.0];
             let dot = |a: [f64; 3]| a[0] * v[0] + a[1] * v[1] + a[2] * v[2];
             let wr = [dot(f.0), dot(f.1), dot(f.2)];
@@ -75,6 +68,23 @@ fn sphere(
             })
         })
         .collect()
+}
+
+/// The frame `(t, b, n)` of the unit sphere's normal `nrm`: `t = cross(+y, n)`
+/// normalised, `b = n x t`.
+fn frame(nrm: [f64; 3]) -> Frame {
+    let unit = |a: [f64; 3]| {
+        let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        a.map(|x| x / l)
+    };
+    let n = unit(nrm);
+    let t = unit([n[2], 0.0, -n[0]]);
+    let b = [
+        n[1] * t[2] - n[2] * t[1],
+        n[2] * t[0] - n[0] * t[2],
+        n[0] * t[1] - n[1] * t[0],
+    ];
+    (t, b, n)
 }
 
 fn image(px: &[Option<Pixel>], size: usize, pick: fn(&Pixel) -> [f32; 3]) -> LinearImage {
@@ -93,8 +103,7 @@ fn image(px: &[Option<Pixel>], size: usize, pick: fn(&Pixel) -> [f32; 3]) -> Lin
 /// per pixel and estimator (default 4096), exposure -1.5 EV as
 /// docs/bench/lighting.sh. CIEDE2000 over the pixels lit in the exact twin
 /// (`Y >= LIT_Y`), as `compare_linear`; per view-angle band too.
-#[test]
-fn nvr_sphere_benchmark() {
+fn main() {
     let n: usize = std::env::var("SUNBEAM_NVR_SAMPLES")
         .ok()
         .and_then(|s| s.parse().ok())

@@ -1,11 +1,12 @@
-//! Measurement, not a check (`test = false` in Cargo.toml: `cargo test` does not run it): the environment estimator's noise at
+//! A measurement that prints, not a check: the environment estimator's noise at
 //! single shading points (docs/LIGHTING.md "Noise"). For a pack (the ridge
 //! field below, or `SUNBEAM_PACK=path.ktx2`), a few views under a constant
 //! white map and under the sky, it prints the mean Y, one sample's relative
 //! standard deviation of Y, and the relative standard deviation of X, Y, Z
 //! of a 256-sample pixel (wavelengths stratified as in the renderer) over 48
 //! pixels.
-//!   cargo test --release -p sunbeam-raster --test env_noise -- --nocapture
+//!   cargo bench -p sunbeam-raster --bench env_noise [-- NAME...]
+//! runs every measurement, or those whose names contain a NAME.
 //! `THETAS=85,89` picks the views; `FIXED_LAMBDA=0.37` holds the wavelengths
 //! constant (the spectral share of the noise); `lobe_technique_alone`,
 //! `r_inside_bins` and `worst_pixels` (`A=a.exr B=b.exr`) dissect the rest;
@@ -40,7 +41,6 @@ fn ridge_pack() -> Arc<Pack> {
     Arc::new(sunbeam_pack::build(f, &BuildOptions::default(), &mut |_, _| {}).unwrap())
 }
 
-#[test]
 fn noise_at_shading_points() {
     let pack = match std::env::var("SUNBEAM_PACK") {
         Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
@@ -112,7 +112,6 @@ fn noise_at_shading_points() {
 /// The lobe technique alone at one wavelength: one sample's relative standard
 /// deviation of `f / p` (the proposal's mismatch with the integrand), and the
 /// share of the second moment held by the largest 1 % of the weights.
-#[test]
 fn lobe_technique_alone() {
     let pack = match std::env::var("SUNBEAM_PACK") {
         Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
@@ -170,7 +169,6 @@ fn lobe_technique_alone() {
 
 /// How much R varies inside a bin: points uniform in bins drawn by their
 /// centre's R, the relative sd of R(point) / R(centre) (at fixed w = -2).
-#[test]
 fn r_inside_bins() {
     let pack = match std::env::var("SUNBEAM_PACK") {
         Ok(p) => Arc::new(Pack::read(std::path::Path::new(&p)).unwrap()),
@@ -218,7 +216,6 @@ fn th_list() -> Vec<(f64, f64)> {
 /// The largest CIEDE2000 differences between two frames `A` and `B` (EXR;
 /// over the pixels lit in `B`: give the reference as `B`), with their pixels
 /// and luminances.
-#[test]
 fn worst_pixels() {
     use sunbeam_raster::LinearImage;
     let a = LinearImage::read_exr(std::path::Path::new(&std::env::var("A").unwrap())).unwrap();
@@ -341,7 +338,6 @@ fn worst_pixels() {
 /// required, masked with the demo's slopes): the quadrature against Monte
 /// Carlo (`M` samples, default 20 000), per `cos(theta_r)` down to 1e-4
 /// (docs/LIGHTING.md "Grazing views: masking").
-#[test]
 fn grazing_views() {
     let pack = Arc::new(
         Pack::read(std::path::Path::new(
@@ -395,7 +391,6 @@ fn grazing_views() {
 /// 1, as a direct sum of `G G2 R_U A / lambda^2` over the hemisphere with `R_U`
 /// from the pack (`Pack::shading_reflectance`) (`NC` x `NPHI` cells, cubic in `cos(theta_i)`), split by
 /// `cos(theta_i)` bands: which directions hold a grazing view's light.
-#[test]
 fn grazing_band_sum() {
     let pack = Pack::read(std::path::Path::new(
         &std::env::var("SUNBEAM_PACK").unwrap(),
@@ -464,7 +459,6 @@ fn grazing_band_sum() {
 
 /// The mean of frames `A` and `B` (EXR, linear light) written to `OUT`: the
 /// mean of two seeds' references without rendering them again.
-#[test]
 fn mean_frames() {
     use sunbeam_raster::LinearImage;
     let read =
@@ -473,4 +467,36 @@ fn mean_frames() {
         .unwrap()
         .write_exr(std::path::Path::new(&std::env::var("OUT").unwrap()))
         .unwrap();
+}
+
+/// Runs the measurements named on the command line (parts of names; none:
+/// all, those that read frames (`A=.. B=..`) only when `A` is set). Options
+/// (`--bench`, given by `cargo bench`) are ignored.
+fn main() {
+    let names: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    let frames = std::env::var_os("A").is_some();
+    // (name, measurement, reads the frames A and B)
+    let all: [(&str, fn(), bool); 7] = [
+        ("noise_at_shading_points", noise_at_shading_points, false),
+        ("lobe_technique_alone", lobe_technique_alone, false),
+        ("r_inside_bins", r_inside_bins, false),
+        ("worst_pixels", worst_pixels, true),
+        ("grazing_views", grazing_views, false),
+        ("grazing_band_sum", grazing_band_sum, false),
+        ("mean_frames", mean_frames, true),
+    ];
+    for (name, f, reads) in all {
+        let picked = if names.is_empty() {
+            !reads || frames
+        } else {
+            names.iter().any(|n| name.contains(n.as_str()))
+        };
+        if picked {
+            println!("## {name}");
+            f();
+        }
+    }
 }

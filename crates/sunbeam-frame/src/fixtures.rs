@@ -135,7 +135,7 @@ pub fn prepared(scene: Scene, mesh: Mesh, pack: Option<Arc<Pack>>) -> Prepared {
         meshes: vec![(Arc::new(mesh), mat)],
         scene,
         environment: None,
-        env_cache: Default::default(),
+        cache: Default::default(),
     }
 }
 

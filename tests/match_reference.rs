@@ -2,32 +2,16 @@
 //! mean CIEDE2000 < 0.5 and 99th percentile < 2 (issue 6). Runs on Mesa lavapipe
 //! in CI; without an adapter the tests skip, or fail under SUNBEAM_REQUIRE_ALL=1.
 
+mod gpu;
+
+use gpu::gpu;
 use std::path::PathBuf;
 use std::sync::Arc;
-use sunbeam_raster::{fixtures, Image, Options, Prepared};
+use sunbeam_frame::{fixtures, Image, Prepared};
+use sunbeam_raster::Options;
 use sunbeam_render::{Gpu, Mode, Settings};
 
 const SIZE: [u32; 2] = [128, 128];
-
-fn gpu() -> Option<Gpu> {
-    let backend = std::env::var("SUNBEAM_TEST_BACKEND")
-        .ok()
-        .and_then(|b| b.parse().ok())
-        .unwrap_or_default();
-    match Gpu::headless(backend) {
-        Ok(g) => {
-            eprintln!("adapter: {}", g.describe());
-            Some(g)
-        }
-        Err(e) => {
-            if sunbeam_common::testdata::require_all() {
-                panic!("{e} (SUNBEAM_REQUIRE_ALL=1: CI needs a GPU adapter; scripts/ensure-deps.sh installs lavapipe)");
-            }
-            eprintln!("SKIP: {e}");
-            None
-        }
-    }
-}
 
 fn data_dir() -> Option<PathBuf> {
     sunbeam_common::testdata::shared_file("snake/BlazingBump.bmp")
@@ -69,7 +53,7 @@ fn check_with(name: &str, gpu: &Gpu, p: &Prepared, st: &Settings, mean_max: f64,
     frame
         .write_png(&dir.join(format!("{name}-gpu.png")))
         .unwrap();
-    let d = sunbeam_raster::compare(&frame, &reference).unwrap();
+    let d = sunbeam_frame::compare(&frame, &reference).unwrap();
     let (mean, sd) = reference.mean_sd();
     eprintln!("{name}: {d} (cpu {t_cpu:.2?}, gpu {t_gpu:.2?}; reference mean {mean:.3} sd {sd:.3}; frames in {})", dir.display());
     assert!(
@@ -94,7 +78,7 @@ fn absolute_exposure() -> f64 {
 
 fn with_pack(
     patch: &fixtures::Patch,
-    mut scene: (sunbeam_scene::Scene, sunbeam_raster::Mesh),
+    mut scene: (sunbeam_scene::Scene, sunbeam_frame::Mesh),
 ) -> Option<Prepared> {
     let dir = data_dir()?;
     scene.0.exposure += absolute_exposure();
@@ -175,7 +159,7 @@ fn masked_snake_matches_reference() {
     let unmasked = sunbeam_raster::render_prepared(&p, &Options::default());
     p.meshes[0].1.masking = sunbeam_optics::masking::Masking::smith(slope);
     let masked = sunbeam_raster::render_prepared(&p, &Options::default());
-    let d = sunbeam_raster::compare(&masked, &unmasked).unwrap();
+    let d = sunbeam_frame::compare(&masked, &unmasked).unwrap();
     eprintln!("masked vs unmasked reference: {d}");
     assert!(d.max > 8.0, "masking changed nothing visible: {d}");
     check("snake-xeno-masked", &gpu, &p, 0.5, 2.0);
@@ -199,7 +183,7 @@ fn relative_reflectance_and_index_match_reference() {
     // relative: back to the fixture's own exposure
     p.scene.exposure -= absolute_exposure();
     let other = sunbeam_raster::render_prepared(&p, &Options::default());
-    let d = sunbeam_raster::compare(&other, &default).unwrap();
+    let d = sunbeam_frame::compare(&other, &default).unwrap();
     eprintln!("ior 1.33 relative vs the default skin (reference): {d}");
     assert!(d.max > 2.0, "the skin changed nothing visible: {d}");
     check("sphere-elaphe-relative", &gpu, &p, 0.5, 2.0);
@@ -217,7 +201,7 @@ fn lambert_mode_is_the_closed_form() {
     };
     let frame: Image = sunbeam_render::render_headless(&gpu, &p, &st, None, 1).unwrap();
     let reference = sunbeam_raster::render_prepared(&p, &Options::default());
-    let d = sunbeam_raster::compare(&frame, &reference).unwrap();
+    let d = sunbeam_frame::compare(&frame, &reference).unwrap();
     assert!(d.max < 0.05, "{d}");
 }
 
@@ -238,7 +222,7 @@ fn response_map_at_scale(name: &str, n: usize, pixel: f64) {
         data: &f.data,
     };
     let pack = sunbeam_pack::build::build(fr, &Default::default(), &mut |_, _| {}).unwrap();
-    let mesh = sunbeam_raster::Mesh::uv_sphere(96, 48);
+    let mesh = sunbeam_frame::Mesh::uv_sphere(96, 48);
     let mut scene = sunbeam_scene::Scene::default_lit(
         "builtin:sphere".into(),
         Some("pack".into()),
@@ -277,8 +261,8 @@ fn response_map_at_scale(name: &str, n: usize, pixel: f64) {
         .write_exr(&dir.join(format!("{name}-ref.exr")))
         .unwrap();
     aa.write_exr(&dir.join(format!("{name}-aa.exr"))).unwrap();
-    let d_aa = sunbeam_raster::compare_linear(&aa, &reference).unwrap();
-    let d_one = sunbeam_raster::compare_linear(&one, &reference).unwrap();
+    let d_aa = sunbeam_frame::compare_linear(&aa, &reference).unwrap();
+    let d_one = sunbeam_frame::compare_linear(&one, &reference).unwrap();
     eprintln!("{name}: anti-aliased {d_aa}; 1x {d_one} (reference {t_cpu:.2?})");
     assert!(
         d_aa.pixels > 48 * 48 / 2,
@@ -316,6 +300,6 @@ fn background_matches_reference() {
     let frame: Image =
         sunbeam_render::render_headless(&gpu, &p, &Settings::default(), None, 1).unwrap();
     let reference = sunbeam_raster::render_prepared(&p, &Options::default());
-    let d = sunbeam_raster::compare(&frame, &reference).unwrap();
+    let d = sunbeam_frame::compare(&frame, &reference).unwrap();
     assert!(d.max < 0.5, "background: {d}");
 }
