@@ -1,0 +1,70 @@
+//! Sky and map lighting in the player (docs/PLAY.md "Environment"): which
+//! modes shade a scene's environment, and the extended-light maps of each
+//! pack under it (sunbeam-response's `build_env`, uploaded by
+//! [`crate::env::EnvMaps`]). The progressive estimator itself is
+//! [`crate::env`] and shaders/environment.wgsl.
+
+use super::Mode;
+use std::sync::Arc;
+use sunbeam_common::{Error, Result};
+use sunbeam_frame::Prepared;
+use sunbeam_light::Environment;
+use sunbeam_pack::Pack;
+
+/// The environment a mode shades: the scene's in the default mode, none for
+/// the Lambert baseline; the other baselines refuse a scene with one.
+pub(super) fn of_scene(p: &Prepared, mode: Mode) -> Result<Option<Arc<Environment>>> {
+    Ok(match mode {
+        Mode::Default => p.environment.clone(),
+        Mode::Lambert => None,
+        m => {
+            if p.environment.is_some() {
+                return Err(Error::usage(format!(
+                    "environment: the player shades sky and map lighting in the default mode only (not --mode {})",
+                    format!("{m:?}").to_lowercase()
+                )));
+            }
+            None
+        }
+    })
+}
+
+/// The environment's maps already built, per pack (the same `Arc`).
+pub(super) type BuiltMaps = Vec<(*const Pack, Arc<crate::env::EnvMaps>)>;
+
+/// The extended-light maps of `pack` (meshes[`mi`]) under `env`, built once
+/// per pack (`built`); what the build took goes to `notes`.
+pub(super) fn maps(
+    gpu: &crate::gpu::Gpu,
+    env: &Environment,
+    pack: &Arc<Pack>,
+    mi: usize,
+    opts: &sunbeam_response::Options,
+    built: &mut BuiltMaps,
+    notes: &mut Vec<String>,
+) -> Result<Arc<crate::env::EnvMaps>> {
+    let key = Arc::as_ptr(pack);
+    if let Some((_, m)) = built.iter().find(|(k, _)| *k == key) {
+        return Ok(m.clone());
+    }
+    if !pack.has_terms() {
+        return Err(Error::internal(format!(
+            "meshes[{mi}].pack: the environment's maps need the pack's terms (read it whole)"
+        )));
+    }
+    let t0 = std::time::Instant::now();
+    let er = sunbeam_response::env::build_env(pack, env, opts);
+    notes.push(format!(
+        "built the environment's response maps for meshes[{mi}].pack ({} x {} x {} texels, {} maps, \
+         {} pyramid levels) in {:.2} s",
+        er.grid.n_theta,
+        er.grid.n_rho,
+        er.grid.n_s,
+        er.basis.len() + usize::from(er.sun.is_some()),
+        er.proposal.offsets.len(),
+        t0.elapsed().as_secs_f64()
+    ));
+    let m = Arc::new(crate::env::EnvMaps::new(gpu, &er)?);
+    built.push((key, m.clone()));
+    Ok(m)
+}

@@ -1,0 +1,608 @@
+//! The diffraction renderer: buffers for meshes and packs, the pipeline of
+//! shaders/diffraction.wgsl, drawing into any colour target, and headless frames.
+//!
+//! One pipeline and one material uniform serve every [`Mode`] (the WGSL
+//! branches on the mode); what each technique uploads is its own module:
+//!
+//! - [`response_map`]: the default mode's point-light response map;
+//! - [`environment`]: sky and map lighting (the default mode's extended-light maps);
+//! - [`baselines`]: the modes the default is measured against (table,
+//!   direct, thesis, Lambert);
+//!
+//! and the shared parts: [`uniforms`] (the uniform structs, checked against
+//! the WGSL), [`pipeline`] (layouts, buffers, the render pipeline),
+//! [`targets`] (depth, colour and offscreen targets, readback).
+
+pub mod baselines;
+pub mod environment;
+pub mod pipeline;
+pub mod response_map;
+pub mod targets;
+pub mod uniforms;
+
+pub use targets::{
+    colour_view, depth_view, depth_view_ms, subpixel_jitter, Offscreen, OFFSCREEN_FORMAT,
+};
+pub use uniforms::term_table;
+
+use crate::gpu::Gpu;
+use pipeline::{bind_group_layouts, dummy_texture, mesh_buffers, render_pipeline};
+use std::sync::Arc;
+use sunbeam_common::{Error, Result};
+use sunbeam_frame::Prepared;
+use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
+use sunbeam_scene::{camera, Camera, Light};
+use uniforms::{pack_uniforms, spectral_samples, spectrum_table, Globals, MaterialU};
+use wgpu::util::DeviceExt;
+
+/// The WGSL source: the skin's material functions (shaders/material.wgsl:
+/// Fresnel, G, masking, the diffuse base's share, the frame), the response-map
+/// material (shaders/response_map.wgsl; both also what `--export-shader`
+/// translates), the player's shading (shaders/diffraction.wgsl) and the
+/// environment's estimator (shaders/environment.wgsl).
+pub const SHADER: &str = concat!(
+    include_str!("../../../../shaders/material.wgsl"),
+    include_str!("../../../../shaders/response_map.wgsl"),
+    include_str!("../../../../shaders/diffraction.wgsl"),
+    include_str!("../../../../shaders/environment.wgsl")
+);
+
+/// shaders/material.wgsl alone: the skin's functions every shader calls
+/// (`sb_fresnel`, `sb_gain`, `sb_masking`, `sb_base_transmission`, `sb_frame`);
+/// [`SHADER`] and [`crate::export::SOURCE`] begin with it, and
+/// the root package's tests/material_wgsl.rs runs it in a compute pass.
+pub const MATERIAL_WGSL: &str = include_str!("../../../../shaders/material.wgsl");
+
+/// Most lights a frame shades with.
+pub const MAX_LIGHTS: usize = 4;
+/// Most series terms the shader evaluates (packs with more are cut, with a warning).
+pub const MAX_TERMS: usize = 64;
+/// Most kernel taps per axis the shader supports.
+pub const MAX_TAPS: usize = 16;
+/// Entries of the per-|t| term-count table.
+pub const TERM_TABLE: usize = 256;
+/// Term count of the thesis mode.
+pub const THESIS_TERMS: u32 = 39;
+
+/// Which shading the pipeline does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    /// PHYSICS.md 2 through the pack's response map (sunbeam-response: built by
+    /// `sunbeam-pack --response`, loaded; polar grid, filtered over the pixel footprint).
+    #[default]
+    Default,
+    /// The former default: a Cartesian 256 x 256 x 32 table over (u, v, w) built on
+    /// the CPU at load (crate::table). Kept as the benchmark baseline.
+    Table,
+    /// PHYSICS.md 2 summed per fragment (terms, taps, wavelengths), no table.
+    Direct,
+    /// The thesis' shader: fixed 39 terms, 5 nm steps, nearest bin.
+    Thesis,
+    /// Plain Lambert with the base colour (benchmark baseline).
+    Lambert,
+}
+
+impl std::str::FromStr for Mode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "default" | "response" => Ok(Mode::Default),
+            "table" => Ok(Mode::Table),
+            "direct" => Ok(Mode::Direct),
+            "thesis" => Ok(Mode::Thesis),
+            "lambert" => Ok(Mode::Lambert),
+            _ => Err(Error::usage(format!(
+                "unknown mode '{s}' (default, table, direct, thesis, lambert)"
+            ))),
+        }
+    }
+}
+
+/// Renderer settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    pub mode: Mode,
+    /// Wavelength samples of the default mode (midpoints over 380..780 nm).
+    pub lambda_samples: usize,
+    pub curve: ToneCurve,
+    /// Bound on |dR| from truncating the series per fragment (None: the pack's own
+    /// tolerance or series bound, whichever is larger).
+    pub term_tolerance: Option<f64>,
+    /// Response table resolution of the table mode.
+    pub table: crate::table::Dims,
+    /// How the default mode builds a response map when none is beside the pack.
+    pub response: sunbeam_response::Options,
+    /// Multisample count of the colour target (1 or 4): anti-aliased silhouettes.
+    pub msaa: u32,
+    /// Default mode: average the response over the pixel's footprint (up to 4 x 4
+    /// samples) instead of reading it at the pixel centre.
+    pub footprint: bool,
+    /// Environment: proposal samples per pixel per frame (crate::env).
+    pub env_samples: u32,
+}
+
+/// Default wavelength sample count (docs/PLAY.md: chosen by measurement).
+pub const DEFAULT_LAMBDA_SAMPLES: usize = 48;
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            mode: Mode::Default,
+            lambda_samples: DEFAULT_LAMBDA_SAMPLES,
+            curve: ToneCurve::default(),
+            term_tolerance: None,
+            table: Default::default(),
+            response: Default::default(),
+            msaa: 4,
+            footprint: true,
+            env_samples: crate::env::DEFAULT_ENV_SAMPLES,
+        }
+    }
+}
+
+/// What can change between frames (the window's orbit camera, light, exposure).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameState {
+    pub camera: Camera,
+    pub lights: Vec<Light>,
+    pub exposure: f64,
+    pub background: [f64; 3],
+}
+
+impl FrameState {
+    pub fn from_scene(p: &Prepared) -> FrameState {
+        FrameState {
+            camera: p.scene.camera.clone(),
+            lights: p.scene.lights.clone(),
+            exposure: p.scene.exposure,
+            background: p.scene.background,
+        }
+    }
+}
+
+/// The renderer of one prepared scene.
+pub struct Renderer {
+    pipeline: wgpu::RenderPipeline,
+    globals: wgpu::Buffer,
+    global_bind: wgpu::BindGroup,
+    meshes: Vec<GpuMesh>,
+    settings: Settings,
+    n_lambda: u32,
+    env: crate::env::EnvScene,
+    /// Colour target format the pipeline writes.
+    pub format: wgpu::TextureFormat,
+    /// Notes for the user (packs cut to MAX_TERMS, ...).
+    pub warnings: Vec<String>,
+    /// What start-up did that took time (environment maps built, ...).
+    pub notes: Vec<String>,
+}
+
+/// Depth format of every pass.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// One mesh on the GPU: its buffers and bind groups.
+struct GpuMesh {
+    vbuf: wgpu::Buffer,
+    ibuf: wgpu::Buffer,
+    count: u32,
+    bind: wgpu::BindGroup,
+    /// Bind group 2: the environment (this mesh's pack's maps, or stand-ins).
+    env_bind: wgpu::BindGroup,
+}
+
+impl Renderer {
+    pub fn new(
+        gpu: &Gpu,
+        p: &Prepared,
+        settings: &Settings,
+        format: wgpu::TextureFormat,
+    ) -> Result<Renderer> {
+        let device = &gpu.device;
+        let mut warnings = Vec::new();
+        let samples = spectral_samples(settings);
+        let spec = spectrum_table(&samples);
+        let lambda_min = samples
+            .0
+            .iter()
+            .map(|s| s.lambda_m)
+            .fold(f64::INFINITY, f64::min);
+        let spectrum = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("spectrum"),
+            contents: bytemuck::cast_slice(&spec),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let globals = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("globals"),
+            size: std::mem::size_of::<Globals>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let [gl0, gl1] = bind_group_layouts(device);
+        // The environment (docs/PLAY.md "Environment"): the default mode shades
+        // it progressively; the Lambert baseline ignores it.
+        let environment = environment::of_scene(p, settings.mode)?;
+        let env_scene = crate::env::EnvScene::new(gpu, environment.clone(), settings.env_samples);
+        let mut notes = Vec::new();
+        let mut env_maps: environment::BuiltMaps = Vec::new();
+        // Response maps: angle repeats, radius and s clamp, trilinear.
+        let resp_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("response map"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let dummy_view = Arc::new(dummy_texture(gpu));
+        let mut resp_views: Vec<(Arc<sunbeam_response::Response>, Arc<wgpu::TextureView>)> =
+            Vec::new();
+        let global_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("globals"),
+            layout: &gl0,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: globals.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: spectrum.as_entire_binding(),
+                },
+            ],
+        });
+
+        // Packs: one terms buffer per distinct pack.
+        let mut pack_bufs: baselines::TermBuffers = Vec::new();
+        let mut meshes = Vec::new();
+        for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
+            let (vbuf, ibuf) = mesh_buffers(device, mesh);
+            let mut mu = MaterialU {
+                base: [
+                    mat.base_color[0] as f32,
+                    mat.base_color[1] as f32,
+                    mat.base_color[2] as f32,
+                    mat.diffuse_weight as f32,
+                ],
+                n_table: 1,
+                table_dt: 1.0,
+                mask_sx: mat.masking.rms_slope()[0] as f32,
+                mask_sy: mat.masking.rms_slope()[1] as f32,
+                ior: mat.skin.ior as f32,
+                norm: mat.skin.norm() as f32,
+                ..Default::default()
+            };
+            let mut response: Option<Vec<[f32; 4]>> = None;
+            let mut resp_map: Option<Arc<sunbeam_response::Response>> = None;
+            let (terms_buf, table): (Arc<wgpu::Buffer>, Vec<u32>) = match &mat.pack {
+                Some(pack) if settings.mode != Mode::Lambert => {
+                    let m = &pack.manifest;
+                    if m.kernel.taps > MAX_TAPS {
+                        return Err(Error::input(format!(
+                            "meshes[{mi}].pack: kernel has {} taps, the player supports up to {MAX_TAPS}",
+                            m.kernel.taps
+                        )));
+                    }
+                    let used = m.terms.min(MAX_TERMS);
+                    if m.terms > MAX_TERMS {
+                        warnings.push(format!(
+                            "meshes[{mi}].pack has {} terms; the player uses the first {MAX_TERMS}",
+                            m.terms
+                        ));
+                    }
+                    let buf = baselines::terms_buffer(
+                        device,
+                        pack,
+                        used,
+                        settings.mode,
+                        mi,
+                        &mut pack_bufs,
+                    )?;
+                    let (table, dt) = pack_uniforms(&mut mu, pack, used, settings, lambda_min);
+                    // The point map serves point lights only: an environment scene
+                    // without any needs just the environment's maps (built below).
+                    let point_lit = environment.is_none() || !p.scene.lights.is_empty();
+                    if settings.mode == Mode::Default && point_lit {
+                        let path = p.scene.meshes.get(mi).and_then(|m| m.pack.as_deref());
+                        resp_map = Some(response_map::point_map(
+                            pack,
+                            path,
+                            settings,
+                            &mut mu,
+                            &mut warnings,
+                        )?);
+                    }
+                    if settings.mode == Mode::Table {
+                        response = Some(baselines::response_table(
+                            pack, &samples, settings, &table, dt, mi, device, &mut mu,
+                        )?);
+                    }
+                    (buf, table)
+                }
+                _ => (
+                    Arc::new(
+                        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                            label: Some("no terms"),
+                            contents: bytemuck::cast_slice(&[0.0f32; 4]),
+                            usage: wgpu::BufferUsages::STORAGE,
+                        }),
+                    ),
+                    vec![1u32],
+                ),
+            };
+            let mbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("material"),
+                contents: bytemuck::bytes_of(&mu),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let tbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("term table"),
+                contents: bytemuck::cast_slice(&table),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let rdata = response.unwrap_or_else(|| vec![[0.0f32; 4]]);
+            let rbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("response table"),
+                contents: bytemuck::cast_slice(&rdata),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let resp_view = match &resp_map {
+                Some(r) => resp_views
+                    .iter()
+                    .find(|(k, _)| Arc::ptr_eq(k, r))
+                    .map(|(_, v)| v.clone())
+                    .unwrap_or_else(|| {
+                        let v = Arc::new(crate::response::response_texture(gpu, r));
+                        resp_views.push((r.clone(), v.clone()));
+                        v
+                    }),
+                None => dummy_view.clone(),
+            };
+            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("material"),
+                layout: &gl1,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: mbuf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: terms_buf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: tbuf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: rbuf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: wgpu::BindingResource::TextureView(&resp_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: wgpu::BindingResource::Sampler(&resp_sampler),
+                    },
+                ],
+            });
+            let maps = match (&environment, &mat.pack) {
+                (Some(env), Some(pack)) => Some(environment::maps(
+                    gpu,
+                    env,
+                    pack,
+                    mi,
+                    &settings.response,
+                    &mut env_maps,
+                    &mut notes,
+                )?),
+                _ => None,
+            };
+            let env_bind = env_scene.bind(gpu, maps.as_deref());
+            meshes.push(GpuMesh {
+                vbuf,
+                ibuf,
+                count: mesh.indices.len() as u32,
+                bind,
+                env_bind,
+            });
+        }
+
+        let pipeline = render_pipeline(
+            device,
+            [&gl0, &gl1, &env_scene.layout],
+            format,
+            settings.msaa,
+        )?;
+        Ok(Renderer {
+            pipeline,
+            globals,
+            global_bind,
+            meshes,
+            settings: settings.clone(),
+            n_lambda: spec.len() as u32,
+            env: env_scene,
+            format,
+            warnings,
+            notes,
+        })
+    }
+
+    /// True when frames are Monte Carlo estimates to accumulate (a scene
+    /// environment in the default mode): see crate::accum.
+    pub fn progressive(&self) -> bool {
+        self.env.env.is_some()
+    }
+
+    /// Set the frame index that seeds the next frame's random numbers.
+    pub fn set_frame(&self, gpu: &Gpu, frame: u32) {
+        if self.progressive() {
+            self.env.set_frame(gpu, frame);
+        }
+    }
+
+    /// Upload the per-frame uniforms for a `w x h` target.
+    pub fn update(&self, gpu: &Gpu, state: &FrameState, w: u32, h: u32) {
+        self.update_jittered(gpu, state, w, h, [0.0; 2]);
+    }
+
+    /// [`Renderer::update`] with the image shifted by `jitter` pixels (x
+    /// right, y down): the progressive sum's frames each take another
+    /// sub-pixel position ([`subpixel_jitter`]), so the settled frame is the
+    /// average over each pixel's area, as a camera sees it (and as the
+    /// reference's stratified sub-pixel samples are), not the shading at its
+    /// centre.
+    pub fn update_jittered(&self, gpu: &Gpu, state: &FrameState, w: u32, h: u32, jitter: [f64; 2]) {
+        let mut vpm = state.camera.view_proj(w, h);
+        // clip.x += (2 jx / w) clip.w, clip.y -= (2 jy / h) clip.w (NDC y is up).
+        let (jx, jy) = (
+            2.0 * jitter[0] / w.max(1) as f64,
+            -2.0 * jitter[1] / h.max(1) as f64,
+        );
+        for c in &mut vpm {
+            c[0] += jx * c[3];
+            c[1] += jy * c[3];
+        }
+        let vp = camera::to_f32(&vpm);
+        let mut lights = [[0.0f32; 4]; MAX_LIGHTS];
+        let mut n = 0;
+        for l in state.lights.iter().take(MAX_LIGHTS) {
+            let d = l.direction;
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if !(len > 0.0 && len.is_finite()) {
+                continue;
+            }
+            lights[n] = [
+                (d[0] / len) as f32,
+                (d[1] / len) as f32,
+                (d[2] / len) as f32,
+                l.intensity as f32,
+            ];
+            n += 1;
+        }
+        let m = colour::XYZ_TO_SRGB;
+        let row = |r: usize| [m[r][0] as f32, m[r][1] as f32, m[r][2] as f32, 0.0];
+        let g = Globals {
+            view_proj: vp,
+            eye: [
+                state.camera.eye[0] as f32,
+                state.camera.eye[1] as f32,
+                state.camera.eye[2] as f32,
+                1.0,
+            ],
+            lights,
+            xyz_to_rgb: [row(0), row(1), row(2)],
+            background: [
+                state.background[0] as f32,
+                state.background[1] as f32,
+                state.background[2] as f32,
+                1.0,
+            ],
+            n_lights: n as u32,
+            mode: match self.settings.mode {
+                Mode::Default | Mode::Table => 0,
+                Mode::Thesis => 1,
+                Mode::Lambert => 2,
+                Mode::Direct => 3,
+            },
+            curve: match self.settings.curve {
+                ToneCurve::Clamp => 0,
+                ToneCurve::Reinhard => 1,
+            },
+            output: if self.format == OFFSCREEN_FORMAT {
+                2
+            } else {
+                u32::from(self.format.is_srgb())
+            },
+            exposure_scale: state.exposure.exp2() as f32,
+            n_lambda: self.n_lambda,
+            msaa: self.msaa(),
+            _g0: 0,
+        };
+        gpu.queue
+            .write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
+    }
+
+    /// The clear colour: the background through the display transform (linear for an sRGB target).
+    pub fn clear_colour(&self, state: &FrameState) -> wgpu::Color {
+        let tm = ToneMap {
+            exposure_ev: state.exposure,
+            curve: self.settings.curve,
+        };
+        let mut e = colour::display_encode(state.background, &tm);
+        if self.format == OFFSCREEN_FORMAT {
+            // Offscreen targets hold linear light times the exposure (the shader's
+            // output 2); the display transform follows on the CPU.
+            let k = state.exposure.exp2();
+            e = state.background.map(|v| (v * k).max(0.0));
+        } else if self.format.is_srgb() {
+            e = e.map(colour::srgb_eotf);
+        }
+        wgpu::Color {
+            r: e[0],
+            g: e[1],
+            b: e[2],
+            a: 1.0,
+        }
+    }
+
+    /// Multisample count of the pipeline (the colour and depth targets must match).
+    pub fn msaa(&self) -> u32 {
+        self.settings.msaa.max(1)
+    }
+
+    /// Tone curve of the display transform.
+    pub fn curve(&self) -> ToneCurve {
+        self.settings.curve
+    }
+
+    /// Record a frame into `colour` (with `depth` of the same size and sample
+    /// count); with MSAA, `colour` is the multisampled target and `resolve` the
+    /// single-sample one that receives the average.
+    pub fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        resolve: Option<&wgpu::TextureView>,
+        depth: &wgpu::TextureView,
+        state: &FrameState,
+    ) {
+        let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("frame"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: colour,
+                depth_slice: None,
+                resolve_target: resolve,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(self.clear_colour(state)),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        rp.set_pipeline(&self.pipeline);
+        rp.set_bind_group(0, &self.global_bind, &[]);
+        for m in &self.meshes {
+            if m.count == 0 {
+                continue;
+            }
+            rp.set_bind_group(1, &m.bind, &[]);
+            rp.set_bind_group(2, &m.env_bind, &[]);
+            rp.set_vertex_buffer(0, m.vbuf.slice(..));
+            rp.set_index_buffer(m.ibuf.slice(..), wgpu::IndexFormat::Uint32);
+            rp.draw_indexed(0..m.count, 0, 0..1);
+        }
+    }
+}

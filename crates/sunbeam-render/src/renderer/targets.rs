@@ -1,0 +1,300 @@
+//! Where frames go: depth and colour targets, the offscreen float target with
+//! its readback and progressive sum, the sub-pixel jitter of the sum's frames.
+
+use super::{FrameState, Renderer, DEPTH_FORMAT};
+use crate::gpu::Gpu;
+use sunbeam_common::{Error, Result};
+use sunbeam_frame::{Image, LinearImage};
+
+/// A depth texture view of the given size (single-sample).
+pub fn depth_view(gpu: &Gpu, w: u32, h: u32) -> wgpu::TextureView {
+    depth_view_ms(gpu, w, h, 1)
+}
+
+/// A depth texture view of the given size and sample count.
+pub fn depth_view_ms(gpu: &Gpu, w: u32, h: u32, samples: u32) -> wgpu::TextureView {
+    gpu.device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("depth"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: samples.max(1),
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+}
+
+/// A colour texture view to render into (`samples > 1`: multisampled, not readable).
+pub fn colour_view(
+    gpu: &Gpu,
+    w: u32,
+    h: u32,
+    format: wgpu::TextureFormat,
+    samples: u32,
+) -> wgpu::TextureView {
+    gpu.device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("msaa colour"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: samples.max(1),
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+}
+
+/// An offscreen float target with readback: frames come back in linear light
+/// (exposure applied) and go through the display transform on the CPU
+/// (`sunbeam_frame::LinearImage::display`), so that MSAA resolves average
+/// linear values, as a camera does.
+pub struct Offscreen {
+    pub width: u32,
+    pub height: u32,
+    tex: wgpu::Texture,
+    view: wgpu::TextureView,
+    msaa: Option<wgpu::TextureView>,
+    depth: wgpu::TextureView,
+    readback: wgpu::Buffer,
+    padded_row: u32,
+    /// The running sum of a progressive renderer (environment scenes).
+    acc: Option<crate::accum::Accumulator>,
+}
+
+/// Colour format of offscreen frames (linear values; MSAA-resolvable everywhere).
+pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+impl Offscreen {
+    /// A target for `r`'s pipeline (its sample count).
+    pub fn new(gpu: &Gpu, r: &Renderer, width: u32, height: u32) -> Result<Offscreen> {
+        let lim = gpu.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > lim || height > lim {
+            return Err(Error::usage(format!(
+                "size {width}x{height}: each side must be 1..{lim} on this GPU"
+            )));
+        }
+        let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("frame"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: OFFSCREEN_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let view = tex.create_view(&Default::default());
+        let acc = if r.progressive() {
+            Some(crate::accum::Accumulator::new(
+                gpu, &view, width, height, true,
+            )?)
+        } else {
+            None
+        };
+        let ms = r.msaa();
+        let msaa = (ms > 1).then(|| colour_view(gpu, width, height, OFFSCREEN_FORMAT, ms));
+        let padded_row = (width * 8).div_ceil(256) * 256;
+        let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: padded_row as u64 * height as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Offscreen {
+            width,
+            height,
+            tex,
+            view,
+            msaa,
+            depth: depth_view_ms(gpu, width, height, ms),
+            readback,
+            padded_row,
+            acc,
+        })
+    }
+
+    /// Frames in the progressive sum (0 for a renderer that does not accumulate).
+    pub fn frames(&self) -> u32 {
+        self.acc.as_ref().map_or(0, |a| a.count())
+    }
+
+    /// Start the progressive sum again (camera, light or exposure changed).
+    pub fn reset(&self) {
+        if let Some(a) = &self.acc {
+            a.reset();
+        }
+    }
+
+    fn record(&self, enc: &mut wgpu::CommandEncoder, r: &Renderer, state: &FrameState) {
+        match &self.msaa {
+            Some(ms) => r.encode(enc, ms, Some(&self.view), &self.depth, state),
+            None => r.encode(enc, &self.view, None, &self.depth, state),
+        }
+    }
+
+    /// The progressive sum (environment scenes), for the window's resolve pass.
+    pub fn accumulator(&self) -> Option<&crate::accum::Accumulator> {
+        self.acc.as_ref()
+    }
+
+    /// Record one frame (and, for a progressive renderer, adding it to the sum:
+    /// the frame index is set from the count). The caller submits.
+    pub fn encode_frame(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        r: &Renderer,
+        state: &FrameState,
+    ) {
+        match &self.acc {
+            Some(a) => {
+                let jitter = subpixel_jitter(a.count());
+                r.update_jittered(gpu, state, self.width, self.height, jitter);
+                r.set_frame(gpu, a.count());
+            }
+            None => r.update(gpu, state, self.width, self.height),
+        }
+        self.record(enc, r, state);
+        if let Some(a) = &self.acc {
+            a.add(gpu, enc);
+        }
+    }
+
+    /// Render one frame and wait for it (no readback); a progressive renderer
+    /// adds it to the running sum.
+    pub fn draw(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<()> {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        self.encode_frame(gpu, &mut enc, r, state);
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait()?;
+        gpu.take_errors()
+    }
+
+    /// Render one frame and read it back as display values.
+    pub fn render(&self, gpu: &Gpu, r: &Renderer, state: &FrameState) -> Result<Image> {
+        Ok(self.render_linear(gpu, r, state)?.display(r.curve()))
+    }
+
+    /// Render one frame and read it back in linear light (exposure applied); a
+    /// progressive renderer adds it to the running sum and returns the mean of
+    /// the frames since the last reset (the settled frame).
+    pub fn render_linear(
+        &self,
+        gpu: &Gpu,
+        r: &Renderer,
+        state: &FrameState,
+    ) -> Result<LinearImage> {
+        if let Some(a) = &self.acc {
+            self.draw(gpu, r, state)?;
+            return a.read(gpu);
+        }
+        r.update(gpu, state, self.width, self.height);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        self.record(&mut enc, r, state);
+        enc.copy_texture_to_buffer(
+            self.tex.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row),
+                    rows_per_image: None,
+                },
+            },
+            wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: 1,
+            },
+        );
+        gpu.queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        self.readback
+            .map_async(wgpu::MapMode::Read, .., move |res| {
+                let _ = tx.send(res);
+            });
+        gpu.wait()?;
+        rx.recv()
+            .map_err(|e| Error::internal(format!("readback: {e}")))?
+            .map_err(|e| Error::internal(format!("readback: {e}")))?;
+        gpu.take_errors()?;
+        let mut img = LinearImage::new(self.width, self.height);
+        {
+            let data = self
+                .readback
+                .get_mapped_range(..)
+                .map_err(|e| Error::internal(format!("readback: {e}")))?;
+            let px: &[u16] = bytemuck::cast_slice(&data);
+            let stride = (self.padded_row / 2) as usize;
+            let f = |b: u16| half::f16::from_bits(b).to_f32();
+            for y in 0..self.height as usize {
+                for x in 0..self.width as usize {
+                    let i = y * stride + x * 4;
+                    img.rgb[y * self.width as usize + x] = [f(px[i]), f(px[i + 1]), f(px[i + 2])];
+                }
+            }
+        }
+        self.readback.unmap();
+        Ok(img)
+    }
+}
+
+/// The sub-pixel offset (pixels, each in [-0.5, 0.5)) of frame `k` of a
+/// progressive sum: the Halton (2, 3) sequence from index 1, so any run of
+/// frames covers the pixel evenly (stratified, unlike independent random
+/// offsets) and the first frame (the one shown while the view moves) sits
+/// near the centre, (0, -1/6).
+pub fn subpixel_jitter(k: u32) -> [f64; 2] {
+    fn radical_inverse(mut i: u32, base: u32) -> f64 {
+        let (mut f, mut r) = (1.0, 0.0);
+        while i > 0 {
+            f /= base as f64;
+            r += f * (i % base) as f64;
+            i /= base;
+        }
+        r
+    }
+    let i = k.wrapping_add(1);
+    [radical_inverse(i, 2) - 0.5, radical_inverse(i, 3) - 0.5]
+}
+
+#[cfg(test)]
+mod jitter_tests {
+    use super::subpixel_jitter;
+
+    /// The offsets stay inside the pixel and cover it evenly: over 64 frames,
+    /// each of the 4 x 4 sub-cells gets 3 to 5 (4 on average), and the mean is the centre.
+    #[test]
+    fn jitter_covers_the_pixel_evenly() {
+        let mut cells = [0u32; 16];
+        let mut mean = [0.0; 2];
+        for k in 0..64 {
+            let j = subpixel_jitter(k);
+            assert!(j.iter().all(|v| (-0.5..0.5).contains(v)), "{j:?}");
+            let c = |v: f64| ((v + 0.5) * 4.0) as usize;
+            cells[c(j[0]) + 4 * c(j[1])] += 1;
+            mean = [mean[0] + j[0] / 64.0, mean[1] + j[1] / 64.0];
+        }
+        assert!(cells.iter().all(|n| (3..=5).contains(n)), "{cells:?}");
+        assert!(mean[0].abs() < 0.02 && mean[1].abs() < 0.02, "{mean:?}");
+    }
+}

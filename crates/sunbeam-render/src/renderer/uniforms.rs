@@ -1,0 +1,365 @@
+//! The uniforms the shaders read (shaders/diffraction.wgsl's `Globals` and
+//! `Material`, mirrored by hand and checked against the WGSL by naga's
+//! reflection in the tests below), the vertex layout, and what fills the
+//! pack's part of the material: the series, crop and kernel, the per-|t| term
+//! table, the spectrum buffer. One `Material` serves every mode (the WGSL
+//! branches on `Globals::mode`); each technique's module fills its fields.
+
+use super::{Mode, Settings, MAX_LIGHTS, MAX_TERMS, TERM_TABLE, THESIS_TERMS};
+use sunbeam_frame::spectral::Samples;
+use sunbeam_optics::cie;
+use sunbeam_pack::{Basis, Model, Pack};
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct Vertex {
+    pub(super) pos: [f32; 3],
+    pub(super) normal: [f32; 3],
+    pub(super) tangent: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct Globals {
+    pub(super) view_proj: [[f32; 4]; 4],
+    pub(super) eye: [f32; 4],
+    pub(super) lights: [[f32; 4]; MAX_LIGHTS],
+    pub(super) xyz_to_rgb: [[f32; 4]; 3],
+    pub(super) background: [f32; 4],
+    pub(super) n_lights: u32,
+    pub(super) mode: u32,
+    pub(super) curve: u32,
+    pub(super) output: u32,
+    pub(super) exposure_scale: f32,
+    pub(super) n_lambda: u32,
+    /// Samples per pixel of the colour target (the shader tells covered pixels from silhouettes).
+    pub(super) msaa: u32,
+    pub(super) _g0: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
+pub(super) struct MaterialU {
+    pub(super) base: [f32; 4],
+    pub(super) has_pack: u32,
+    pub(super) basis: u32,
+    pub(super) model: u32,
+    pub(super) taps: u32,
+    pub(super) crop_w: u32,
+    pub(super) crop_h: u32,
+    pub(super) kx: i32,
+    pub(super) ky: i32,
+    pub(super) terms: u32,
+    pub(super) fixed_terms: u32,
+    pub(super) n_table: u32,
+    pub(super) _p0: u32,
+    pub(super) bin_scale_um: [f32; 2],
+    pub(super) half_range_um: f32,
+    pub(super) beta: f32,
+    pub(super) sigma_bins: [f32; 2],
+    pub(super) kb_norm: f32,
+    pub(super) table_dt: f32,
+    pub(super) tab_nu: u32,
+    pub(super) tab_nv: u32,
+    pub(super) tab_nw: u32,
+    pub(super) tab_on: u32,
+    pub(super) tab_u0: f32,
+    pub(super) tab_du: f32,
+    pub(super) tab_dv: f32,
+    pub(super) tab_w0: f32,
+    pub(super) tab_dw: f32,
+    pub(super) mask_sx: f32,
+    pub(super) mask_sy: f32,
+    /// The skin's refractive index (scene `meshes[].ior`).
+    pub(super) ior: f32,
+    pub(super) resp_on: u32,
+    pub(super) resp_n_theta: f32,
+    pub(super) resp_n_rho: f32,
+    pub(super) resp_n_s: f32,
+    pub(super) resp_r0: f32,
+    pub(super) resp_rho_scale: f32,
+    pub(super) resp_footprint: u32,
+    /// What G is divided by: `sunbeam_optics::gain::Material::norm` (1
+    /// absolute, F(0) relative).
+    pub(super) norm: f32,
+    /// The window's sigma in um (window model: R_U in the direct mode), 0 = R.
+    pub(super) window_sigma_um: f32,
+    pub(super) _s: [f32; 3],
+}
+
+/// Smallest term count whose truncation bound stays below `tol` for every |t| up to `t`.
+fn terms_for(basis: Basis, t: f64, tol: f64, start: usize, cap: usize) -> usize {
+    let mut n = start.max(1);
+    while n < cap && sunbeam_pack::series::tail_bound_upto(basis, t, n) >= tol {
+        n += 1;
+    }
+    n
+}
+
+/// The per-|t| term table of a pack: entry i covers |t| <= (i + 1) dt.
+pub fn term_table(pack: &Pack, t_max: f64, tol: f64) -> (Vec<u32>, f64) {
+    let m = &pack.manifest;
+    let cap = m.terms.min(MAX_TERMS);
+    let dt = (t_max / TERM_TABLE as f64).max(1e-6);
+    let mut out = Vec::with_capacity(TERM_TABLE);
+    let mut n = 1;
+    for i in 0..TERM_TABLE {
+        n = terms_for(m.basis, (i + 1) as f64 * dt, tol, n, cap);
+        out.push(n as u32);
+    }
+    (out, dt)
+}
+
+/// The pack's part of a material's uniforms (series, crop, kernel, per-|t| term
+/// table; docs/PACK_FORMAT.md "Evaluation"): the term table and its |t| step.
+pub(super) fn pack_uniforms(
+    mu: &mut MaterialU,
+    pack: &Pack,
+    used: usize,
+    settings: &Settings,
+    lambda_min: f64,
+) -> (Vec<u32>, f64) {
+    let m = &pack.manifest;
+    let h = m.height_half_range_m;
+    let t_max = 4.0 * std::f64::consts::PI * h / lambda_min;
+    let tol = settings
+        .term_tolerance
+        .unwrap_or_else(|| m.error.tolerance.unwrap_or(0.0).max(m.error.series_bound))
+        .max(1e-12);
+    let (table, dt) = term_table(pack, t_max, tol);
+    let w = m.kernel.taps as f64;
+    mu.has_pack = 1;
+    mu.basis = match m.basis {
+        Basis::Chebyshev => 0,
+        Basis::Taylor => 1,
+    };
+    mu.model = match m.model {
+        Model::Window => 0,
+        Model::Tiled => 1,
+    };
+    mu.taps = m.kernel.taps as u32;
+    mu.crop_w = m.crop.width as u32;
+    mu.crop_h = m.crop.height as u32;
+    mu.kx = m.crop.kx as i32;
+    mu.ky = m.crop.ky as i32;
+    mu.terms = used as u32;
+    mu.fixed_terms = if settings.mode == Mode::Thesis {
+        THESIS_TERMS
+    } else {
+        0
+    };
+    mu.n_table = table.len() as u32;
+    mu.bin_scale_um = [
+        (m.bin_scale_m[0] * 1e6) as f32,
+        (m.bin_scale_m[1] * 1e6) as f32,
+    ];
+    mu.half_range_um = (h * 1e6) as f32;
+    mu.beta = m.kernel.beta as f32;
+    mu.sigma_bins = [m.kernel.sigma_bins[0] as f32, m.kernel.sigma_bins[1] as f32];
+    mu.kb_norm = if m.kernel.beta > 0.0 {
+        (m.kernel.beta / (w * m.kernel.beta.sinh())) as f32
+    } else {
+        0.0
+    };
+    mu.table_dt = dt as f32;
+    // PHYSICS.md 2b's exact grazing term (Pack::shading_reflectance) in the
+    // direct mode; the thesis mode keeps the thesis' R.
+    mu.window_sigma_um = if m.model == Model::Window && settings.mode == Mode::Direct {
+        (m.window_sigma_m * 1e6) as f32
+    } else {
+        0.0
+    };
+    (table, dt)
+}
+
+/// Wavelength samples of a mode: the thesis' 5 nm steps, else `lambda_samples` midpoints.
+pub(super) fn spectral_samples(settings: &Settings) -> Samples {
+    match settings.mode {
+        Mode::Thesis => Samples::stepped(380, 780, 5),
+        _ => Samples::uniform(settings.lambda_samples.max(1), cie::DEFAULT_RANGE_NM),
+    }
+}
+
+/// The spectrum buffer of the shader: XYZ weight and 1 / lambda in 1/um per sample.
+pub(super) fn spectrum_table(samples: &Samples) -> Vec<[f32; 4]> {
+    samples
+        .0
+        .iter()
+        .map(|s| {
+            [
+                s.weight[0] as f32,
+                s.weight[1] as f32,
+                s.weight[2] as f32,
+                (1e-6 / s.lambda_m) as f32,
+            ]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod layout_tests {
+    //! The uniform structs mirror the WGSL by hand; naga's reflection of the
+    //! shader checks every shared member's offset and the total size, so the two
+    //! cannot drift (a field added on one side only fails here).
+    use super::super::SHADER;
+    use super::{Globals, MaterialU};
+    use std::mem::{offset_of, size_of};
+
+    fn wgsl_struct(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+        let module = naga::front::wgsl::parse_str(src).expect("the shader parses");
+        for (_, ty) in module.types.iter() {
+            if ty.name.as_deref() == Some(name) {
+                if let naga::TypeInner::Struct { members, span } = &ty.inner {
+                    return (
+                        *span,
+                        members
+                            .iter()
+                            .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                            .collect(),
+                    );
+                }
+            }
+        }
+        panic!("struct {name} not found in the WGSL");
+    }
+
+    fn check(name: &str, size: usize, rust: &[(&str, usize)]) {
+        check_in(SHADER, name, size, rust)
+    }
+
+    fn check_in(src: &str, name: &str, size: usize, rust: &[(&str, usize)]) {
+        let (span, members) = wgsl_struct(src, name);
+        assert_eq!(span as usize, size, "{name}: WGSL size vs Rust size");
+        let mut matched = 0;
+        for (field, off) in rust {
+            let Some((_, w)) = members.iter().find(|(n, _)| n == field) else {
+                panic!("{name}.{field} is not in the WGSL struct");
+            };
+            assert_eq!(
+                *w as usize, *off,
+                "{name}.{field}: WGSL offset vs Rust offset"
+            );
+            matched += 1;
+        }
+        let named = members.iter().filter(|(n, _)| !n.starts_with('_')).count();
+        assert_eq!(
+            matched, named,
+            "{name}: every named WGSL member has a Rust twin"
+        );
+    }
+
+    #[test]
+    fn globals_match_the_wgsl() {
+        macro_rules! f {
+            ($($n:ident),*) => { [$((stringify!($n), offset_of!(Globals, $n))),*] };
+        }
+        check(
+            "Globals",
+            size_of::<Globals>(),
+            &f!(
+                view_proj,
+                eye,
+                lights,
+                xyz_to_rgb,
+                background,
+                n_lights,
+                mode,
+                curve,
+                output,
+                exposure_scale,
+                n_lambda,
+                msaa
+            ),
+        );
+    }
+
+    #[test]
+    fn material_matches_the_wgsl() {
+        macro_rules! f {
+            ($($n:ident),*) => { [$((stringify!($n), offset_of!(MaterialU, $n))),*] };
+        }
+        check(
+            "Material",
+            size_of::<MaterialU>(),
+            &f!(
+                base,
+                has_pack,
+                basis,
+                model,
+                taps,
+                crop_w,
+                crop_h,
+                kx,
+                ky,
+                terms,
+                fixed_terms,
+                n_table,
+                bin_scale_um,
+                half_range_um,
+                beta,
+                sigma_bins,
+                kb_norm,
+                table_dt,
+                tab_nu,
+                tab_nv,
+                tab_nw,
+                tab_on,
+                tab_u0,
+                tab_du,
+                tab_dv,
+                tab_w0,
+                tab_dw,
+                mask_sx,
+                mask_sy,
+                ior,
+                resp_on,
+                resp_n_theta,
+                resp_n_rho,
+                resp_n_s,
+                resp_r0,
+                resp_rho_scale,
+                resp_footprint,
+                norm,
+                window_sigma_um
+            ),
+        );
+    }
+
+    #[test]
+    fn environment_uniforms_match_the_wgsl() {
+        use crate::env::{EnvGlobals, EnvProposalU};
+        macro_rules! f {
+            ($t:ty; $($n:ident),*) => { [$((stringify!($n), offset_of!($t, $n))),*] };
+        }
+        check(
+            "EnvGlobals",
+            size_of::<EnvGlobals>(),
+            &f!(EnvGlobals; basis_to_rgb, sun_dir, sun_rgb, sun_t, sun_b, table_w, table_h, frame, on, has_sun, samples),
+        );
+        check(
+            "EnvProposal",
+            size_of::<EnvProposalU>(),
+            &f!(EnvProposalU; offsets, pw, ph, top, n_s, n_theta, n_rho, n_s_f, r0, rho_scale, on, has_sun),
+        );
+    }
+
+    #[test]
+    fn accumulation_uniforms_match_the_wgsl() {
+        use crate::accum::{AccU, ResolveU, ACCUMULATE_WGSL, RESOLVE_WGSL};
+        macro_rules! f {
+            ($t:ty; $($n:ident),*) => { [$((stringify!($n), offset_of!($t, $n))),*] };
+        }
+        check_in(
+            ACCUMULATE_WGSL,
+            "AccU",
+            size_of::<AccU>(),
+            &f!(AccU; width, height, count),
+        );
+        check_in(
+            RESOLVE_WGSL,
+            "ResolveU",
+            size_of::<ResolveU>(),
+            &f!(ResolveU; width, inv_n, curve, output),
+        );
+    }
+}
