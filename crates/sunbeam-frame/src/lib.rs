@@ -233,3 +233,23 @@ pub fn load_environment(e: &sunbeam_scene::Environment) -> Result<Arc<sunbeam_li
         }
     }))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::RendererCache;
+    use std::sync::Arc;
+
+    /// The slot is filled once and shared by clones; another type gets None
+    /// and leaves the slot alone.
+    #[test]
+    fn the_renderer_cache_is_filled_once_and_shared() {
+        let a = RendererCache::default();
+        let b = a.clone();
+        let x = a.get_or_init(|| 7u32).expect("a u32");
+        let y = b.get_or_init(|| 8u32).expect("the same u32");
+        assert!(Arc::ptr_eq(&x, &y) && *y == 7);
+        assert!(b.get_or_init(|| "other").is_none());
+        assert_eq!(*a.get_or_init(|| 9u32).unwrap(), 7);
+        assert!(format!("{a:?}").contains("filled"));
+    }
+}
