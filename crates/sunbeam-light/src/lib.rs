@@ -39,8 +39,11 @@ pub enum EnvError {
     NotEquirectangular { width: usize, height: usize },
     /// Pixel count does not match width * height.
     SizeMismatch { expected: usize, got: usize },
-    /// A texel is negative, NaN or infinite.
+    /// A texel is NaN or infinite.
     BadTexel { index: usize },
+    /// The negative texels outweigh lossy-compression noise: their summed
+    /// magnitude is more than [`NEGATIVE_MASS_LIMIT`] of the positive sum.
+    NegativeMass { negative: f64, positive: f64 },
     /// Intensity negative, NaN or infinite.
     BadIntensity(f64),
 }
@@ -56,8 +59,14 @@ impl std::fmt::Display for EnvError {
                 write!(f, "expected {expected} pixels, got {got}")
             }
             EnvError::BadTexel { index } => {
-                write!(f, "pixel {index} is negative or not finite")
+                write!(f, "pixel {index} is not finite")
             }
+            EnvError::NegativeMass { negative, positive } => write!(
+                f,
+                "the negative texels sum to {negative:.4e} against {positive:.4e} positive \
+                 (more than {:.0} %): not a radiance map",
+                100.0 * NEGATIVE_MASS_LIMIT
+            ),
             EnvError::BadIntensity(v) => {
                 write!(f, "intensity {v} must be finite and >= 0")
             }
@@ -81,6 +90,25 @@ pub fn rot_y(d: [f64; 3], deg: f64) -> [f64; 3] {
     [c * d[0] - s * d[2], d[1], s * d[0] + c * d[2]]
 }
 
+/// The largest summed magnitude of negative channel values, as a fraction of
+/// the positive sum, that a map may carry: lossy OpenEXR compression (DWAA,
+/// DWAB, PXR24, B44) leaves a few near-black texels slightly below zero (a
+/// public library's HDRIs: up to about a thousand texels of 512 K, down to
+/// -0.003, a fraction of about 1e-7 of the map's energy); those are set to 0.
+/// A map whose negatives weigh more than this is not radiance and is refused.
+pub const NEGATIVE_MASS_LIMIT: f64 = 0.01;
+
+/// Negative channel values [`EnvMap::new`] set to 0.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Clamped {
+    /// Texels with at least one negative channel.
+    pub texels: usize,
+    /// Negative channel values (a texel counts once per negative channel).
+    pub values: usize,
+    /// The most negative channel value (0 when none).
+    pub min: f32,
+}
+
 /// An equirectangular RGB radiance map (linear, scaled by `intensity`),
 /// rotated by `rotation_deg` about +y, with its importance sampler.
 #[derive(Debug, Clone)]
@@ -89,6 +117,7 @@ pub struct EnvMap {
     height: usize,
     rgb: Vec<[f32; 3]>,
     rotation_deg: f64,
+    clamped: Clamped,
     /// Marginal CDF over rows (len height + 1), cumulative of row weights.
     marginal: Vec<f64>,
     /// Conditional CDF per row (height rows of width + 1).
@@ -123,13 +152,29 @@ impl EnvMap {
             return Err(EnvError::BadIntensity(intensity));
         }
         let mut rgb = rgb;
+        let mut clamped = Clamped::default();
+        let (mut negative, mut positive) = (0.0f64, 0.0f64);
         for (index, c) in rgb.iter_mut().enumerate() {
-            if c.iter().any(|v| !v.is_finite() || *v < 0.0) {
+            if c.iter().any(|v| !v.is_finite()) {
                 return Err(EnvError::BadTexel { index });
             }
+            if c.iter().any(|v| *v < 0.0) {
+                clamped.texels += 1;
+            }
             for v in c.iter_mut() {
+                if *v < 0.0 {
+                    clamped.values += 1;
+                    negative -= *v as f64;
+                    clamped.min = clamped.min.min(*v);
+                    *v = 0.0;
+                } else {
+                    positive += *v as f64;
+                }
                 *v = (*v as f64 * intensity) as f32;
             }
+        }
+        if negative > NEGATIVE_MASS_LIMIT * positive {
+            return Err(EnvError::NegativeMass { negative, positive });
         }
         let mut conditional = vec![0.0; height * (width + 1)];
         let mut marginal = vec![0.0; height + 1];
@@ -147,6 +192,7 @@ impl EnvMap {
             height,
             rgb,
             rotation_deg,
+            clamped,
             marginal,
             conditional,
             total,
@@ -161,6 +207,11 @@ impl EnvMap {
 
     pub fn width(&self) -> usize {
         self.width
+    }
+
+    /// The negative texels set to 0 when the map was built.
+    pub fn clamped(&self) -> Clamped {
+        self.clamped
     }
 
     pub fn height(&self) -> usize {
@@ -278,6 +329,31 @@ mod tests {
         EnvMap::new(w, h, rgb, rot, 2.0).unwrap()
     }
 
+    /// Compression noise below zero is set to 0, counted, and leaves the
+    /// sampler's density exact for the map it keeps.
+    #[test]
+    fn sets_small_negatives_to_zero() {
+        let mut px = vec![[2.0f32; 3]; 32];
+        px[7] = [-0.003, 0.5, -1e-6];
+        px[20][1] = -0.001;
+        let m = EnvMap::new(8, 4, px, 0.0, 3.0).unwrap();
+        assert_eq!(
+            m.clamped(),
+            Clamped {
+                texels: 2,
+                values: 3,
+                min: -0.003
+            }
+        );
+        // Texel 7 of the 8 x 4 map: column 7, row 0.
+        let theta = PI * 0.5 / 4.0;
+        let phi = 2.0 * PI * 7.5 / 8.0;
+        assert_eq!(m.lookup(direction(theta.cos(), phi)), [0.0, 1.5, 0.0]);
+        assert_eq!(m.clamped(), m.clone().clamped());
+        let clean = EnvMap::new(8, 4, vec![[2.0f32; 3]; 32], 0.0, 3.0).unwrap();
+        assert_eq!(clean.clamped(), Clamped::default());
+    }
+
     #[test]
     fn refuses_bad_maps() {
         assert!(matches!(
@@ -298,6 +374,19 @@ mod tests {
             EnvMap::new(4, 2, px, 0.0, 1.0).unwrap_err(),
             EnvError::BadTexel { index: 3 }
         );
+        let mut px = vec![[1.0; 3]; 8];
+        px[5][2] = f32::INFINITY;
+        assert_eq!(
+            EnvMap::new(4, 2, px, 0.0, 1.0).unwrap_err(),
+            EnvError::BadTexel { index: 5 }
+        );
+        // Negatives past the limit: 0.25 of 24 - 0.25 is more than 1 %.
+        let mut px = vec![[1.0; 3]; 8];
+        px[2][0] = -0.25;
+        assert!(matches!(
+            EnvMap::new(4, 2, px, 0.0, 1.0).unwrap_err(),
+            EnvError::NegativeMass { .. }
+        ));
     }
 
     /// Closed form: a constant map is sampled with density 1 / (4 pi)

@@ -43,6 +43,25 @@ pub const INSTALL_HINT: &str = "no GPU adapter found. On a machine without a GPU
      `apt-get install mesa-vulkan-drivers libvulkan1` (Vulkan, lavapipe) or `libegl1 libegl-mesa0 libgl1-mesa-dri` \
      (GL, llvmpipe; run with --backend gl)";
 
+/// Keep a successful run free of `error:` lines from the system's display
+/// probe. Mesa's Vulkan device-select layer (an implicit layer of every Mesa
+/// install) looks for a Wayland compositor when wgpu enables the Wayland
+/// surface extension, and libwayland prints `error: XDG_RUNTIME_DIR is invalid
+/// or not set in the environment.` when that variable is missing (twice per
+/// run, headless included). The layer only moves the desktop's GPU to the
+/// front of the adapter list; wgpu chooses by power preference and surface
+/// instead. So where the probe can only fail (no usable `XDG_RUNTIME_DIR`),
+/// turn the layer off with Mesa's switch `NODEVICE_SELECT=1`, unless the user
+/// set it. The environment is process-wide: call this before other threads
+/// start (a tool's first step after parsing its arguments).
+pub fn quiet_display_probe() {
+    let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR")
+        .is_some_and(|d| !d.is_empty() && std::path::Path::new(&d).is_dir());
+    if !runtime_dir && std::env::var_os("NODEVICE_SELECT").is_none() {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
+}
+
 /// A device and its queue, plus the errors wgpu reported outside an error scope.
 pub struct Gpu {
     pub instance: wgpu::Instance,

@@ -122,6 +122,7 @@ fn inputs(p: &Prepared, cli: &Cli) -> Vec<PathBuf> {
 }
 
 pub(crate) fn run(cli: Cli) -> Result<()> {
+    sunbeam_render::gpu::quiet_display_probe();
     if let Some(lang) = cli.export_shader {
         return export_shader(lang, &cli);
     }

@@ -4,43 +4,11 @@
 //! default mode still renders; `--mode direct` (which needs the terms) and a
 //! map from another pack (which forces a rebuild from the terms) do not.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::{gpu_available, pack, scratch, BIN};
+use std::path::Path;
 use std::process::Command;
-
-const BIN: &str = env!("CARGO_BIN_EXE_sunbeam-play");
-
-fn tool(name: &str) -> PathBuf {
-    PathBuf::from(BIN).with_file_name(name)
-}
-
-fn ok(c: &mut Command) {
-    let o = c.output().unwrap();
-    assert!(
-        o.status.success(),
-        "{c:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
-fn pack(dir: &Path, name: &str, preset: &str) -> PathBuf {
-    let h = dir.join(format!("{name}.exr"));
-    let p = dir.join(format!("{name}.ktx2"));
-    ok(Command::new(tool("sunbeam-import"))
-        .args([
-            &format!("synthetic:{preset}"),
-            "--synthetic-size",
-            "64",
-            "-q",
-            "-o",
-        ])
-        .arg(&h));
-    ok(Command::new(tool("sunbeam-pack"))
-        .arg(&h)
-        .arg("-o")
-        .arg(&p)
-        .args(["--response", "-q"]));
-    p
-}
 
 /// Overwrite the first term values of a KTX2 pack with NaN (level 0 offset at byte 80).
 fn spoil(p: &Path) {
@@ -65,17 +33,10 @@ fn render(scene: &Path, extra: &[&str]) -> std::process::Output {
 
 #[test]
 fn default_mode_reads_the_manifest_only_when_the_map_is_current() {
-    if sunbeam_render::Gpu::headless(Default::default()).is_err() {
-        assert!(
-            !sunbeam_common::testdata::require_all(),
-            "no GPU adapter and SUNBEAM_REQUIRE_ALL=1 (install mesa-vulkan-drivers)"
-        );
-        eprintln!("SKIP: no GPU adapter");
+    if !gpu_available() {
         return;
     }
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("play-manifest-only");
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
+    let d = scratch("play-manifest-only");
     let p = pack(&d, "x", "xenopeltis");
     let other = pack(&d, "y", "elaphe");
     let scene = d.join("scene.json");
