@@ -18,6 +18,7 @@ from . import exr, tools
 from .tools import SunbeamError
 
 _INF = float("inf")
+SPINE = "<spine>"  # in bake_source's flags: where bake() puts the spine file it writes
 
 
 def to_sunbeam(v):
@@ -296,13 +297,15 @@ def bake_source(depsgraph, obj):
     elif o.source == "CURVE":
         if o.curve is None:
             raise SunbeamError(f"{what} > Spine: no curve object set")
+        if o.curve.type != "CURVE":
+            raise SunbeamError(f"{what} > Spine: '{o.curve.name}' is not a curve object")
         curve = o.curve.evaluated_get(depsgraph)
         mesh = curve.to_mesh()
         spine = [to_sunbeam(curve.matrix_world @ v.co) for v in mesh.vertices]
         curve.to_mesh_clear()
         if len(spine) < 2:
             raise SunbeamError(f"{what} > Spine: curve '{o.curve.name}' has fewer than 2 points")
-        args = ["--curve"]
+        args = ["--curve", SPINE]
     else:
         uv_layers = obj.data.uv_layers
         if len(uv_layers) <= o.uv_set:
@@ -367,7 +370,7 @@ def bake(depsgraph, job, tmp, index, cancelled):
         spine = os.path.join(tmp, f"spine{index}.json")
         with open(spine, "w") as f:
             json.dump({"points": job.spine}, f)
-        args.append(spine)
+        args[args.index(SPINE)] = spine
     baked = os.path.join(tmp, f"mesh{index}-baked.glb")
     try:
         tools.run("sunbeam-bake", [exported, "-o", baked, "-q", *args], cancelled)

@@ -26,7 +26,7 @@ def _channels(op, _context):
     """The channels `sunbeam-import --list` reports for the chosen file."""
     path = bpy.path.abspath(op.filepath)
     if path not in _channel_items:
-        items = [("", "Default", "The first height channel")]
+        items = [("DEFAULT", "Default", "The first height channel")]
         if os.path.isfile(path):
             try:
                 listing = json.loads(tools.run("sunbeam-import", [path, "--list", "--json"]))
@@ -80,7 +80,7 @@ class SUNBEAM_OT_import_scan(bpy.types.Operator, ImportHelper):
         folder = bpy.path.abspath(self.output_folder) if self.output_folder else os.path.dirname(scan)
         stem = Path(scan).stem
         args = []
-        if self.channel:
+        if self.channel != "DEFAULT":
             args += ["--channel", self.channel]
         if self.level != "none":
             args += ["--level", "plane" if self.level == "plane" else f"poly:{self.poly_degree}"]

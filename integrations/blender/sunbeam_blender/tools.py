@@ -43,7 +43,7 @@ def find_tool(name):
             return str(path)
         raise SunbeamError(
             f"{name} not found in the binaries folder '{folder}' "
-            "(Preferences > Add-ons > Sunbeam > Binaries folder)")
+            "(Preferences > Add-ons > Sunbeam > Binaries Folder)")
     found = shutil.which(name)
     if found:
         return found
@@ -52,7 +52,7 @@ def find_tool(name):
         return str(path)
     raise SunbeamError(
         f"{name} not found on PATH nor in {_PROJECT_RELEASE} "
-        "(set Preferences > Add-ons > Sunbeam > Binaries folder)")
+        "(set Preferences > Add-ons > Sunbeam > Binaries Folder)")
 
 
 def _tool_message(name, stderr):
@@ -71,21 +71,21 @@ def run(name, args, cancelled=lambda: False, poll_s=0.1):
     and Cancelled is raised. A non-zero exit raises SunbeamError with the tool's message.
     """
     exe = find_tool(name)
-    proc = subprocess.Popen([exe, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            stdin=subprocess.DEVNULL, text=True)
     out, err = [], []
-    readers = [threading.Thread(target=lambda s=s, b=b: b.append(s.read()), daemon=True)
-               for s, b in ((proc.stdout, out), (proc.stderr, err))]
-    for reader in readers:
-        reader.start()
-    while proc.poll() is None:
-        if cancelled():
-            proc.kill()
-            proc.wait()
-            raise Cancelled()
-        time.sleep(poll_s)
-    for reader in readers:
-        reader.join()
+    with subprocess.Popen([exe, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                          stdin=subprocess.DEVNULL, text=True) as proc:
+        readers = [threading.Thread(target=lambda s=s, b=b: b.append(s.read()), daemon=True)
+                   for s, b in ((proc.stdout, out), (proc.stderr, err))]
+        for reader in readers:
+            reader.start()
+        while proc.poll() is None:
+            if cancelled():
+                proc.kill()
+                proc.wait()
+                raise Cancelled()
+            time.sleep(poll_s)
+        for reader in readers:
+            reader.join()
     if proc.returncode != 0:
         raise SunbeamError(_tool_message(name, "".join(err)))
     return "".join(out)
