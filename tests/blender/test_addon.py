@@ -20,6 +20,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 from pathlib import Path
 
@@ -36,7 +37,7 @@ HDRI = ROOT.parent / "shared" / "data" / "hdri" / "studio.exr"
 REQUIRE_ALL = os.environ.get("SUNBEAM_REQUIRE_ALL") == "1"
 IMG_OUT = os.environ.get("SUNBEAM_BLENDER_IMG")
 SCALE = 2 if IMG_OUT else 1  # frames for the docs twice as large (4x the time)
-TOOLS = ("sunbeam-import", "sunbeam-pack", "sunbeam-bake", "sunbeam-eval")
+TOOLS = ("sunbeam-import", "sunbeam-pack", "sunbeam-bake", "sunbeam-eval", "sunbeam-play")
 
 WORK = None  # a private folder: the test pack, the frames, and tempfile's folder
 
@@ -415,6 +416,39 @@ class OperatorTest(unittest.TestCase):
             self.assertEqual(data[:4], b"glTF")
             self.assertIn(b"_ORIENTATION", data)
             self.assertIn(b"SUNBEAM_materials_diffraction", data)
+
+
+class ViewportTest(unittest.TestCase):
+    def test_the_viewport_path_renders_the_export_with_the_player(self):
+        """What the viewport's rendered mode runs (view_update's export, view_draw's
+        sunbeam-play), minus the drawing, which needs a window."""
+        from sunbeam_blender import engine, export
+        scene = empty_scene(48, 48)
+        sunbeam_skin(add_sphere(scene))
+        cam = add_camera(scene, (0.0, -2.5, 0.4), (0.0, 0.0, 0.0))
+        sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+        scene.collection.objects.link(sun)
+        sun.rotation_euler = (0.7, 0.0, 0.3)
+        with tempfile.TemporaryDirectory() as tmp:
+            doc = export.build_scene(bpy.context.evaluated_depsgraph_get(), tmp, "sunbeam-play",
+                                     lambda: False, lambda *_: None, [])
+            path = export.save_scene(doc, export.camera_from_object(scene, cam, []), (48, 48),
+                                     os.path.join(tmp, "view.json"))
+            frame = os.path.join(tmp, "view.exr")
+            engine.preview_frame(path, frame, 2, lambda: False)
+            lit = (linear_pixels(frame).sum(-1) > 0).sum()
+        self.assertGreater(lit, 400)
+
+    def test_cancel_kills_the_child(self):
+        from sunbeam_blender import tools
+        out = WORK / "cancelled.exr"
+        start = time.monotonic()
+        with self.assertRaises(tools.Cancelled):
+            tools.run("sunbeam-eval", ["render", "--mesh", "builtin:sphere", "--pack", WORK / "skin.ktx2",
+                                       "--size", "512x512", "--samples", "4096", "-o", out],
+                      lambda: time.monotonic() - start > 0.5)
+        self.assertLess(time.monotonic() - start, 5.0)
+        self.assertFalse(out.exists())
 
 
 class ZipTest(unittest.TestCase):

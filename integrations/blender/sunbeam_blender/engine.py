@@ -52,6 +52,10 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
 
     _preview = None  # (thread, holder) of the viewport's running sunbeam-play
     _texture = None  # the last finished viewport frame
+    _export_dir = None  # the viewport's exported meshes and World
+    _doc = None  # their scene document (no camera or size)
+    _view = None  # (camera, size) of the last viewport frame started
+    _runs = 0
 
     # ------------------------------------------------------------ final render (F12)
 
@@ -67,9 +71,10 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
         try:
             with tempfile.TemporaryDirectory(prefix="sunbeam-render-") as tmp:
                 camera = export.camera_from_object(scene, scene.camera, warnings)
-                scene_json = export.write_scene(
-                    depsgraph, camera, (width, height), tmp, "sunbeam-eval", self.test_break,
-                    self._progress, warnings)
+                doc = export.build_scene(depsgraph, tmp, "sunbeam-eval", self.test_break,
+                                         self._progress, warnings)
+                scene_json = export.save_scene(doc, camera, (width, height),
+                                               os.path.join(tmp, "scene.json"))
                 frame = os.path.join(tmp, "frame.exr")
                 self._progress(0.5, f"sunbeam-eval render: {width} x {height}, {samples} samples")
                 tools.run("sunbeam-eval", ["render", scene_json, "-o", frame, "-q",
@@ -104,41 +109,50 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
         self.update_stats("Sunbeam", text)
 
     # ------------------------------------------------------------ viewport (rendered mode)
+    #
+    # view_update (a scene edit) exports and bakes in the main thread, into a folder kept while
+    # the viewport renders; view_draw (also each view change) runs sunbeam-play on that export
+    # with the view's camera in a worker thread and draws the last finished frame.
 
     def view_update(self, context, depsgraph):
-        self._start_preview(context, depsgraph)
-
-    def _start_preview(self, context, depsgraph):
-        """Export in this (the main) thread, then run sunbeam-play in a worker thread."""
+        if self._doc is not None and not any(
+                u.is_updated_geometry or u.is_updated_transform or u.is_updated_shading
+                for u in depsgraph.updates):
+            return  # e.g. a selection change (the export's own included): nothing to redo
         self._cancel_preview()
-        region, rv3d, space = context.region, context.region_data, context.space_data
+        if self._export_dir is not None:
+            self._export_dir.cleanup()
+        self._export_dir = tempfile.TemporaryDirectory(prefix="sunbeam-view-")
+        self._doc, self._view = None, None
+        try:
+            self._doc = export.build_scene(depsgraph, self._export_dir.name, "sunbeam-play",
+                                           lambda: False, lambda *_: None, [])
+        except SunbeamError as e:
+            self.report({"ERROR"}, str(e))
+            self.update_stats("Sunbeam", str(e))
+
+    def _view_camera(self, context):
+        region, rv3d = context.region, context.region_data
         if not rv3d.is_perspective:
-            self.report({"ERROR"}, "Viewport: Sunbeam renders perspective views only")
-            return
+            raise SunbeamError("Viewport: Sunbeam renders perspective views only")
         inv = rv3d.view_matrix.inverted()
         fov = 2.0 * math.degrees(math.atan(1.0 / rv3d.window_matrix[1][1]))
-        size = (region.width, region.height)
-        holder = {"cancel": False, "frame": None, "error": None,
-                  "tmp": tempfile.TemporaryDirectory(prefix="sunbeam-view-")}
-        warnings = []
-        try:
-            camera = export.view_camera(inv.translation, inv.to_3x3() @ Vector((0, 0, -1)),
-                                        inv.to_3x3() @ Vector((0, 1, 0)), fov,
-                                        space.clip_start, "Viewport")
-            scene_json = export.write_scene(depsgraph, camera, size, holder["tmp"].name,
-                                            "sunbeam-play", lambda: holder["cancel"],
-                                            lambda *_: None, warnings)
-        except SunbeamError as e:
-            holder["tmp"].cleanup()
-            self.report({"ERROR"}, str(e))
-            return
-        frames = depsgraph.scene.sunbeam.preview_frames
+        camera = export.view_camera(inv.translation, inv.to_3x3() @ Vector((0, 0, -1)),
+                                    inv.to_3x3() @ Vector((0, 1, 0)), fov,
+                                    context.space_data.clip_start, "Viewport")
+        return camera, (region.width, region.height)
+
+    def _start_preview(self, camera, size, frames):
+        self._cancel_preview()
+        self._runs += 1
+        holder = {"cancel": False, "frame": None, "error": None}
+        scene_json = export.save_scene(self._doc, camera, size,
+                                       os.path.join(self._export_dir.name, "view.json"))
+        frame = os.path.join(self._export_dir.name, f"view{self._runs}.exr")
 
         def work():
-            frame = os.path.join(holder["tmp"].name, "frame.exr")
             try:
-                tools.run("sunbeam-play", [scene_json, "--headless", "-o", frame, "-q",
-                                           "--frames", str(frames)], lambda: holder["cancel"])
+                preview_frame(scene_json, frame, frames, lambda: holder["cancel"])
                 holder["frame"] = frame
             except Cancelled:
                 pass
@@ -154,10 +168,18 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
             thread, holder = self._preview
             holder["cancel"] = True
             thread.join()
-            holder["tmp"].cleanup()
             self._preview = None
 
     def view_draw(self, context, depsgraph):
+        if self._doc is not None:
+            try:
+                view = self._view_camera(context)
+            except SunbeamError as e:
+                self.update_stats("Sunbeam", str(e))
+                view = None
+            if view is not None and view != self._view:
+                self._view = view
+                self._start_preview(*view, depsgraph.scene.sunbeam.preview_frames)
         if self._preview:
             thread, holder = self._preview
             if thread.is_alive():
@@ -167,10 +189,11 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
                 self._preview = None
                 if holder["error"]:
                     self.report({"ERROR"}, holder["error"])
+                    self.update_stats("Sunbeam", holder["error"])
                 elif holder["frame"]:
                     self._texture = _frame_texture(holder["frame"])
+                    os.remove(holder["frame"])
                     self.update_stats("Sunbeam", "Preview done")
-                holder["tmp"].cleanup()
         if self._texture is None:
             return
         gpu.state.blend_set("ALPHA_PREMULT")
@@ -178,6 +201,12 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
         draw_texture_2d(self._texture, (0, 0), context.region.width, context.region.height)
         self.unbind_display_space_shader()
         gpu.state.blend_set("NONE")
+
+
+def preview_frame(scene_json, frame, frames, cancelled):
+    """The viewport's frame: sunbeam-play's headless linear EXR of `scene_json`."""
+    tools.run("sunbeam-play", [scene_json, "--headless", "-o", frame, "-q", "--frames", str(frames)],
+              cancelled)
 
 
 def get_panels():

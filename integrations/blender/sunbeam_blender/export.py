@@ -415,20 +415,25 @@ def check_tools(jobs, renderer):
             break
 
 
-def write_scene(depsgraph, camera, size, tmp, renderer, cancelled, progress, warnings):
-    """Check, export, bake and write `tmp`/scene.json; its path. `progress(fraction, text)`."""
+def build_scene(depsgraph, tmp, renderer, cancelled, progress, warnings):
+    """Check, then export and bake into `tmp`: the scene document without camera and size.
+    `progress(fraction, text)` is told each mesh."""
     jobs = mesh_jobs(depsgraph, warnings)
     check_tools(jobs, renderer)
-    scene = depsgraph.scene
-    environment, background = world(scene, tmp, warnings)
-    doc = {"camera": camera, "lights": lights(depsgraph, bounds_centre(jobs), warnings),
-           "meshes": [], "exposure": 0, "background": background, "size": list(size)}
+    environment, background = world(depsgraph.scene, tmp, warnings)
+    doc = {"lights": lights(depsgraph, bounds_centre(jobs), warnings), "meshes": [],
+           "exposure": 0, "background": background}
     if environment:
         doc["environment"] = environment
     for i, job in enumerate(jobs):
         progress(0.5 * i / len(jobs), f"Exporting and baking {job.obj.name}")
         doc["meshes"].append(mesh_entry(job, bake(depsgraph, job, tmp, i, cancelled)))
-    path = os.path.join(tmp, "scene.json")
-    with open(path, "w") as f:
-        json.dump(doc, f, indent=1)
+    return doc
+
+
+def save_scene(doc, camera, size, path):
+    """`doc` seen by `camera` at `size` as scene JSON at `path` (a temporary name, then a rename)."""
+    with open(path + ".part", "w") as f:
+        json.dump({**doc, "camera": camera, "size": list(size)}, f, indent=1)
+    os.replace(path + ".part", path)
     return path
