@@ -13,10 +13,12 @@ SUNBEAM_REQUIRE_ALL=1. SUNBEAM_BLENDER_IMG=DIR also writes the rendered frames t
 """
 
 import ast
+import json
 import math
 import os
 import re
 import shutil
+import struct
 import subprocess
 import sys
 import tempfile
@@ -261,7 +263,6 @@ class RenderTest(unittest.TestCase):
             "exposure": 0, "background": [0, 0, 0], "size": [64 * SCALE, 48 * SCALE],
         }
         self.assertAlmostEqual(skin.ior, 1.6, places=5)
-        import json
         (WORK / "ref.json").write_text(json.dumps(ref))
         report = tool("sunbeam-eval", "render", WORK / "ref.json", "-o", WORK / "ref.exr", "--samples", "4",
                       "--compare", addon_frame)
@@ -416,6 +417,14 @@ class OperatorTest(unittest.TestCase):
             self.assertEqual(data[:4], b"glTF")
             self.assertIn(b"_ORIENTATION", data)
             self.assertIn(b"SUNBEAM_materials_diffraction", data)
+            (json_len,) = struct.unpack_from("<I", data, 12)
+            doc = json.loads(data[20:20 + json_len])
+            ext = next(m["extensions"]["SUNBEAM_materials_diffraction"] for m in doc["materials"]
+                       if "SUNBEAM_materials_diffraction" in m.get("extensions", {}))
+            packs = [v for v in json.dumps(ext).split('"') if v.endswith(".ktx2")]
+            self.assertTrue(packs, ext)
+            for pack in packs:  # paths relative to the GLB: they must lead to the pack
+                self.assertTrue((out.parent / pack).is_file(), f"{pack} from {out}")
 
 
 class ViewportTest(unittest.TestCase):

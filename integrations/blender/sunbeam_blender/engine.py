@@ -24,9 +24,9 @@ from .tools import Cancelled, SunbeamError
 VIEWPORT_IMAGE = "Sunbeam Viewport"
 
 
-def _square_root(n):
+def _is_square(n):
     root = int(round(n ** 0.5))
-    return root if root * root == n else None
+    return root * root == n
 
 
 def _frame_texture(path):
@@ -62,7 +62,7 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
     def render(self, depsgraph):
         scene = depsgraph.scene
         samples = scene.sunbeam.samples
-        if _square_root(samples) is None:
+        if not _is_square(samples):
             self.report({"ERROR"}, f"Render Properties > Sunbeam > Samples: {samples} is not a "
                         "square number (1, 4, 9, 16, ...)")
             return
@@ -83,7 +83,7 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
                 self._progress(1.0, "Done")
         except Cancelled:
             return
-        except SunbeamError as e:
+        except (SunbeamError, OSError) as e:
             self.report({"ERROR"}, str(e))
             return
         for w in warnings:

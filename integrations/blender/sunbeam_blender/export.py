@@ -346,11 +346,15 @@ def _export_glb(obj, path):
         for o in selected:
             o.select_set(False)
         obj.select_set(True)
-        bpy.ops.export_scene.gltf(
-            filepath=path, export_format="GLB", use_selection=True, export_apply=True,
-            export_yup=True, export_texcoords=True, export_normals=True, export_materials="NONE",
-            export_cameras=False, export_lights=False, export_animations=False, export_skins=False,
-            export_morph=False, export_extras=False, will_save_settings=False)
+        try:
+            bpy.ops.export_scene.gltf(
+                filepath=path, export_format="GLB", use_selection=True, export_apply=True,
+                export_yup=True, export_texcoords=True, export_normals=True,
+                export_materials="NONE", export_cameras=False, export_lights=False,
+                export_animations=False, export_skins=False, export_morph=False,
+                export_extras=False, will_save_settings=False)
+        except RuntimeError as e:
+            raise SunbeamError(f"Object '{obj.name}': glTF export: {e}") from None
     finally:
         obj.select_set(False)
         for o in selected:
@@ -359,8 +363,10 @@ def _export_glb(obj, path):
         raise SunbeamError(f"Object '{obj.name}': the glTF exporter wrote nothing")
 
 
-def bake(depsgraph, job, tmp, index, cancelled):
-    """Export `job`'s object and, for a Sunbeam material, bake its orientation field: the GLB path."""
+def bake(depsgraph, job, tmp, index, cancelled, out=None):
+    """Export `job`'s object into `tmp` and, with bake flags, bake its orientation field (into
+    `out` if given: sunbeam-bake writes atomically, and paths it writes are relative to the
+    output): the GLB's path."""
     exported = os.path.join(tmp, f"mesh{index}.glb")
     _export_glb(job.obj, exported)
     if job.bake_args is None:
@@ -371,7 +377,7 @@ def bake(depsgraph, job, tmp, index, cancelled):
         with open(spine, "w") as f:
             json.dump({"points": job.spine}, f)
         args[args.index(SPINE)] = spine
-    baked = os.path.join(tmp, f"mesh{index}-baked.glb")
+    baked = out or os.path.join(tmp, f"mesh{index}-baked.glb")
     try:
         tools.run("sunbeam-bake", [exported, "-o", baked, "-q", *args], cancelled)
     except SunbeamError as e:

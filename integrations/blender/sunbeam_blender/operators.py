@@ -105,7 +105,7 @@ class SUNBEAM_OT_import_scan(bpy.types.Operator, ImportHelper):
                 _commit(tmp, names, folder)
             finally:
                 shutil.rmtree(tmp, ignore_errors=True)
-        except SunbeamError as e:
+        except (SunbeamError, OSError) as e:
             self.report({"ERROR"}, f"Import '{os.path.basename(scan)}': {e}")
             return {"CANCELLED"}
         pack = os.path.join(folder, names[1])
@@ -178,10 +178,8 @@ class SUNBEAM_OT_bake_orientation(bpy.types.Operator, ExportHelper):
             job = export.MeshJob(obj, mat, args, spine)
             tools.find_tool("sunbeam-bake")
             with tempfile.TemporaryDirectory(prefix="sunbeam-bake-") as tmp:
-                baked = export.bake(depsgraph, job, tmp, 0, lambda: False)
-                shutil.move(baked, out + ".part")
-                os.replace(out + ".part", out)
-        except SunbeamError as e:
+                export.bake(depsgraph, job, tmp, 0, lambda: False, out)
+        except (SunbeamError, OSError) as e:
             self.report({"ERROR"}, str(e) if str(e).startswith("Object") else f"Object '{obj.name}': {e}")
             return {"CANCELLED"}
         self.report({"INFO"}, f"Wrote {out}")
