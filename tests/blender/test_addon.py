@@ -25,6 +25,7 @@ import tempfile
 import time
 import unittest
 from pathlib import Path
+from types import SimpleNamespace
 
 import bpy
 import numpy as np
@@ -324,6 +325,25 @@ class CameraTest(unittest.TestCase):
 
     def test_horizontal_fit_portrait(self):
         self.check((500, 1000), 100, "HORIZONTAL", 5.0, 85.0)
+
+
+    def test_viewport_camera(self):
+        """The viewport's camera from its matrices, here those of a camera looking through it."""
+        from sunbeam_blender import engine
+        scene = empty_scene(64, 48)
+        cam = add_camera(scene, (1.2, -3.0, 1.5), (0.1, 0.2, 0.0), lens=35.0, roll_deg=10.0)
+        window = cam.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=64, y=48)
+        context = SimpleNamespace(
+            region=SimpleNamespace(width=64, height=48),
+            region_data=SimpleNamespace(is_perspective=True, view_matrix=cam.matrix_world.inverted(),
+                                        window_matrix=window),
+            space_data=SimpleNamespace(clip_start=cam.data.clip_start))
+        camera, size = engine.viewport_camera(context)
+        for p in self.MARKERS:
+            ndc = world_to_camera_view(scene, cam, Vector(p))
+            blender = (ndc.x * size[0], (1 - ndc.y) * size[1])
+            for a, b in zip(blender, sunbeam_projection(camera, size, p)):
+                self.assertLess(abs(a - b), 0.5)
 
 
 class BadInputTest(unittest.TestCase):

@@ -131,17 +131,6 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
             self.report({"ERROR"}, str(e))
             self.update_stats("Sunbeam", str(e))
 
-    def _view_camera(self, context):
-        region, rv3d = context.region, context.region_data
-        if not rv3d.is_perspective:
-            raise SunbeamError("Viewport: Sunbeam renders perspective views only")
-        inv = rv3d.view_matrix.inverted()
-        fov = 2.0 * math.degrees(math.atan(1.0 / rv3d.window_matrix[1][1]))
-        camera = export.view_camera(inv.translation, inv.to_3x3() @ Vector((0, 0, -1)),
-                                    inv.to_3x3() @ Vector((0, 1, 0)), fov,
-                                    context.space_data.clip_start, "Viewport")
-        return camera, (region.width, region.height)
-
     def _start_preview(self, camera, size, frames):
         self._cancel_preview()
         self._runs += 1
@@ -173,7 +162,7 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
     def view_draw(self, context, depsgraph):
         if self._doc is not None:
             try:
-                view = self._view_camera(context)
+                view = viewport_camera(context)
             except SunbeamError as e:
                 self.update_stats("Sunbeam", str(e))
                 view = None
@@ -201,6 +190,19 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
         draw_texture_2d(self._texture, (0, 0), context.region.width, context.region.height)
         self.unbind_display_space_shader()
         gpu.state.blend_set("NONE")
+
+
+def viewport_camera(context):
+    """The scene camera and frame size of a 3D viewport (its view and projection matrices)."""
+    region, rv3d = context.region, context.region_data
+    if not rv3d.is_perspective:
+        raise SunbeamError("Viewport: Sunbeam renders perspective views only")
+    inv = rv3d.view_matrix.inverted()
+    fov = 2.0 * math.degrees(math.atan(1.0 / rv3d.window_matrix[1][1]))
+    camera = export.view_camera(inv.translation, inv.to_3x3() @ Vector((0, 0, -1)),
+                                inv.to_3x3() @ Vector((0, 1, 0)), fov,
+                                context.space_data.clip_start, "Viewport")
+    return camera, (region.width, region.height)
 
 
 def preview_frame(scene_json, frame, frames, cancelled):
