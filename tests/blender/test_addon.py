@@ -25,7 +25,7 @@ import tempfile
 import time
 import unittest
 from pathlib import Path
-from types import SimpleNamespace
+from types import MethodType, SimpleNamespace
 
 import bpy
 import numpy as np
@@ -449,23 +449,36 @@ class OperatorTest(unittest.TestCase):
 
 class ViewportTest(unittest.TestCase):
     def test_the_viewport_path_renders_the_export_with_the_player(self):
-        """What the viewport's rendered mode runs (view_update's export, view_draw's
-        sunbeam-play), minus the drawing, which needs a window."""
-        from sunbeam_blender import engine, export
+        """The viewport's export (what view_update's timer runs) and its sunbeam-play run (what
+        view_draw starts), on a stand-in for the engine: bpy has no window, so neither the
+        timer nor the drawing can run here."""
+        from sunbeam_blender import engine
         scene = empty_scene(48, 48)
         sunbeam_skin(add_sphere(scene))
         cam = add_camera(scene, (0.0, -2.5, 0.4), (0.0, 0.0, 0.0))
         sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
         scene.collection.objects.link(sun)
         sun.rotation_euler = (0.7, 0.0, 0.3)
-        with tempfile.TemporaryDirectory() as tmp:
-            doc = export.build_scene(bpy.context.evaluated_depsgraph_get(), tmp, "sunbeam-play",
-                                     lambda: False, lambda *_: None, [])
-            path = export.save_scene(doc, export.camera_from_object(scene, cam, []), (48, 48),
-                                     os.path.join(tmp, "view.json"))
-            frame = os.path.join(tmp, "view.exr")
-            engine.preview_frame(path, frame, 2, lambda: False)
-            lit = (linear_pixels(frame).sum(-1) > 0).sum()
+        bpy.context.view_layer.update()
+        stand_in = SimpleNamespace(_preview=None, _export_dir=None, _doc=None, _runs=0, reports=[])
+        stand_in.report = lambda _kind, message: stand_in.reports.append(message)
+        stand_in.update_stats = stand_in.tag_redraw = lambda *_: None
+        for name in ("_cancel_preview", "_start_preview", "_export_viewport"):
+            setattr(stand_in, name, MethodType(getattr(engine.SunbeamRenderEngine, name), stand_in))
+        stand_in._export_viewport()
+        self.assertEqual(stand_in.reports, [])
+        window = cam.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=48, y=48)
+        context = SimpleNamespace(
+            region=SimpleNamespace(width=48, height=48),
+            region_data=SimpleNamespace(is_perspective=True, view_matrix=cam.matrix_world.inverted(),
+                                        window_matrix=window),
+            space_data=SimpleNamespace(clip_start=cam.data.clip_start))
+        stand_in._start_preview(*engine.viewport_camera(context), 2)
+        thread, holder = stand_in._preview
+        thread.join()
+        self.assertIsNone(holder["error"])
+        lit = (linear_pixels(holder["frame"]).sum(-1) > 0).sum()
+        stand_in._export_dir.cleanup()
         self.assertGreater(lit, 400)
 
     def test_cancel_kills_the_child(self):

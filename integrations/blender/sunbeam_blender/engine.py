@@ -54,6 +54,7 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
     _texture = None  # the last finished viewport frame
     _export_dir = None  # the viewport's exported meshes and World
     _doc = None  # their scene document (no camera or size)
+    _exported = False  # an export was started for the scene as it is
     _view = None  # (camera, size) of the last viewport frame started
     _runs = 0
 
@@ -110,26 +111,42 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
 
     # ------------------------------------------------------------ viewport (rendered mode)
     #
-    # view_update (a scene edit) exports and bakes in the main thread, into a folder kept while
-    # the viewport renders; view_draw (also each view change) runs sunbeam-play on that export
-    # with the view's camera in a worker thread and draws the last finished frame.
+    # view_update (a scene edit) schedules the export and bake: a timer runs it in the main
+    # thread outside drawing, where operators (the glTF exporter) and selection changes are
+    # allowed; it writes into a folder kept while the viewport renders. view_draw (also each
+    # view change) runs sunbeam-play on that export with the view's camera in a worker thread
+    # and draws the last finished frame.
 
     def view_update(self, context, depsgraph):
-        if self._doc is not None and not any(
+        if self._exported and not any(
                 u.is_updated_geometry or u.is_updated_transform or u.is_updated_shading
                 for u in depsgraph.updates):
             return  # e.g. a selection change (the export's own included): nothing to redo
         self._cancel_preview()
+        self._exported, self._doc, self._view = True, None, None
+        engine = self
+
+        def export_later():
+            try:
+                engine._export_viewport()
+            except ReferenceError:
+                pass  # the viewport left rendered mode before the timer ran
+            return None  # once
+
+        bpy.app.timers.register(export_later)
+
+    def _export_viewport(self):
         if self._export_dir is not None:
             self._export_dir.cleanup()
         self._export_dir = tempfile.TemporaryDirectory(prefix="sunbeam-view-")
-        self._doc, self._view = None, None
         try:
-            self._doc = export.build_scene(depsgraph, self._export_dir.name, "sunbeam-play",
+            self._doc = export.build_scene(bpy.context.evaluated_depsgraph_get(),
+                                           self._export_dir.name, "sunbeam-play",
                                            lambda: False, lambda *_: None, [])
         except SunbeamError as e:
             self.report({"ERROR"}, str(e))
             self.update_stats("Sunbeam", str(e))
+        self.tag_redraw()
 
     def _start_preview(self, camera, size, frames):
         self._cancel_preview()
