@@ -338,27 +338,32 @@ def mesh_jobs(depsgraph, warnings):
     return jobs
 
 
-def _export_glb(obj, path):
-    """`obj` alone as GLB by Blender's glTF exporter (modifiers applied, +Y up, UVs kept)."""
-    view_layer = bpy.context.view_layer
-    selected = [o for o in view_layer.objects if o.select_get()]
+def _export_glb(depsgraph, obj, path):
+    """`obj` alone as GLB by Blender's glTF exporter (modifiers applied, +Y up, UVs kept).
+
+    The scene and view layer come from `depsgraph`, not from bpy.context, which a final
+    render's thread may not have: they are passed to the exporter by a context override, and
+    the selection it exports is set (and restored) on that view layer."""
+    scene, view_layer = depsgraph.scene, depsgraph.view_layer
+    selected = [o for o in view_layer.objects if o.select_get(view_layer=view_layer)]
     try:
         for o in selected:
-            o.select_set(False)
-        obj.select_set(True)
+            o.select_set(False, view_layer=view_layer)
+        obj.select_set(True, view_layer=view_layer)
         try:
-            bpy.ops.export_scene.gltf(
-                filepath=path, export_format="GLB", use_selection=True, export_apply=True,
-                export_yup=True, export_texcoords=True, export_normals=True,
-                export_materials="NONE", export_cameras=False, export_lights=False,
-                export_animations=False, export_skins=False, export_morph=False,
-                export_extras=False, will_save_settings=False)
+            with bpy.context.temp_override(scene=scene, view_layer=view_layer):
+                bpy.ops.export_scene.gltf(
+                    filepath=path, export_format="GLB", use_selection=True, export_apply=True,
+                    export_yup=True, export_texcoords=True, export_normals=True,
+                    export_materials="NONE", export_cameras=False, export_lights=False,
+                    export_animations=False, export_skins=False, export_morph=False,
+                    export_extras=False, will_save_settings=False)
         except RuntimeError as e:
             raise SunbeamError(f"Object '{obj.name}': glTF export: {e}") from None
     finally:
-        obj.select_set(False)
+        obj.select_set(False, view_layer=view_layer)
         for o in selected:
-            o.select_set(True)
+            o.select_set(True, view_layer=view_layer)
     if not os.path.isfile(path):
         raise SunbeamError(f"Object '{obj.name}': the glTF exporter wrote nothing")
 
@@ -368,7 +373,7 @@ def bake(depsgraph, job, tmp, index, cancelled, out=None):
     `out` if given: sunbeam-bake writes atomically, and paths it writes are relative to the
     output): the GLB's path."""
     exported = os.path.join(tmp, f"mesh{index}.glb")
-    _export_glb(job.obj, exported)
+    _export_glb(depsgraph, job.obj, exported)
     if job.bake_args is None:
         return exported
     args = list(job.bake_args)
