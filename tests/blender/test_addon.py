@@ -115,7 +115,7 @@ def add_camera(scene, location, target, lens=50.0, fit="AUTO", roll_deg=0.0):
     return cam
 
 
-def add_sphere(scene, uvs=True):
+def add_sphere(uvs=True):
     bpy.ops.mesh.primitive_uv_sphere_add(segments=32, ring_count=16, radius=0.5, calc_uvs=uvs)
     sphere = bpy.context.active_object
     sphere.name = "Sphere"
@@ -131,7 +131,7 @@ def sunbeam_skin(sphere):
 
 
 def render_to(scene, path):
-    """F12 with the Sunbeam engine, the result saved as a linear float EXR."""
+    """F12 with the scene's engine, the result saved as a linear float EXR."""
     scene.render.filepath = str(path)
     settings = scene.render.image_settings
     settings.file_format, settings.color_depth, settings.exr_codec = "OPEN_EXR", "32", "NONE"
@@ -181,7 +181,7 @@ class RenderTest(unittest.TestCase):
     def white_sphere_scene(self):
         """A white Diffuse BSDF sphere (no pack: Sunbeam's Lambert base) before a camera."""
         scene = empty_scene(64 * SCALE, 48 * SCALE)
-        sphere = add_sphere(scene)
+        sphere = add_sphere()
         bpy.ops.object.shade_smooth()
         mat = bpy.data.materials.new("White")
         mat.use_nodes = True
@@ -247,7 +247,7 @@ class RenderTest(unittest.TestCase):
         if not HDRI.is_file():
             missing(f"no {HDRI}")
         scene = empty_scene(128 * SCALE, 96 * SCALE, 50)  # 64 x 48: the percentage counts
-        sphere = add_sphere(scene)
+        sphere = add_sphere()
         skin = sunbeam_skin(sphere)
         eye = (0.4, -2.6, 0.9)
         add_camera(scene, eye, (0.0, 0.0, 0.0), lens=50.0)
@@ -373,7 +373,7 @@ class BadInputTest(unittest.TestCase):
 
     def sphere_scene(self, uvs=True):
         scene = empty_scene(32, 32)
-        sphere = add_sphere(scene, uvs)
+        sphere = add_sphere(uvs)
         sunbeam_skin(sphere)
         add_camera(scene, (0, -3, 0), (0, 0, 0))
         return scene, sphere
@@ -434,7 +434,7 @@ class BadInputTest(unittest.TestCase):
 class OperatorTest(unittest.TestCase):
     def test_import_scan_makes_and_assigns_a_pack(self):
         scene = empty_scene(32, 32)
-        sphere = add_sphere(scene)
+        sphere = add_sphere()
         out = WORK / "import"
         out.mkdir()
         bpy.ops.sunbeam.import_scan(filepath=str(WORK / "skin.exr"), output_folder=str(out),
@@ -446,7 +446,7 @@ class OperatorTest(unittest.TestCase):
 
     def test_bake_sources_write_a_glb_with_the_orientation(self):
         scene = empty_scene(32, 32)
-        sphere = add_sphere(scene)
+        sphere = add_sphere()
         sunbeam_skin(sphere)
         bpy.ops.curve.primitive_bezier_curve_add()
         spine = bpy.context.active_object
@@ -476,7 +476,7 @@ class ViewportTest(unittest.TestCase):
         timer nor the drawing can run here."""
         from sunbeam_blender import engine
         scene = empty_scene(48, 48)
-        sunbeam_skin(add_sphere(scene))
+        sunbeam_skin(add_sphere())
         cam = add_camera(scene, (0.0, -2.5, 0.4), (0.0, 0.0, 0.0))
         sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
         scene.collection.objects.link(sun)
