@@ -433,7 +433,7 @@ class BadInputTest(unittest.TestCase):
 
 class OperatorTest(unittest.TestCase):
     def test_import_scan_makes_and_assigns_a_pack(self):
-        scene = empty_scene(32, 32)
+        empty_scene(32, 32)
         sphere = add_sphere()
         out = WORK / "import"
         out.mkdir()
@@ -445,7 +445,7 @@ class OperatorTest(unittest.TestCase):
         self.assertEqual(Path(mat.sunbeam.pack), out / "skin.ktx2")
 
     def test_bake_sources_write_a_glb_with_the_orientation(self):
-        scene = empty_scene(32, 32)
+        empty_scene(32, 32)
         sphere = add_sphere()
         sunbeam_skin(sphere)
         bpy.ops.curve.primitive_bezier_curve_add()
