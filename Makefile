@@ -13,7 +13,7 @@ BIN = $(TARGET_DIR)/$(PROFILE_DIR)
 # Goals of examples/Makefile for `make demo` (default: all of it).
 DEMO_GOALS ?=
 
-.PHONY: all build demo test deps clean
+.PHONY: all build demo test deps clean blender-addon blender-docs-img
 
 # wgpu's GL/Wayland probing complains without a runtime dir; give tests a private one.
 XDG_RUNTIME_DIR ?= $(shell d=$${TMPDIR:-/tmp}/sunbeam-xdg-$$(id -u); mkdir -p -m 700 $$d && echo $$d)
@@ -35,6 +35,17 @@ demo: deps build
 test: deps
 	$(CARGO) build $(CARGO_FLAGS) --workspace --all-targets
 	$(CARGO) test $(CARGO_FLAGS) --workspace --no-fail-fast
+	SUNBEAM_BIN='$(BIN)' tests/blender/run.sh
+
+# The Blender add-on as an installable zip (docs/BLENDER.md), byte-identical for the same sources.
+BLENDER_ZIP ?= target/blender/sunbeam_blender.zip
+blender-addon:
+	mkdir -p $(dir $(BLENDER_ZIP))
+	scripts/blender-addon-zip.py $(BLENDER_ZIP)
+
+# docs/img/blender-*.png: the add-on's test render and its hand-written reference (docs/BLENDER.md).
+blender-docs-img: deps
+	SUNBEAM_BIN='$(BIN)' SUNBEAM_BLENDER_IMG=docs/img tests/blender/run.sh RenderTest
 
 clean:
 	$(CARGO) clean

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Install what `make test` / `make demo` need when it is missing: Debian packages
 # (software Vulkan/GL drivers, Xvfb, OpenEXR tools, Ninja, glslang and SPIRV-Tools, Chromium) and the
-# npm packages (glTF-Validator, three.js, playwright-core) under tests/node. Idempotent; quiet when all is there.
+# npm packages (glTF-Validator, three.js, playwright-core) under tests/node, and Blender as a Python module
+# for the add-on's tests (scripts/ensure-bpy.sh). Idempotent; quiet when all is there.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -22,4 +23,10 @@ if [ -f tests/node/package.json ] && { [ ! -d tests/node/node_modules ] || [ ! -
   command -v npm >/dev/null || { echo "ensure-deps: npm not found (apt-get install nodejs npm)" >&2; exit 1; }
   echo "ensure-deps: installing npm validators in tests/node" >&2
   (cd tests/node && for i in 1 2 3; do npm ci --no-audit --no-fund --loglevel=error && break; sleep 5; done)
+fi
+
+# bpy for tests/blender: a failed install fails CI (SUNBEAM_REQUIRE_ALL=1); elsewhere those tests skip.
+if ! scripts/ensure-bpy.sh; then
+  [ "${SUNBEAM_REQUIRE_ALL:-}" = 1 ] && exit 1
+  echo "ensure-deps: no bpy; tests/blender will skip" >&2
 fi
