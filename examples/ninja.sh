@@ -198,6 +198,8 @@ EOF
   echo "build $o/snake.glb: bake | $(path "$BIN/sunbeam-bake")"
   echo "  target = $(esc "$OUT/snake.glb")"
   echo "  tidy = $(esc "$OUT/.snake.glb").tmp.*"
+  # The last row of the sheet: the frames before the model's correction (examples/Makefile's BEFORE).
+  for m in elaphe xeno; do sheet_in="$sheet_in ../docs/img/demo-before-$m-point.png ../docs/img/demo-before-$m-sky.png"; done
   sheet_tool=${SHEET%% *}
   echo "build $o/contact-sheet.png: sheet$sheet_in | $(path "$sheet_tool")"
   echo "  target = $(esc "$OUT/contact-sheet.png")"
