@@ -9,6 +9,9 @@
 //! (`renderer::MATERIAL_WGSL`, the file the player and the export begin with)
 //! plus a small entry point, not a copy.
 
+mod common;
+
+use common::gpu;
 use sunbeam_common::rng::SplitMix64;
 use sunbeam_optics::gain::{self, Material, Reflectance};
 use sunbeam_optics::masking::Masking;
@@ -83,26 +86,6 @@ struct Out {
     t: [f32; 4],
     b: [f32; 4],
     n: [f32; 4],
-}
-
-fn gpu() -> Option<Gpu> {
-    let backend = std::env::var("SUNBEAM_TEST_BACKEND")
-        .ok()
-        .and_then(|b| b.parse().ok())
-        .unwrap_or_default();
-    match Gpu::headless(backend) {
-        Ok(g) => {
-            eprintln!("adapter: {}", g.describe());
-            Some(g)
-        }
-        Err(e) => {
-            if sunbeam_common::testdata::require_all() {
-                panic!("{e} (SUNBEAM_REQUIRE_ALL=1: CI needs a GPU adapter)");
-            }
-            eprintln!("SKIP: {e}");
-            None
-        }
-    }
 }
 
 /// A unit direction at polar cosine `c` and azimuth `phi`.
