@@ -543,7 +543,6 @@ fn xyz_to_rgb(c: vec3<f32>) -> vec3<f32> {
 // shading every covered sample; the frames' sub-pixel jitter moves the samples
 // over the pixel.
 fn covered_pick(covered: u32, u: f32) -> vec2<f32> {
-    let pos = array<vec2<f32>, 4>(vec2<f32>(-0.125, -0.375), vec2<f32>(0.375, -0.125), vec2<f32>(-0.375, 0.125), vec2<f32>(0.125, 0.375));
     let n = countOneBits(covered & 15u);
     if (n == 0u) {
         return vec2<f32>(0.0);
@@ -552,12 +551,52 @@ fn covered_pick(covered: u32, u: f32) -> vec2<f32> {
     for (var j = 0u; j < 4u; j = j + 1u) {
         if (((covered >> j) & 1u) == 1u) {
             if (k == 0u) {
-                return pos[j];
+                return msaa_position(j);
             }
             k = k - 1u;
         }
     }
     return vec2<f32>(0.0);
+}
+
+// One point light's radiance (linear RGB, before the exposure) at a point of
+// the surface with frame fr (columns t, b, n) seen along wr (world); the
+// response map's footprint from the screen derivatives of the pixel centre's
+// (u, v, w) (duv_*, dw_*) and texel coordinates (jx, jy).
+fn shade_light(i: u32, fr: mat3x3<f32>, wr: vec3<f32>, diffract: bool, dw: f32, duv_x: vec2<f32>, duv_y: vec2<f32>, dw_x: f32, dw_y: f32, jx: vec3<f32>, jy: vec3<f32>) -> vec3<f32> {
+    let t = fr[0];
+    let b = fr[1];
+    let n = fr[2];
+    let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
+    let wi = g.lights[i].xyz;
+    let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
+    let cos_i = max(wi_l.z, 0.0);
+    // The base gets what the skin does not reflect (PHYSICS.md 2).
+    let base_in = cos_i * sb_base_transmission(cos_i, mat.ior, diffract);
+    let uvw = -wi_l - wr_l;
+    var diff = vec3<f32>(0.0);
+    if (diffract && dw < 1.0 && wi_l.z > 0.0 && wr_l.z > 0.0) {
+        var xyz: vec3<f32>;
+        if (g.mode == 0u && mat.resp_on == 1u) {
+            // G is inside the footprint average; the masking, smooth over
+            // the footprint, at its centre
+            xyz = response_map_xyz(wi_l, uvw, vec3<f32>(duv_x, dw_x), vec3<f32>(duv_y, dw_y), jx, jy)
+                * masking(wi_l, wr_l);
+        } else if (g.mode == 0u && mat.tab_on == 1u) {
+            xyz = response_xyz(wi_l, wr_l) * gain(wi_l, wr_l);
+        } else {
+            xyz = diffraction_xyz(wi_l, wr_l) * gain(wi_l, wr_l);
+        }
+        diff = xyz_to_rgb(xyz);
+    }
+    return g.lights[i].w * (dw * mat.base.xyz * base_in + (1.0 - dw) * diff);
+}
+
+// The standard 4x MSAA sample positions (pixels from the centre; Vulkan,
+// D3D, Metal alike).
+fn msaa_position(j: u32) -> vec2<f32> {
+    let pos = array<vec2<f32>, 4>(vec2<f32>(-0.125, -0.375), vec2<f32>(0.375, -0.125), vec2<f32>(-0.375, 0.125), vec2<f32>(0.125, 0.375));
+    return pos[j];
 }
 
 @fragment
@@ -574,15 +613,32 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
     if (!diffract) {
         dw = 1.0;
     }
+    // The attributes' screen derivatives, in uniform control flow: they carry
+    // the attributes from the centre to a covered sample below.
+    let dworld_x = dpdx(in.world);
+    let dworld_y = dpdy(in.world);
+    let dnormal_x = dpdx(in.normal);
+    let dnormal_y = dpdy(in.normal);
+    let dtangent_x = dpdx(in.tangent);
+    let dtangent_y = dpdy(in.tangent);
+    // A partly covered pixel whose centre sees the surface at a grazing angle
+    // or from below (a silhouette, with MSAA) shades the point lights at each
+    // of its covered samples and takes their mean: the centre lies past the
+    // triangle there, where the attributes extrapolated along their
+    // derivatives tilt the normal beyond the limb (the base's cos(theta_i)
+    // too small, G's 1 / cos(theta_r) too large or the view below the
+    // horizon), while the resolve weighs the pixel by its covered samples and
+    // the reference shades each covered sub-pixel position (docs/PLAY.md
+    // "Where a pixel shades"; crates/sunbeam-render/tests/silhouette.rs).
+    let n_cov = countOneBits(covered & 15u);
+    let at_samples = g.msaa >= 4u && n_cov > 0u && n_cov < 4u && dot(wr, n) <= ENV_GRAZING_COS;
     var rgb = vec3<f32>(0.0);
     for (var i = 0u; i < g.n_lights; i = i + 1u) {
         let wi = g.lights[i].xyz;
         let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
-        let cos_i = max(wi_l.z, 0.0);
-        // The base gets what the skin does not reflect (PHYSICS.md 2).
-        let base_in = cos_i * sb_base_transmission(cos_i, mat.ior, diffract);
-        // Response-map coordinates and their screen derivatives, here in uniform
-        // control flow (derivatives are undefined inside the branch below).
+        // Response-map coordinates and their screen derivatives at the
+        // centre, here in uniform control flow (derivatives are undefined
+        // inside the branches of shade_light).
         let uvw = -wi_l - wr_l;
         let gr = resp_grid();
         let rc = sb_resp_coords(uvw, gr);
@@ -592,22 +648,23 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
         let dw_y = dpdy(uvw.z);
         let jx = vec3<f32>(sb_resp_dtheta(uvw.xy, duv_x, gr), dpdx(rc.y), dpdx(rc.z));
         let jy = vec3<f32>(sb_resp_dtheta(uvw.xy, duv_y, gr), dpdy(rc.y), dpdy(rc.z));
-        var diff = vec3<f32>(0.0);
-        if (diffract && dw < 1.0 && wi_l.z > 0.0 && wr_l.z > 0.0) {
-            var xyz: vec3<f32>;
-            if (g.mode == 0u && mat.resp_on == 1u) {
-                // G is inside the footprint average; the masking, smooth over
-                // the footprint, at its centre
-                xyz = response_map_xyz(wi_l, uvw, vec3<f32>(duv_x, dw_x), vec3<f32>(duv_y, dw_y), jx, jy)
-                    * masking(wi_l, wr_l);
-            } else if (g.mode == 0u && mat.tab_on == 1u) {
-                xyz = response_xyz(wi_l, wr_l) * gain(wi_l, wr_l);
-            } else {
-                xyz = diffraction_xyz(wi_l, wr_l) * gain(wi_l, wr_l);
+        if (at_samples) {
+            var acc = vec3<f32>(0.0);
+            for (var j = 0u; j < 4u; j = j + 1u) {
+                if (((covered >> j) & 1u) == 1u) {
+                    let o = msaa_position(j);
+                    let world_s = in.world + dworld_x * o.x + dworld_y * o.y;
+                    let fs = sb_frame(in.normal + dnormal_x * o.x + dnormal_y * o.y, in.tangent + dtangent_x * o.x + dtangent_y * o.y);
+                    let wr_s = normalize(g.eye.xyz - world_s);
+                    // each sample stands for a quarter of the pixel: half the
+                    // footprint along each axis
+                    acc = acc + shade_light(i, fs, wr_s, diffract, dw, 0.5 * duv_x, 0.5 * duv_y, 0.5 * dw_x, 0.5 * dw_y, 0.5 * jx, 0.5 * jy);
+                }
             }
-            diff = xyz_to_rgb(xyz);
+            rgb = rgb + acc / f32(n_cov);
+        } else {
+            rgb = rgb + shade_light(i, fr, wr, diffract, dw, duv_x, duv_y, dw_x, dw_y, jx, jy);
         }
-        rgb = rgb + g.lights[i].w * (dw * base * base_in + (1.0 - dw) * diff);
     }
     // The scene's environment (shaders/environment.wgsl): one Monte Carlo
     // estimate per frame, accumulated by the caller.
@@ -641,9 +698,9 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
             env_seed_at(vec2<u32>(in.clip.xy), envg.frame);
             off = covered_pick(covered, env_qmc(envg.frame + 1u, 31u));
         }
-        let world_c = in.world + dpdx(in.world) * off.x + dpdy(in.world) * off.y;
-        let normal_c = in.normal + dpdx(in.normal) * off.x + dpdy(in.normal) * off.y;
-        let tangent_c = in.tangent + dpdx(in.tangent) * off.x + dpdy(in.tangent) * off.y;
+        let world_c = in.world + dworld_x * off.x + dworld_y * off.y;
+        let normal_c = in.normal + dnormal_x * off.x + dnormal_y * off.y;
+        let tangent_c = in.tangent + dtangent_x * off.x + dtangent_y * off.y;
         let fc = sb_frame(normal_c, tangent_c);
         let wr_c = normalize(g.eye.xyz - world_c);
         let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));

@@ -213,36 +213,12 @@ fn lambert_mode_is_the_closed_form() {
 /// player's own 1x frame p99 < 2).
 fn response_map_at_scale(name: &str, n: usize, pixel: f64) {
     let Some(gpu) = gpu() else { return };
-    let f = sunbeam_synth::preset("xenopeltis", n, pixel).unwrap();
-    let fr = sunbeam_pack::build::FieldRef {
-        width: f.width,
-        height: f.height,
-        dx: f.dx,
-        dy: f.dy,
-        data: &f.data,
-    };
-    let pack = sunbeam_pack::build::build(fr, &Default::default(), &mut |_, _| {}).unwrap();
-    let mesh = sunbeam_frame::Mesh::uv_sphere(96, 48);
-    let mut scene = sunbeam_scene::Scene::default_lit(
-        "builtin:sphere".into(),
-        Some("pack".into()),
-        mesh.bounds(),
-        sunbeam_scene::DefaultLighting::Point,
-    );
-    scene.camera.eye = [0.0, 0.0, 1.6];
-    scene.camera.target = [0.0, 0.0, 0.0];
-    scene.lights[0].direction = [0.15, 0.1, 1.0];
-    scene.meshes[0].diffuse_weight = 0.1;
-    scene.size = [48, 48];
     // The frame as this test had it in the relative normalisation: the
     // diffraction as bright (the exposure) and the grey base as faint beside
     // it (its colour times F(0)). Brightened 25 times, the base's silhouette
     // alone (4x MSAA coverage against 16 samples per pixel) gave the 1x frame
     // p99 2.35, with p99 0.25 inside the silhouette.
-    scene.exposure += absolute_exposure();
-    let f0 = sunbeam_optics::gain::f0(sunbeam_optics::gain::DEFAULT_IOR);
-    scene.meshes[0].base_color = scene.meshes[0].base_color.map(|c| c * f0);
-    let p = fixtures::prepared(scene, mesh, Some(Arc::new(pack)));
+    let p = gpu::ridge_sphere(gpu::ridge_pack(n, pixel), 1.6, 48);
     let t = std::time::Instant::now();
     let reference = sunbeam_raster::render_prepared_linear(
         &p,
