@@ -101,7 +101,7 @@ pub struct Report {
     pub skipped_primitives: Vec<String>,
     pub warnings: Vec<String>,
     pub texture: Option<serde_json::Value>,
-    /// `--scales`: the tiling and its textures ([`crate::scales::ScaleReport`]).
+    /// `--scales`: the tiling and its textures (set by the caller that bakes them).
     pub scales: Option<serde_json::Value>,
 }
 
