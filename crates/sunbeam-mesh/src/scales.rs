@@ -302,6 +302,31 @@ pub struct ScaleReport {
     pub normal_map_bytes: usize,
     pub orientation_map_bytes: usize,
     pub uv_set: usize,
+    /// Fraction of the vertices whose baked field lies within 30 deg of +-u
+    /// (the tiling assumes u runs along the body; a low value warns).
+    pub field_along_u: f64,
+}
+
+/// Fraction of the vertices whose baked direction is within 30 deg of the
+/// direction of increasing u (either sign); 0 without UVs.
+pub fn field_along_u(work: &[Work]) -> f64 {
+    let (mut n, mut along) = (0usize, 0usize);
+    for w in work {
+        let Some(uw) = &w.u_world else { continue };
+        for (d, u) in w.dir.iter().zip(uw) {
+            if let (Some(d), Some(u)) = (d, u) {
+                n += 1;
+                if crate::geom::dot(*d, *u).abs() >= 30f64.to_radians().cos() {
+                    along += 1;
+                }
+            }
+        }
+    }
+    if n == 0 {
+        0.0
+    } else {
+        along as f64 / n as f64
+    }
 }
 
 /// Bake the maps into `doc`: images, a sampler and textures; every material
@@ -356,5 +381,6 @@ pub fn attach(
         normal_map_bytes: nm_png.len(),
         orientation_map_bytes: om_png.len(),
         uv_set,
+        field_along_u: field_along_u(work),
     })
 }

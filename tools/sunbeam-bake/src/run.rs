@@ -121,6 +121,12 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             cli.uv_set,
             ext,
         )?;
+        if rep.field_along_u < 0.5 {
+            baked.report.warnings.push(format!(
+                "--scales: the baked field runs along u at only {:.0} % of the vertices; the tiling assumes u runs along the body (docs/BAKE.md \"Scales\")",
+                100.0 * rep.field_along_u
+            ));
+        }
         baked.report.scales =
             Some(serde_json::to_value(rep).map_err(|e| Error::internal(e.to_string()))?);
     } else if let Some(ext) = ext {

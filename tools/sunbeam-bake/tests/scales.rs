@@ -55,6 +55,7 @@ fn scaled_snake_validates_and_every_texel_is_unit() {
     let sc = &rep["scales"];
     assert_eq!(sc["texels_per_scale_width"], 16, "{sc}");
     assert_eq!(sc["params"]["rows"], 20, "{sc}");
+    assert!(sc["field_along_u"].as_f64().unwrap() > 0.9, "{sc}");
     // The snake: 1 m long, ~0.17 m around at its widest: ~100-200 scales along.
     let along = sc["scales_along"].as_u64().unwrap();
     assert!((80..=250).contains(&along), "{sc}");
@@ -208,5 +209,19 @@ fn bad_input_is_refused_with_no_output() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("nouv.obj") && err.contains("UV"), "{err}");
     assert!(!out.exists());
+    // A field across u: baked, with a warning.
+    let quad = d.join("quad.obj");
+    std::fs::write(
+        &quad,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    let o = bake_env(
+        &[&s(&quad), "--axis", "0,1,0", "--scales", "-o", &s(&out)],
+        None,
+    );
+    ok(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("runs along u at only 0 %"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
