@@ -212,3 +212,69 @@ impl ScaleMaps {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn enc(x: f64) -> u8 {
+        ((0.5 + 0.5 * x) * 255.0).round() as u8
+    }
+
+    /// Two texels along u (ridges at +-40 deg, normals tilted +-x), one row
+    /// repeated around v: u clamps, v wraps with no seam.
+    fn maps() -> ScaleMaps {
+        let (a, n) = (40f64.to_radians(), 0.3f64);
+        let nz = (1.0 - n * n).sqrt();
+        let normal = Rgba8 {
+            size: [2, 2],
+            data: [[enc(n), 128, enc(nz), 255], [enc(-n), 128, enc(nz), 255]]
+                .repeat(2)
+                .concat(),
+            repeat: [false, true],
+        };
+        let orient = Rgba8 {
+            size: [2, 2],
+            data: [
+                [enc(a.cos()), enc(a.sin()), 255, 0],
+                [enc(a.cos()), enc(-a.sin()), 255, 1],
+            ]
+            .repeat(2)
+            .concat(),
+            repeat: [false, true],
+        };
+        ScaleMaps {
+            normal,
+            orient,
+            texcoord: 0,
+        }
+    }
+
+    #[test]
+    fn vectors_are_interpolated_and_renormalised() {
+        let m = maps();
+        let mid = m.sample([0.5, 0.25]);
+        // Halfway: the ridge vectors' mean points along +u, unit (an angle
+        // average would agree here; the length check is the vector's).
+        assert!((mid.ridge[0] - 1.0).abs() < 1e-9 && mid.ridge[1].abs() < 0.01);
+        let l = mid.normal.iter().map(|x| x * x).sum::<f64>().sqrt();
+        assert!((l - 1.0).abs() < 1e-12 && mid.normal[0].abs() < 0.01);
+        // At a texel centre, the texel's own value.
+        let c = m.sample([0.25, 0.25]);
+        assert!((c.ridge[1].atan2(c.ridge[0]).to_degrees() - 40.0).abs() < 0.5);
+        // u clamps at the borders.
+        assert_eq!(m.sample([0.0, 0.25]), m.sample([0.25, 0.25]));
+    }
+
+    #[test]
+    fn v_wraps_without_a_seam() {
+        let m = maps();
+        let a = m.sample([0.3, 1e-9]);
+        let b = m.sample([0.3, 1.0 - 1e-9]);
+        for k in 0..3 {
+            assert!((a.normal[k] - b.normal[k]).abs() < 1e-6);
+        }
+        assert!((a.mask - b.mask).abs() < 1e-6);
+        assert_eq!(m.sample([0.3, 0.1]), m.sample([0.3, 1.1]));
+    }
+}
