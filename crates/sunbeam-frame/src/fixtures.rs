@@ -130,6 +130,7 @@ pub fn prepared(scene: Scene, mesh: Mesh, pack: Option<Arc<Pack>>) -> Prepared {
         diffuse_weight: mi.diffuse_weight,
         masking: sunbeam_optics::masking::Masking::Off,
         skin: sunbeam_optics::gain::Material::default(),
+        scales: None,
     };
     Prepared {
         meshes: vec![(Arc::new(mesh), mat)],

@@ -11,11 +11,13 @@ pub mod diff;
 pub mod fixtures;
 pub mod image;
 pub mod linear;
+pub mod scales;
 pub mod spectral;
 
 pub use diff::ColourDiff;
 pub use image::{compare, Image};
 pub use linear::{compare_linear, LinearImage};
+pub use scales::{load_mesh_with_scales, MeshScales};
 pub use sunbeam_scene::geometry::Mesh;
 
 use std::any::Any;
@@ -37,6 +39,8 @@ pub struct Material {
     pub masking: Masking,
     /// The skin's interface: index and normalisation of `G` (scene `ior`, `reflectance`).
     pub skin: sunbeam_optics::gain::Material,
+    /// The mesh's scale maps (`sunbeam-bake --scales`; the reference applies them).
+    pub scales: Option<Arc<MeshScales>>,
 }
 
 /// A scene with its meshes and packs loaded (shared by both renderers).
@@ -86,7 +90,11 @@ pub fn load_mesh(path: &Path) -> Result<Mesh> {
     if let Some(b) = Mesh::builtin(path) {
         return b.map_err(Error::input);
     }
-    let tm = sunbeam_mesh::load_scene_mesh(path)?;
+    mesh_from_trimesh(sunbeam_mesh::load_scene_mesh(path)?, path)
+}
+
+/// The render mesh of a loaded scene mesh (its orientation field becomes `t`).
+pub(crate) fn mesh_from_trimesh(tm: sunbeam_mesh::TriMesh, path: &Path) -> Result<Mesh> {
     let tangents = tm
         .orientation
         .iter()
@@ -136,15 +144,16 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
         .map(load_environment)
         .transpose()?;
     let mut meshes = Vec::new();
-    let mut mesh_cache: Vec<(std::path::PathBuf, Arc<Mesh>)> = Vec::new();
+    type Loaded = (Arc<Mesh>, Option<Arc<MeshScales>>);
+    let mut mesh_cache: Vec<(std::path::PathBuf, Loaded)> = Vec::new();
     let mut pack_cache: Vec<(std::path::PathBuf, Arc<Pack>)> = Vec::new();
     for (i, mi) in scene.meshes.iter().enumerate() {
-        let mesh = match mesh_cache.iter().find(|(p, _)| *p == mi.mesh) {
+        let (mesh, scales) = match mesh_cache.iter().find(|(p, _)| *p == mi.mesh) {
             Some((_, m)) => m.clone(),
             None => {
-                let m = Arc::new(
-                    load_mesh(&mi.mesh).map_err(|e| e.context(format!("meshes[{i}].mesh")))?,
-                );
+                let (m, sc) = load_mesh_with_scales(&mi.mesh)
+                    .map_err(|e| e.context(format!("meshes[{i}].mesh")))?;
+                let m = (Arc::new(m), sc.map(Arc::new));
                 mesh_cache.push((mi.mesh.clone(), m.clone()));
                 m
             }
@@ -200,6 +209,7 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
                 diffuse_weight: mi.diffuse_weight,
                 masking,
                 skin,
+                scales,
             },
         ));
     }

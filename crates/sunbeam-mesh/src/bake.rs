@@ -37,6 +37,10 @@ pub struct BakeOptions {
     /// 3D samples farther than this from the surface are rejected; None: 2% of
     /// the bounding-box diagonal.
     pub max_snap: Option<f64>,
+    /// Write `TANGENT.xyz` as the UV frame (direction of increasing u, what
+    /// normal maps need, `--scales`) instead of the orientation field;
+    /// `_ORIENTATION` keeps the field either way.
+    pub uv_tangents: bool,
 }
 
 impl BakeOptions {
@@ -47,6 +51,7 @@ impl BakeOptions {
             uv_set: 0,
             interp: Interp::Natural,
             max_snap: None,
+            uv_tangents: false,
         }
     }
 }
@@ -96,6 +101,8 @@ pub struct Report {
     pub skipped_primitives: Vec<String>,
     pub warnings: Vec<String>,
     pub texture: Option<serde_json::Value>,
+    /// `--scales`: the tiling and its textures (set by the caller that bakes them).
+    pub scales: Option<serde_json::Value>,
 }
 
 /// Per-primitive working data, in world space.
@@ -738,6 +745,18 @@ fn finish_local(w: &mut Work) {
         .collect();
 }
 
+/// Unit direction of increasing u in each local tangent plane (the field where
+/// the UVs are degenerate); None without UVs.
+fn uv_tangents(w: &Work) -> Option<Vec<V3>> {
+    let uv = w.local.uvs.as_ref()?;
+    let (du, _) = crate::geom::uv_derivatives(&w.local.positions, uv, &w.local.triangles);
+    Some(
+        (0..w.t_local.len())
+            .map(|i| normalize(project(du[i], w.n_local[i])).unwrap_or(w.t_local[i]))
+            .collect(),
+    )
+}
+
 /// Bake and attach the attributes: the returned document is ready for [`Document::to_glb`].
 pub fn bake(mut doc: Document, opts: &BakeOptions) -> Result<Baked> {
     let (work, mut report) = compute(&doc, opts)?;
@@ -749,8 +768,14 @@ pub fn bake(mut doc: Document, opts: &BakeOptions) -> Result<Baked> {
             attrs.push(("NORMAL", doc.push_f32_accessor(&n, 3, false)));
             report.normals_written += 1;
         }
-        let t: Vec<f32> = w
-            .t_local
+        let uv_t = if opts.uv_tangents {
+            uv_tangents(w)
+        } else {
+            None
+        };
+        let t: Vec<f32> = uv_t
+            .as_ref()
+            .unwrap_or(&w.t_local)
             .iter()
             .zip(&w.w_sign)
             .flat_map(|(v, s)| [v[0] as f32, v[1] as f32, v[2] as f32, *s as f32])

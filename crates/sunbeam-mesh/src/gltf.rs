@@ -309,7 +309,7 @@ impl Document {
     }
 
     /// The bytes of a buffer view and its stride.
-    fn view_bytes(&self, bv: usize, what: &str) -> Result<(&[u8], Option<usize>)> {
+    pub fn view_bytes(&self, bv: usize, what: &str) -> Result<(&[u8], Option<usize>)> {
         let v = self
             .array("bufferViews")
             .get(bv)

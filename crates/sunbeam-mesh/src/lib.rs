@@ -46,6 +46,8 @@ pub mod gltf;
 pub mod nodes;
 pub mod obj;
 pub mod orient;
+pub mod scale_maps;
+pub mod scales;
 pub mod snake;
 pub mod texture;
 

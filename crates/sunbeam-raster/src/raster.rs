@@ -13,9 +13,11 @@ pub struct Fragment {
     pub mesh: Option<u32>,
     /// World position.
     pub pos: [f64; 3],
-    /// Interpolated (not normalised) normal.
+    /// Interpolated (not normalised) normal; on a mesh with scale maps, the
+    /// normal map's normal (unit, `sunbeam_frame::MeshScales::perturb`).
     pub normal: [f64; 3],
-    /// Interpolated (not normalised) orientation `t`.
+    /// Interpolated (not normalised) orientation `t`; with scale maps, the
+    /// texel's ridge direction (unit, orthogonal to the mapped normal).
     pub tangent: [f64; 3],
     /// Depth in [0, 1].
     pub depth: f64,
@@ -123,7 +125,8 @@ pub fn rasterise_rows_at(
         };
         (w as usize) * (rows.len())
     ];
-    for (mi, (mesh, _)) in p.meshes.iter().enumerate() {
+    for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
+        let scales = mat.scales.as_deref();
         let clip: Vec<[f64; 4]> = mesh
             .positions
             .iter()
@@ -140,7 +143,16 @@ pub fn rasterise_rows_at(
                 }
             });
             for t in clip_near(cv) {
-                raster_triangle(&mut buf, w, h, &rows, at, mi as u32, mesh, idx, &t);
+                raster_triangle(
+                    &mut buf,
+                    w,
+                    h,
+                    &rows,
+                    at,
+                    (mi as u32, mesh, scales),
+                    idx,
+                    &t,
+                );
             }
         }
     }
@@ -159,8 +171,7 @@ fn raster_triangle(
     h: u32,
     rows: &std::ops::Range<u32>,
     at: Positions,
-    mi: u32,
-    mesh: &crate::Mesh,
+    (mi, mesh, scales): (u32, &crate::Mesh, Option<&sunbeam_frame::MeshScales>),
     idx: [usize; 3],
     t: &[ClipVert; 3],
 ) {
@@ -261,11 +272,22 @@ fn raster_triangle(
                     .map(|o| bo[o] * mesh.tangents[idx[o]][c] as f64)
                     .sum()
             });
+            let mut normal = attr(&mesh.normals);
+            let mut tangent = tang;
+            // Scale maps: the normal map and the ridge direction at the texel.
+            if let Some(sc) = scales {
+                let uv = [0, 1].map(|c| (0..3).map(|o| bo[o] * mesh.uvs[idx[o]][c] as f64).sum());
+                let t4: [f64; 4] = [0, 1, 2, 3]
+                    .map(|c| (0..3).map(|o| bo[o] * sc.tangents[idx[o]][c] as f64).sum());
+                if let Some((n2, t2)) = sc.perturb(normal, t4, uv) {
+                    (normal, tangent) = (n2, t2);
+                }
+            }
             *pix = Fragment {
                 mesh: Some(mi),
                 pos: attr(&mesh.positions),
-                normal: attr(&mesh.normals),
-                tangent: tang,
+                normal,
+                tangent,
                 depth: z,
             };
         }

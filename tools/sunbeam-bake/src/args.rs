@@ -95,6 +95,48 @@ pub(crate) struct Cli {
     #[arg(long, value_name = "FILE")]
     pub(crate) spine_out: Option<PathBuf>,
 
+    /// Bake scales (docs/BAKE.md "Scales"): a tiling in the UV layout (u along the
+    /// body, v around it, v periodic), written as the material's normalTexture and
+    /// the SUNBEAM_materials_diffraction orientationTexture; TANGENT becomes the UV
+    /// frame (+u), _ORIENTATION keeps the field. Needs UVs.
+    #[arg(long)]
+    pub(crate) scales: bool,
+    /// Scale rows around the body (one turn of v).
+    #[arg(long, value_name = "N", default_value_t = 20, requires = "scales",
+          value_parser = clap::value_parser!(u32).range(3..=200))]
+    pub(crate) scale_rows: u32,
+    /// Scale length along the body, in scale widths.
+    #[arg(long, value_name = "L", default_value_t = 1.0, requires = "scales",
+          value_parser = ranged(0.25, 4.0))]
+    pub(crate) scale_length: f64,
+    /// Overlap of a scale's free edge over the scale behind it, in scale lengths.
+    #[arg(long, value_name = "F", default_value_t = 0.3, requires = "scales",
+          value_parser = ranged(0.0, 0.6))]
+    pub(crate) scale_overlap: f64,
+    /// Dome height of a scale, in scale widths.
+    #[arg(long, value_name = "H", default_value_t = 0.06, requires = "scales",
+          value_parser = ranged(0.0, 0.3))]
+    pub(crate) scale_dome: f64,
+    /// Tilt of the free edge, degrees (the scale's normal turns toward the head).
+    #[arg(long, value_name = "DEG", default_value_t = 6.0, requires = "scales",
+          allow_hyphen_values = true, value_parser = ranged(-30.0, 30.0))]
+    pub(crate) scale_tilt: f64,
+    /// Per-scale jitter of the tilt (uniform in +-DEG).
+    #[arg(long, value_name = "DEG", default_value_t = 4.0, requires = "scales",
+          value_parser = ranged(0.0, 20.0))]
+    pub(crate) scale_tilt_jitter: f64,
+    /// Per-scale jitter of the ridge angle about the normal (uniform in +-DEG).
+    #[arg(long, value_name = "DEG", default_value_t = 6.0, requires = "scales",
+          value_parser = ranged(0.0, 45.0))]
+    pub(crate) scale_ridge_jitter: f64,
+    /// Texels across one scale width (reduced when a side would pass 8192).
+    #[arg(long, value_name = "N", default_value_t = 32, requires = "scales",
+          value_parser = clap::value_parser!(u32).range(4..=256))]
+    pub(crate) scale_texels: u32,
+    /// Seed of the per-scale jitter.
+    #[arg(long, value_name = "N", default_value_t = 1, requires = "scales")]
+    pub(crate) scale_seed: u64,
+
     /// Print a JSON report on stdout.
     #[arg(long)]
     pub(crate) json: bool,
@@ -107,4 +149,19 @@ pub(crate) struct Cli {
     /// Verbose: print the report summary on stderr.
     #[arg(short, long)]
     pub(crate) verbose: bool,
+}
+
+/// A clap value parser for a finite f64 in [lo, hi].
+fn ranged(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
+    move |s: &str| {
+        let v: f64 = s
+            .trim()
+            .parse()
+            .map_err(|_| format!("{s:?} is not a number"))?;
+        if v.is_finite() && (lo..=hi).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("{v} is outside [{lo}, {hi}]"))
+        }
+    }
 }

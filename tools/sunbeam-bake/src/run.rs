@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use sunbeam_common::{Error, Result};
 use sunbeam_mesh::bake::{bake, BakeOptions};
 use sunbeam_mesh::orient::{parse_axis, Curve, Interp, Samples, Source, UvAxis};
+use sunbeam_mesh::scales::{self, ScaleParams};
 use sunbeam_mesh::snake::{self, SnakeParams};
 use sunbeam_mesh::texture::{self, TextureOptions};
 
@@ -82,6 +83,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             InterpArg::Sibson => Interp::SibsonC1,
         },
         max_snap: cli.max_snap,
+        uv_tangents: cli.scales,
     };
     let mut baked = bake(doc, &opts)?;
     // Files the document read (external buffers, images embedded while merging, MTL).
@@ -103,8 +105,32 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         baked.report.texture = Some(rep);
         tex_bytes = Some(bytes);
     }
-    if let Some(pack) = &cli.pack {
-        inputs.extend(attach_diffraction(&mut baked.doc, pack, &cli)?);
+    let ext = match &cli.pack {
+        Some(pack) => {
+            let (ext, files) = diffraction_ext(pack, &cli)?;
+            inputs.extend(files);
+            Some(ext)
+        }
+        None => None,
+    };
+    if cli.scales {
+        let rep = scales::attach(
+            &mut baked.doc,
+            &baked.work,
+            &scale_params(&cli),
+            cli.uv_set,
+            ext,
+        )?;
+        if rep.field_along_u < 0.5 {
+            baked.report.warnings.push(format!(
+                "--scales: the baked field runs along u at only {:.0} % of the vertices; the tiling assumes u runs along the body (docs/BAKE.md \"Scales\")",
+                100.0 * rep.field_along_u
+            ));
+        }
+        baked.report.scales =
+            Some(serde_json::to_value(rep).map_err(|e| Error::internal(e.to_string()))?);
+    } else if let Some(ext) = ext {
+        sunbeam_mesh::diffraction_ext::attach(&mut baked.doc, &ext, BASE);
     }
     let glb = baked.doc.to_glb();
     if to_stdout {
@@ -176,13 +202,27 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     Ok(())
 }
 
-/// `--pack`: the SUNBEAM_materials_diffraction extension on the GLB's materials
-/// (docs/ENGINES.md). Returns the files it read (for the depfile).
-fn attach_diffraction(
-    doc: &mut sunbeam_mesh::gltf::Document,
-    pack: &Path,
-    cli: &Cli,
-) -> Result<Vec<PathBuf>> {
+/// Base colour written with the extension.
+const BASE: [f64; 3] = [0.05, 0.05, 0.05];
+
+/// The `--scale-*` options.
+fn scale_params(cli: &Cli) -> ScaleParams {
+    ScaleParams {
+        rows: cli.scale_rows,
+        length: cli.scale_length,
+        overlap: cli.scale_overlap,
+        dome: cli.scale_dome,
+        tilt_deg: cli.scale_tilt,
+        tilt_jitter_deg: cli.scale_tilt_jitter,
+        ridge_jitter_deg: cli.scale_ridge_jitter,
+        texels_per_scale: cli.scale_texels,
+        seed: cli.scale_seed,
+    }
+}
+
+/// `--pack`: the SUNBEAM_materials_diffraction extension object for the GLB's
+/// materials (docs/ENGINES.md), and the files it read (for the depfile).
+fn diffraction_ext(pack: &Path, cli: &Cli) -> Result<(serde_json::Value, Vec<PathBuf>)> {
     if cli.output.as_os_str() == "-" {
         return Err(Error::usage(
             "--pack needs a file output (the URIs are relative to it)",
@@ -219,7 +259,7 @@ fn attach_diffraction(
             .collect::<Vec<_>>()
             .join("/"))
     };
-    let base = [0.05, 0.05, 0.05];
+    let base = BASE;
     let ext = serde_json::json!({
         "responseMap": { "uri": uri(&map_path)?, "mimeType": "image/ktx2" },
         "pack": { "uri": uri(pack)? },
@@ -228,8 +268,7 @@ fn attach_diffraction(
         "diffuseWeight": cli.diffuse_weight,
         "baseColor": base,
     });
-    sunbeam_mesh::diffraction_ext::attach(doc, &ext, base);
-    Ok(vec![pack.to_path_buf(), map_path])
+    Ok((ext, vec![pack.to_path_buf(), map_path]))
 }
 
 /// `target` relative to the folder `from` (both made absolute first).

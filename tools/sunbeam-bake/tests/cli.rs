@@ -4,6 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+mod common;
+use common::{ok, validate};
+
 const BIN: &str = env!("CARGO_BIN_EXE_sunbeam-bake");
 
 fn tmpdir(name: &str) -> PathBuf {
@@ -18,46 +21,6 @@ fn bake(args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("run sunbeam-bake")
-}
-
-fn ok(o: &Output) {
-    assert!(
-        o.status.success(),
-        "exit {:?}\nstderr: {}",
-        o.status.code(),
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
-/// The Khronos validator on `files` (skips, or fails under SUNBEAM_REQUIRE_ALL=1, without node).
-fn validate(files: &[&Path]) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let node_dir = root.join("tests/node");
-    if !sunbeam_common::testdata::have_command("node", &[]) {
-        return;
-    }
-    if !node_dir.join("node_modules/gltf-validator").is_dir() {
-        assert!(
-            !sunbeam_common::testdata::require_all(),
-            "tests/node/node_modules/gltf-validator missing (run scripts/ensure-deps.sh)"
-        );
-        eprintln!("SKIP: tests/node/node_modules/gltf-validator missing");
-        return;
-    }
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/validate.mjs");
-    let o = Command::new("node")
-        .arg(script)
-        .arg(&node_dir)
-        .args(files)
-        .output()
-        .expect("run node");
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success(),
-        "glTF-Validator reports errors:\n{out}\n{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert_eq!(out.lines().count(), files.len(), "{out}");
 }
 
 const OBJ_PLAIN: &str =
