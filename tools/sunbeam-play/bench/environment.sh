@@ -18,7 +18,9 @@
 # SCENES (default "sphere snake"), SUPERSAMPLE (the
 # player's --supersample, default 1), SPHERE_MASKING and SNAKE_MASKING (the
 # meshes' "masking", default off and smith: docs/LIGHTING.md "Grazing views:
-# masking"), SUNBEAM_BIN (the folder of the binaries).
+# masking"), SUNBEAM_BIN (the folder of the binaries). The skin reflects
+# absolutely (4 % head-on): base colour 0.03 x F(0) and exposure -1.5 + 4.6 EV
+# keep the frames as bright as the figures measured under the relative model.
 set -euo pipefail
 out=${1:?usage: environment.sh OUT_DIR PACK.ktx2 SNAKE.glb [FRAMES ...]}
 pack=$(realpath "${2:?pack}")
@@ -41,13 +43,13 @@ export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-$(d=${TMPDIR:-/tmp}/sunbeam-xdg-$(id -
 sky='"environment": { "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 70, "turbidity": 3 }, "intensity": 1 }'
 cat > "$out/sphere.json" <<JSON
 { "camera": { "eye": [0, 0.25, 1.2], "target": [0, 0, 0] },
-  "meshes": [ { "mesh": "builtin:sphere", "pack": "$pack", "base_color": [0.03, 0.03, 0.035], "diffuse_weight": 0.15, "masking": "$sphere_masking" } ],
-  $sky, "exposure": -1.5, "size": [$res, $res] }
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "$pack", "base_color": [0.0012, 0.0012, 0.0014], "diffuse_weight": 0.15, "masking": "$sphere_masking" } ],
+  $sky, "exposure": 3.1, "size": [$res, $res] }
 JSON
 cat > "$out/snake.json" <<JSON
 { "camera": { "eye": [0.0, -0.55, 1.05], "target": [0.0, -0.01, 0.0], "up": [0, 1, 0], "fov_y_deg": 28 },
-  "meshes": [ { "mesh": "$snake", "pack": "$pack", "base_color": [0.03, 0.03, 0.035], "diffuse_weight": 0.15, "masking": "$snake_masking" } ],
-  $sky, "exposure": -1.5, "size": [$snake_w, $snake_h] }
+  "meshes": [ { "mesh": "$snake", "pack": "$pack", "base_color": [0.0012, 0.0012, 0.0014], "diffuse_weight": 0.15, "masking": "$snake_masking" } ],
+  $sky, "exposure": 3.1, "size": [$snake_w, $snake_h] }
 JSON
 cie() { sed -E 's/.*mean ([0-9.]+) p99 ([0-9.]+) max ([0-9.]+).*/\1 \/ \2 \/ \3/'; }
 j() { python3 -c "import json,sys; d=json.load(sys.stdin); print($1)"; }
