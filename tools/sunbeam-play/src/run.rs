@@ -165,6 +165,12 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         "mode": format!("{:?}", st.mode).to_lowercase(),
         "msaa": st.msaa,
     });
+    if let Some((line, c)) = sunbeam_frame::environment_clamped_warning(&prepared) {
+        if !cli.quiet {
+            eprintln!("sunbeam-play: warning: {line}");
+        }
+        report["environment_negatives_zeroed"] = serde_json::json!({"values": c.values, "texels": c.texels, "min": c.min, "bound": c.bound});
+    }
     let image: LinearImage = if cli.cpu {
         let t = std::time::Instant::now();
         let k = cli.supersample.max(1);
