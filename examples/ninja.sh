@@ -80,7 +80,7 @@ rule import
   deps = gcc
   description = import \${name}
 rule pack
-  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-pack \$in -o \${target} --response $(esc "$PACK_FLAGS") --depfile \${target}.d \$q
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-pack \$in -o \${target} --response --response-sky \${sky} $(esc "$PACK_FLAGS") --depfile \${target}.d \$q
   depfile = \${target}.d
   deps = gcc
   description = pack \${target}
@@ -161,9 +161,14 @@ EOF
       IFS=: read -r ext rule from tool <<<"$s"
       sep=.; [ "$rule" = pack ] || sep=-
       t="$OUT/$m$sep$ext"
-      extra=; [ "$rule" = pack ] && extra=" | $o/$m.response.ktx2"
-      echo "build $(path "$t")$extra: $rule $o/$m.$from | $(path "$BIN/$tool")"
+      extra=; dep=
+      if [ "$rule" = pack ]; then
+        extra=" | $o/$m.response.ktx2 $o/$m.env-response.ktx2"
+        dep=" $o/$m-sky.json"
+      fi
+      echo "build $(path "$t")$extra: $rule $o/$m.$from |$dep $(path "$BIN/$tool")"
       echo "  target = $(esc "$t")"
+      if [ "$rule" = pack ]; then echo "  sky = $o/$m-sky.json"; fi
       echo "  tidy = $(esc "$OUT/.$m$sep$ext").tmp.*"
     done
     echo "build $o/$m-scene.json: scene scene.json.in"
@@ -180,7 +185,7 @@ EOF
     echo "build $o/$m-sky.png: sky $o/$m-sky.json | $o/$m.ktx2 $o/snake.glb $(path "$EVAL")"
     echo "  target = $(esc "$OUT/$m-sky.png")"
     echo "  tidy = $(esc "$OUT/.$m-sky.png").tmp.*"
-    echo "build $o/$m-play-sky.png: play_sky $o/$m-sky.json | $o/$m.ktx2 $o/snake.glb $(path "$BIN/sunbeam-play")"
+    echo "build $o/$m-play-sky.png: play_sky $o/$m-sky.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/$m.env-response.ktx2 $o/snake.glb $(path "$BIN/sunbeam-play")"
     echo "  target = $(esc "$OUT/$m-play-sky.png")"
     echo "  tidy = $(esc "$OUT/.$m-play-sky.png").tmp.*"
     echo "build $o/snake-$m.glb: bake_pack $o/$m.ktx2 | $o/$m.response.ktx2 $(path "$BIN/sunbeam-bake")"

@@ -130,6 +130,39 @@ pub fn default_scene(
     Ok(s)
 }
 
+/// The negative texels of the scene's map set to 0 when it was loaded
+/// (docs/SCENE.md "environment"): None without a map or without any.
+pub fn environment_clamped(p: &Prepared) -> Option<sunbeam_light::Clamped> {
+    match p.environment.as_deref() {
+        Some(sunbeam_light::Environment::Map(m)) if m.clamped().values > 0 => Some(m.clamped()),
+        _ => None,
+    }
+}
+
+/// The one warning line (without the tool's prefix) for the negative texels
+/// of the scene's map set to 0, with their counts (for a `--json` report's
+/// `"environment_negatives_zeroed"`), or None when there were none.
+pub fn environment_clamped_warning(p: &Prepared) -> Option<(String, sunbeam_light::Clamped)> {
+    let c = environment_clamped(p)?;
+    let map = p
+        .scene
+        .environment
+        .as_ref()
+        .and_then(|e| e.map.as_ref())
+        .map(|m| m.display().to_string())
+        .unwrap_or_default();
+    let line = format!(
+        "environment.map {map}: set {} negative values in {} texels to 0 (down to {:.3e}; \
+         lossy compression; refused below -{:.3e}, {} x the mean luminance)",
+        c.values,
+        c.texels,
+        c.min,
+        c.bound,
+        sunbeam_light::NEGATIVE_TEXEL_LIMIT
+    );
+    Some((line, c))
+}
+
 /// Load every mesh and pack of a scene (each file once).
 pub fn prepare(scene: &Scene) -> Result<Prepared> {
     prepare_with(scene, &Pack::read)

@@ -8,6 +8,20 @@ use crate::sky::Sky;
 use crate::{daylight, EnvMap};
 use sunbeam_optics::{cie, colour};
 
+/// The basis spectra of every sky (CIE daylight `S0, S1, S2`), as
+/// [`Environment::basis_at`] for a sky: the same for every sky, so a pack's
+/// maps in this basis can be built before the scene is known.
+pub fn sky_basis_at(lambda_m: f64) -> [f64; 3] {
+    daylight::basis_at(lambda_m)
+}
+
+/// The basis spectra of every map (`D65(lambda) b_k(lambda)`), as
+/// [`Environment::basis_at`] for a map (the same for every map).
+pub fn map_basis_at(lambda_m: f64) -> [f64; 3] {
+    let d65 = cie::d65_at(lambda_m);
+    RgbBasis::get().at(lambda_m).map(|b| d65 * b)
+}
+
 /// Extended light around a scene.
 #[derive(Debug, Clone)]
 pub enum Environment {
@@ -63,11 +77,8 @@ impl Environment {
     /// (docs/LIGHTING.md "Basis spectra").
     pub fn basis_at(&self, lambda_m: f64) -> [f64; 3] {
         match self {
-            Environment::Sky(_) => daylight::basis_at(lambda_m),
-            Environment::Map(_) => {
-                let d65 = cie::d65_at(lambda_m);
-                RgbBasis::get().at(lambda_m).map(|b| d65 * b)
-            }
+            Environment::Sky(_) => sky_basis_at(lambda_m),
+            Environment::Map(_) => map_basis_at(lambda_m),
         }
     }
 

@@ -9,14 +9,22 @@ use sunbeam_common::{Error, Result};
 /// not an image, not equirectangular, bad pixels, bad intensity) is an input
 /// error naming the file and, where it is one, the scene field.
 pub fn load(path: &Path, rotation_deg: f64, intensity: f64) -> Result<EnvMap> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| Error::input_file(path, format!("environment.map: {e}")))?;
+    let io_err = |e: std::io::Error| Error::input_file(path, format!("environment.map: {e}"));
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase());
-    let (w, h, rgb) = decode(&bytes, ext.as_deref().unwrap_or(""))
-        .map_err(|e| Error::input_file(path, format!("environment.map: {e}")))?;
+    // OpenEXR is read from the file through a buffer (an 8192 x 4096 map's
+    // file is not held next to its texels: docs/bench/hdri.md).
+    let decoded = if ext.as_deref() == Some("exr") {
+        let f = std::fs::File::open(path).map_err(io_err)?;
+        read_exr_from(std::io::BufReader::new(f))
+    } else {
+        let bytes = std::fs::read(path).map_err(io_err)?;
+        decode(&bytes, ext.as_deref().unwrap_or(""))
+    };
+    let (w, h, rgb) =
+        decoded.map_err(|e| Error::input_file(path, format!("environment.map: {e}")))?;
     EnvMap::new(w, h, rgb, rotation_deg, intensity).map_err(|e| {
         let field = match e {
             crate::EnvError::BadIntensity(_) => "environment.intensity",
@@ -40,6 +48,13 @@ pub fn decode(bytes: &[u8], ext: &str) -> std::result::Result<Pixels, String> {
 }
 
 fn read_exr(bytes: &[u8]) -> std::result::Result<Pixels, String> {
+    read_exr_from(std::io::Cursor::new(bytes))
+}
+
+/// The first RGB layer of an OpenEXR stream, at its largest resolution.
+fn read_exr_from(
+    r: impl std::io::Read + std::io::Seek + Send,
+) -> std::result::Result<Pixels, String> {
     use exr::prelude::{read, ReadChannels, ReadLayers, Vec2};
     let img = read()
         .no_deep_data()
@@ -60,7 +75,7 @@ fn read_exr(bytes: &[u8]) -> std::result::Result<Pixels, String> {
         .first_valid_layer()
         .all_attributes()
         .non_parallel()
-        .from_buffered(std::io::Cursor::new(bytes))
+        .from_buffered(r)
         .map_err(|e| format!("not an RGB OpenEXR image: {e}"))?;
     Ok(img.layer_data.channel_data.pixels)
 }

@@ -41,9 +41,13 @@ pub enum EnvError {
     SizeMismatch { expected: usize, got: usize },
     /// A texel is NaN or infinite.
     BadTexel { index: usize },
-    /// The negative texels outweigh lossy-compression noise: their summed
-    /// magnitude is more than [`NEGATIVE_MASS_LIMIT`] of the positive sum.
-    NegativeMass { negative: f64, positive: f64 },
+    /// A channel value below zero by more than lossy-compression noise: more
+    /// than [`NEGATIVE_TEXEL_LIMIT`] times the map's mean luminance.
+    NegativeTexel {
+        index: usize,
+        value: f32,
+        bound: f64,
+    },
     /// Intensity negative, NaN or infinite.
     BadIntensity(f64),
 }
@@ -61,11 +65,15 @@ impl std::fmt::Display for EnvError {
             EnvError::BadTexel { index } => {
                 write!(f, "pixel {index} is not finite")
             }
-            EnvError::NegativeMass { negative, positive } => write!(
+            EnvError::NegativeTexel {
+                index,
+                value,
+                bound,
+            } => write!(
                 f,
-                "the negative texels sum to {negative:.4e} against {positive:.4e} positive \
-                 (more than {:.0} %): not a radiance map",
-                100.0 * NEGATIVE_MASS_LIMIT
+                "pixel {index} has the value {value:.4e}, below -{bound:.4e} ({} times the \
+                 map's mean luminance, what lossy compression leaves): not a radiance map",
+                NEGATIVE_TEXEL_LIMIT
             ),
             EnvError::BadIntensity(v) => {
                 write!(f, "intensity {v} must be finite and >= 0")
@@ -90,13 +98,16 @@ pub fn rot_y(d: [f64; 3], deg: f64) -> [f64; 3] {
     [c * d[0] - s * d[2], d[1], s * d[0] + c * d[2]]
 }
 
-/// The largest summed magnitude of negative channel values, as a fraction of
-/// the positive sum, that a map may carry: lossy OpenEXR compression (DWAA,
-/// DWAB, PXR24, B44) leaves a few near-black texels slightly below zero (a
-/// public library's HDRIs: up to about a thousand texels of 512 K, down to
-/// -0.003, a fraction of about 1e-7 of the map's energy); those are set to 0.
-/// A map whose negatives weigh more than this is not radiance and is refused.
-pub const NEGATIVE_MASS_LIMIT: f64 = 0.01;
+/// How far below zero a channel value may lie, as a fraction of the map's
+/// mean luminance (the plain mean over texels of `0.2126 R + 0.7152 G +
+/// 0.0722 B`, negatives counted as 0): lossy OpenEXR compression (DWAA, DWAB,
+/// PXR24, B44) leaves a few near-black texels slightly below zero (a public
+/// library's HDRIs: up to about a thousand texels of 512 K, down to -0.003;
+/// ../shared/data/hdri/night.exr: -0.0033 against a mean luminance of
+/// 0.141, a ratio of 0.024, four times below this limit); those are set to 0 and counted
+/// ([`Clamped`]). A value further below zero is not radiance: the map is
+/// refused, naming the texel.
+pub const NEGATIVE_TEXEL_LIMIT: f64 = 0.1;
 
 /// Negative channel values [`EnvMap::new`] set to 0.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -107,6 +118,9 @@ pub struct Clamped {
     pub values: usize,
     /// The most negative channel value (0 when none).
     pub min: f32,
+    /// The bound that applied: [`NEGATIVE_TEXEL_LIMIT`] times the map's mean
+    /// luminance (before `intensity`).
+    pub bound: f64,
 }
 
 /// An equirectangular RGB radiance map (linear, scaled by `intensity`),
@@ -152,29 +166,37 @@ impl EnvMap {
             return Err(EnvError::BadIntensity(intensity));
         }
         let mut rgb = rgb;
-        let mut clamped = Clamped::default();
-        let (mut negative, mut positive) = (0.0f64, 0.0f64);
-        for (index, c) in rgb.iter_mut().enumerate() {
+        let mut sum = 0.0f64;
+        for (index, c) in rgb.iter().enumerate() {
             if c.iter().any(|v| !v.is_finite()) {
                 return Err(EnvError::BadTexel { index });
             }
+            sum += luminance(c.map(|v| v.max(0.0)));
+        }
+        let bound = NEGATIVE_TEXEL_LIMIT * sum / rgb.len() as f64;
+        let mut clamped = Clamped {
+            bound,
+            ..Clamped::default()
+        };
+        for (index, c) in rgb.iter_mut().enumerate() {
             if c.iter().any(|v| *v < 0.0) {
                 clamped.texels += 1;
             }
             for v in c.iter_mut() {
                 if *v < 0.0 {
+                    if -(*v as f64) > bound {
+                        return Err(EnvError::NegativeTexel {
+                            index,
+                            value: *v,
+                            bound,
+                        });
+                    }
                     clamped.values += 1;
-                    negative -= *v as f64;
                     clamped.min = clamped.min.min(*v);
                     *v = 0.0;
-                } else {
-                    positive += *v as f64;
                 }
                 *v = (*v as f64 * intensity) as f32;
             }
-        }
-        if negative > NEGATIVE_MASS_LIMIT * positive {
-            return Err(EnvError::NegativeMass { negative, positive });
         }
         let mut conditional = vec![0.0; height * (width + 1)];
         let mut marginal = vec![0.0; height + 1];
@@ -337,21 +359,19 @@ mod tests {
         px[7] = [-0.003, 0.5, -1e-6];
         px[20][1] = -0.001;
         let m = EnvMap::new(8, 4, px, 0.0, 3.0).unwrap();
-        assert_eq!(
-            m.clamped(),
-            Clamped {
-                texels: 2,
-                values: 3,
-                min: -0.003
-            }
-        );
+        // The mean luminance (negatives as 0): 30 white texels of 2, one of
+        // G = 0.5 alone, one of R = B = 2.
+        let mean = (30.0 * 2.0 + 0.7152 * 0.5 + (0.2126 + 0.0722) * 2.0) / 32.0;
+        let c = m.clamped();
+        assert_eq!((c.texels, c.values, c.min), (2, 3, -0.003));
+        assert!((c.bound - 0.1 * mean).abs() < 1e-12, "{c:?}");
         // Texel 7 of the 8 x 4 map: column 7, row 0.
         let theta = PI * 0.5 / 4.0;
         let phi = 2.0 * PI * 7.5 / 8.0;
         assert_eq!(m.lookup(direction(theta.cos(), phi)), [0.0, 1.5, 0.0]);
         assert_eq!(m.clamped(), m.clone().clamped());
         let clean = EnvMap::new(8, 4, vec![[2.0f32; 3]; 32], 0.0, 3.0).unwrap();
-        assert_eq!(clean.clamped(), Clamped::default());
+        assert_eq!(clean.clamped().texels + clean.clamped().values, 0);
     }
 
     #[test]
@@ -380,13 +400,21 @@ mod tests {
             EnvMap::new(4, 2, px, 0.0, 1.0).unwrap_err(),
             EnvError::BadTexel { index: 5 }
         );
-        // Negatives past the limit: 0.25 of 24 - 0.25 is more than 1 %.
+        // Negatives past a tenth of the mean luminance (7 white texels and
+        // one of G = 1 alone: mean (7 + 0.7152) / 8 = 0.9644) name the texel;
+        // one just inside is set to 0.
+        let mean = (7.0 + 0.7152) / 8.0;
         let mut px = vec![[1.0; 3]; 8];
-        px[2][0] = -0.25;
-        assert!(matches!(
-            EnvMap::new(4, 2, px, 0.0, 1.0).unwrap_err(),
-            EnvError::NegativeMass { .. }
-        ));
+        px[2][0] = -0.1 * mean as f32 * 1.01;
+        px[2][2] = -0.5;
+        match EnvMap::new(4, 2, px, 0.0, 1.0).unwrap_err() {
+            EnvError::NegativeTexel { index, .. } => assert_eq!(index, 2),
+            e => panic!("{e}"),
+        }
+        let mut px = vec![[1.0; 3]; 8];
+        px[2][0] = -0.1 * mean as f32 * 0.99;
+        px[2][2] = 0.0;
+        assert_eq!(EnvMap::new(4, 2, px, 0.0, 1.0).unwrap().clamped().values, 1);
     }
 
     /// Closed form: a constant map is sampled with density 1 / (4 pi)

@@ -28,8 +28,9 @@ pub mod raster;
 pub mod shade;
 
 pub use sunbeam_frame::{
-    compare, compare_linear, default_scene, load_environment, load_mesh, load_mesh_with_scales,
-    mesh_bounds, prepare, prepare_with, ColourDiff, Image, LinearImage, Material, Mesh, Prepared,
+    compare, compare_linear, default_scene, environment_clamped_warning, load_environment,
+    load_mesh, load_mesh_with_scales, mesh_bounds, prepare, prepare_with, ColourDiff, Image,
+    LinearImage, Material, Mesh, Prepared,
 };
 pub use sunbeam_frame::{diff, fixtures, image, linear, spectral};
 

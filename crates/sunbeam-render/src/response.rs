@@ -32,6 +32,25 @@ pub fn load_pack(path: &Path) -> Result<Pack> {
     Pack::read(path)
 }
 
+/// [`load_pack`] for a scene with an environment: only the manifest when the
+/// environment's maps (`NAME.env-response.ktx2`) and the point map beside the
+/// pack were both built from it (the maps still have to serve the scene's
+/// environment: if not, the renderer reads the pack whole to build them).
+pub fn load_pack_for_environment(path: &Path) -> Result<Pack> {
+    let side = sunbeam_response::env_file::sidecar_path(path);
+    if side.is_file() {
+        if let (Ok(m), Ok(info)) = (
+            Pack::read_manifest(path),
+            sunbeam_response::env_file::read_info(&side),
+        ) {
+            if info.pack == m {
+                return load_pack(path);
+            }
+        }
+    }
+    Pack::read(path)
+}
+
 /// The map of `pack` (read from `path`'s sidecar, or built), and a note for the
 /// user when it had to be built.
 pub fn load_or_build(

@@ -22,6 +22,7 @@
 use crate::build::{self, Options};
 use crate::grid::Grid;
 use crate::Response;
+use sunbeam_light::sky::Sky;
 use sunbeam_light::Environment;
 use sunbeam_optics::masking::Masking;
 use sunbeam_optics::{cie, colour, gain};
@@ -90,7 +91,7 @@ pub fn build_env(pack: &Pack, env: &Environment, opts: &Options) -> EnvResponse 
 }
 
 /// `Info::quantity` of an extended-light map of `pack` for basis spectrum `b`.
-fn quantity(pack: &Pack, b: &str) -> String {
+pub(crate) fn quantity(pack: &Pack, b: &str) -> String {
     format!(
         "XYZ without G: sum_l {}(u, v, w, l) (A / l^2) B(l) cmf(l) / sum_l D65(l) ybar(l), B = {b}",
         build::reflectance_name(pack)
@@ -99,7 +100,7 @@ fn quantity(pack: &Pack, b: &str) -> String {
 
 /// The maps whose luminance the proposal follows: `E_0` for the sky (`S0` is
 /// close to the mean daylight), `E_0 + E_1 + E_2` for a map (D65).
-fn proposal_maps<'a>(env: &Environment, basis: &'a [Response]) -> Vec<&'a Response> {
+pub(crate) fn proposal_maps<'a>(env: &Environment, basis: &'a [Response]) -> Vec<&'a Response> {
     match env {
         Environment::Sky(_) => vec![&basis[0]],
         Environment::Map(_) => basis.iter().collect(),
@@ -119,6 +120,19 @@ pub fn coherent_area_m2(pack: &Pack) -> f64 {
 /// discrete sum as the point map's, so `B = D65` integrates to `Y = 1` exactly
 /// (Parseval) over the same samples.
 pub fn env_weights(pack: &Pack, env: &Environment, n: usize) -> build::WeightSets {
+    weight_sets(pack, n, &[&|l| env.basis_at(l)], env.sun())
+}
+
+/// The weight sets of [`env_weights`] for several bases at once (three sets
+/// each, in order), then the sun's set when `sun` is given: what
+/// `sunbeam-pack --response` builds in one pass for every sky and every map
+/// ([`crate::env_file`]).
+pub fn weight_sets(
+    pack: &Pack,
+    n: usize,
+    bases: &[&dyn Fn(f64) -> [f64; 3]],
+    sun: Option<&Sky>,
+) -> build::WeightSets {
     let a = coherent_area_m2(pack);
     let lw = build::wavelength_weights(n);
     let lambdas: Vec<f64> = lw.iter().map(|l| l.0).collect();
@@ -130,23 +144,25 @@ pub fn env_weights(pack: &Pack, env: &Environment, n: usize) -> build::WeightSet
         let f = a / (l * l) * b / norm;
         cie::cmf_at(l).map(|c| c * f)
     };
-    let mut sets: Vec<Vec<[f64; 3]>> = (0..3)
-        .map(|k| {
-            lambdas
-                .iter()
-                .map(|&l| weight(l, env.basis_at(l)[k]))
-                .collect()
+    let mut sets: Vec<Vec<[f64; 3]>> = bases
+        .iter()
+        .flat_map(|basis| {
+            let lambdas = &lambdas;
+            (0..3).map(move |k| lambdas.iter().map(|&l| weight(l, basis(l)[k])).collect())
         })
         .collect();
-    if let Some(sky) = env.sun() {
-        sets.push(
-            lambdas
-                .iter()
-                .map(|&l| weight(l, sky.sun_solid_angle() * sky.sun_spectral(l)))
-                .collect(),
-        );
+    if let Some(sky) = sun {
+        sets.push(sun_weights(&lambdas, sky, &weight));
     }
     build::WeightSets { lambdas, sets }
+}
+
+/// The sun's weight set: `weight(l, Omega_sun sun(l))` at every wavelength.
+fn sun_weights(lambdas: &[f64], sky: &Sky, weight: &dyn Fn(f64, f64) -> [f64; 3]) -> Vec<[f64; 3]> {
+    lambdas
+        .iter()
+        .map(|&l| weight(l, sky.sun_solid_angle() * sky.sun_spectral(l)))
+        .collect()
 }
 
 impl EnvResponse {

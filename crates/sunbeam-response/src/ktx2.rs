@@ -35,11 +35,11 @@ fn dfd() -> Vec<u8> {
     d
 }
 
-fn kvd(info_json: &str) -> Vec<u8> {
+fn kvd(key: &str, info_json: &str) -> Vec<u8> {
     let writer = format!("sunbeam-response {}", env!("CARGO_PKG_VERSION"));
     let mut out = Vec::new();
-    // Sorted by key bytes: "KTXwriter" < "sunbeam.response".
-    for (k, v) in [("KTXwriter", writer.as_str()), (INFO_KEY, info_json)] {
+    // Sorted by key bytes: "KTXwriter" < "sunbeam.*".
+    for (k, v) in [("KTXwriter", writer.as_str()), (key, info_json)] {
         let len = k.len() + 1 + v.len() + 1;
         out.extend_from_slice(&(len as u32).to_le_bytes());
         out.extend_from_slice(k.as_bytes());
@@ -57,20 +57,31 @@ fn kvd(info_json: &str) -> Vec<u8> {
 pub fn encode(r: &Response) -> Vec<u8> {
     let g = &r.info.grid;
     let info = serde_json::to_string(&r.info).expect("info serialises");
+    encode_texture(INFO_KEY, &info, [g.n_theta, g.n_rho, g.n_s], &r.data)
+}
+
+/// A 3D RGBA16F texture of `size` texels (`data`: f16 bits, layer-major) with
+/// `info_json` under `key`, as KTX2 bytes (deterministic).
+pub(crate) fn encode_texture(
+    key: &str,
+    info_json: &str,
+    size: [usize; 3],
+    data: &[u16],
+) -> Vec<u8> {
     let dfd = dfd();
-    let kvd = kvd(&info);
+    let kvd = kvd(key, info_json);
     let dfd_off = HEADER_LEN + LEVEL_INDEX_LEN;
     let kvd_off = dfd_off + dfd.len();
     let data_off = (kvd_off + kvd.len()).div_ceil(TEXEL) * TEXEL;
-    let data_len = r.data.len() * 2;
+    let data_len = data.len() * 2;
     let mut out = Vec::with_capacity(data_off + data_len);
     out.extend_from_slice(&IDENTIFIER);
     for v in [
         VK_R16G16B16A16_SFLOAT,
         2, // typeSize
-        g.n_theta as u32,
-        g.n_rho as u32,
-        g.n_s as u32,
+        size[0] as u32,
+        size[1] as u32,
+        size[2] as u32,
         0, // layerCount
         1, // faceCount
         1, // levelCount
@@ -90,7 +101,7 @@ pub fn encode(r: &Response) -> Vec<u8> {
     out.extend_from_slice(&dfd);
     out.extend_from_slice(&kvd);
     out.resize(data_off, 0);
-    for v in &r.data {
+    for v in data {
         out.extend_from_slice(&v.to_le_bytes());
     }
     out
@@ -105,6 +116,29 @@ pub fn is_response(bytes: &[u8]) -> bool {
 
 /// Decode KTX2 bytes; every size is checked against the file length first.
 pub fn decode(bytes: &[u8]) -> Result<Response> {
+    let (text, [w, h, d], raw) = decode_texture(bytes, INFO_KEY)?;
+    let data = halves(raw);
+    let info: Info = serde_json::from_str(&text)
+        .map_err(|e| Error::input(format!("{INFO_KEY} JSON is invalid: {e}")))?;
+    let g = &info.grid;
+    if (g.n_theta, g.n_rho, g.n_s) != (w, h, d) {
+        return Err(Error::input(format!(
+            "{INFO_KEY} grid {}x{}x{} differs from the texture {w}x{h}x{d}",
+            g.n_theta, g.n_rho, g.n_s
+        )));
+    }
+    let r = Response { info, data };
+    r.validate()?;
+    Ok(r)
+}
+
+/// The JSON under `key`, the size and the texels (f16 bits) of a KTX2 3D
+/// RGBA16F texture (raw little-endian bytes); every size is checked against
+/// the file length first.
+pub(crate) fn decode_texture<'a>(
+    bytes: &'a [u8],
+    key: &str,
+) -> Result<(String, [usize; 3], &'a [u8])> {
     if !bytes.starts_with(&IDENTIFIER) {
         return Err(Error::input("not a KTX2 file (wrong identifier)"));
     }
@@ -143,33 +177,34 @@ pub fn decode(bytes: &[u8]) -> Result<Response> {
             bytes.len()
         )));
     }
-    let info = parse_info(bytes, kvd_off, kvd_len)?;
-    let g = &info.grid;
-    if (g.n_theta, g.n_rho, g.n_s) != (w, h, d) {
-        return Err(Error::input(format!(
-            "sunbeam.response grid {}x{}x{} differs from the texture {w}x{h}x{d}",
-            g.n_theta, g.n_rho, g.n_s
-        )));
-    }
-    let raw = &bytes[lv_off as usize..(lv_off + lv_len) as usize];
-    let data = raw
-        .chunks_exact(2)
-        .map(|c| u16::from_le_bytes([c[0], c[1]]))
-        .collect();
-    let r = Response { info, data };
-    r.validate()?;
-    Ok(r)
+    let text = parse_entry(bytes, kvd_off, kvd_len, key)?;
+    Ok((
+        text,
+        [w, h, d],
+        &bytes[lv_off as usize..(lv_off + lv_len) as usize],
+    ))
 }
 
-/// The `sunbeam.response` entry of the key/value data at `kvd_off..+kvd_len`.
-fn parse_info(bytes: &[u8], kvd_off: usize, kvd_len: usize) -> Result<Info> {
+/// Little-endian f16 bits from raw texel bytes.
+pub(crate) fn halves(raw: &[u8]) -> Vec<u16> {
+    raw.chunks_exact(2)
+        .map(|c| u16::from_le_bytes([c[0], c[1]]))
+        .collect()
+}
+
+/// The value (text) under `key` in the key/value data at `kvd_off..+kvd_len`.
+pub(crate) fn parse_entry(
+    bytes: &[u8],
+    kvd_off: usize,
+    kvd_len: usize,
+    key: &str,
+) -> Result<String> {
     let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
     if kvd_off.checked_add(kvd_len).is_none_or(|e| e > bytes.len()) {
         return Err(Error::input(
             "KTX2 key/value data runs past the end of the file",
         ));
     }
-    let mut info: Option<Info> = None;
     let mut p = kvd_off;
     while p + 4 <= kvd_off + kvd_len {
         let len = u32_at(p) as usize;
@@ -177,26 +212,70 @@ fn parse_info(bytes: &[u8], kvd_off: usize, kvd_len: usize) -> Result<Info> {
             return Err(Error::input("KTX2 key/value data truncated"));
         };
         if let Some(z) = entry.iter().position(|&b| b == 0) {
-            if &entry[..z] == INFO_KEY.as_bytes() {
+            if &entry[..z] == key.as_bytes() {
                 let v = &entry[z + 1..];
                 let v = v.strip_suffix(&[0]).unwrap_or(v);
-                let text = std::str::from_utf8(v)
-                    .map_err(|_| Error::input("sunbeam.response is not UTF-8"))?;
-                info =
-                    Some(serde_json::from_str(text).map_err(|e| {
-                        Error::input(format!("sunbeam.response JSON is invalid: {e}"))
-                    })?);
+                return std::str::from_utf8(v)
+                    .map(str::to_owned)
+                    .map_err(|_| Error::input(format!("{key} is not UTF-8")));
             }
         }
         p += 4 + len.div_ceil(4) * 4;
     }
-    info.ok_or_else(|| Error::input("KTX2 file has no sunbeam.response key"))
+    Err(Error::input(format!("KTX2 file has no {key} key")))
 }
 
 /// Only a map's description (grid, wavelengths, the pack's manifest), from the
 /// file's head: the texels are not read (the player checks a map against its
 /// pack this way before it reads either in full).
 pub fn read_info(path: &std::path::Path) -> Result<Info> {
+    let text = read_entry(path, INFO_KEY)?;
+    serde_json::from_str(&text).map_err(|e| {
+        Error::input(format!("{INFO_KEY} JSON is invalid: {e}")).context(path.display().to_string())
+    })
+}
+
+/// The text under `key`, the texture's size and the level's byte offset from
+/// a KTX2 3D RGBA16F file's head (the texels are not read; the level must lie
+/// inside the file).
+pub(crate) fn read_head_layout(
+    path: &std::path::Path,
+    key: &str,
+) -> Result<(String, [usize; 3], u64)> {
+    let text = read_entry(path, key)?;
+    let head = sunbeam_common::magic::read_ktx2_head(path)?
+        .ok_or_else(|| Error::input_file(path, "not a KTX2 file (wrong identifier)"))?;
+    let u32_at = |o: usize| u32::from_le_bytes(head[o..o + 4].try_into().unwrap());
+    let u64_at = |o: usize| u64::from_le_bytes(head[o..o + 8].try_into().unwrap());
+    if head.len() < HEADER_LEN + LEVEL_INDEX_LEN {
+        return Err(Error::input_file(path, "KTX2 file truncated in its header"));
+    }
+    let size = [u32_at(20), u32_at(24), u32_at(28)].map(|v| v as usize);
+    if u32_at(36) != 1 || u32_at(40) != 1 || u32_at(44) != 0 {
+        return Err(Error::input_file(
+            path,
+            "KTX2 response map must have one face, one level, no supercompression",
+        ));
+    }
+    let (lv_off, lv_len) = (u64_at(80), u64_at(88));
+    let need = size.iter().map(|&v| v as u128).product::<u128>() * TEXEL as u128;
+    let file_len = std::fs::metadata(path)
+        .map_err(|e| Error::input_file(path, e))?
+        .len();
+    if lv_len as u128 != need || lv_off.checked_add(lv_len).is_none_or(|e| e > file_len) {
+        return Err(Error::input_file(
+            path,
+            format!(
+                "KTX2 level of {lv_len} bytes at {lv_off} does not fit a {}x{}x{} RGBA16F texture in a {file_len}-byte file",
+                size[0], size[1], size[2]
+            ),
+        ));
+    }
+    Ok((text, size, lv_off))
+}
+
+/// The text under `key` from a KTX2 file's head (the texels are not read).
+pub(crate) fn read_entry(path: &std::path::Path, key: &str) -> Result<String> {
     let head = sunbeam_common::magic::read_ktx2_head(path)?
         .ok_or_else(|| Error::input_file(path, "not a KTX2 file (wrong identifier)"))?;
     let ctx = |e: Error| e.context(path.display().to_string());
@@ -210,7 +289,7 @@ pub fn read_info(path: &std::path::Path) -> Result<Info> {
             u32_at(12)
         ))));
     }
-    parse_info(&head, u32_at(56) as usize, u32_at(60) as usize).map_err(ctx)
+    parse_entry(&head, u32_at(56) as usize, u32_at(60) as usize, key).map_err(ctx)
 }
 
 /// Read a map from a file (errors name the file).

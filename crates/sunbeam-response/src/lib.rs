@@ -18,6 +18,7 @@
 
 pub mod build;
 pub mod env;
+pub mod env_file;
 pub mod exr;
 pub mod grid;
 pub mod ktx2;

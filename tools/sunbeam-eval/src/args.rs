@@ -193,6 +193,10 @@ pub(crate) struct GratingArgs {
 pub(crate) struct RenderArgs {
     /// Scene JSON (docs/SCENE.md); or give --mesh and --pack for the default scene.
     pub(crate) scene: Option<PathBuf>,
+    /// Print a JSON report on stdout (output, samples, the environment map's
+    /// negative values set to 0).
+    #[arg(long)]
+    pub(crate) json: bool,
     /// Output: FRAME.png (display values) or FRAME.exr (linear light, exposure applied).
     #[arg(short, long)]
     pub(crate) output: PathBuf,

@@ -29,7 +29,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
                 quick: a.quick,
             })
         }
-        Cmd::Render(a) => render::run(&a),
+        Cmd::Render(a) => render::run(&a, cli.quiet),
         Cmd::Sheet(a) => sheet::run(&a.output, &a.inputs, a.columns),
     }
 }

@@ -18,7 +18,7 @@ fn lighting(a: &crate::args::RenderArgs) -> Result<DefaultLighting> {
     a.lighting.parse().map_err(Error::usage)
 }
 
-pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
+pub fn run(a: &crate::args::RenderArgs, quiet: bool) -> Result<()> {
     let mut scene = match (&a.scene, &a.mesh) {
         (Some(_), Some(_)) => {
             return Err(Error::usage(
@@ -70,15 +70,42 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
         }
         return turntable(&scene, &opts, n, a);
     }
+    // The scene's files, read once (an environment map is checked here: its
+    // negative values set to 0 make one warning line and the report's count).
+    let prepared = sunbeam_raster::prepare(&scene)?;
+    let mut report = serde_json::json!({
+        "tool": "sunbeam-eval render",
+        "output": a.output.display().to_string(),
+        "samples": samples,
+    });
+    if let Some((line, c)) = sunbeam_raster::environment_clamped_warning(&prepared) {
+        if !quiet {
+            eprintln!("sunbeam-eval: warning: {line}");
+        }
+        report["environment_negatives_zeroed"] = serde_json::json!({"values": c.values, "texels": c.texels, "min": c.min, "bound": c.bound});
+    }
+    render_frame(a, &prepared, &opts)?;
+    if a.json {
+        println!("{report}");
+    }
+    Ok(())
+}
+
+/// Render and write the frame (with `--compare`, print the difference).
+fn render_frame(
+    a: &crate::args::RenderArgs,
+    prepared: &sunbeam_raster::Prepared,
+    opts: &sunbeam_raster::Options,
+) -> Result<()> {
     // The frame in linear light: one seed's, or the mean of several seeds'.
     let linear = || -> Result<sunbeam_raster::LinearImage> {
-        let mut frames = vec![sunbeam_raster::render_linear(&scene, &opts)?];
+        let mut frames = vec![sunbeam_raster::render_prepared_linear(prepared, opts)?];
         for &seed in &a.seed[1..] {
             let o = sunbeam_raster::Options {
                 seed,
                 ..opts.clone()
             };
-            frames.push(sunbeam_raster::render_linear(&scene, &o)?);
+            frames.push(sunbeam_raster::render_prepared_linear(prepared, &o)?);
         }
         sunbeam_raster::linear::mean_of(&frames)
     };
@@ -104,7 +131,7 @@ pub fn run(a: &crate::args::RenderArgs) -> Result<()> {
     } else if a.seed.len() > 1 {
         linear()?.display(opts.curve).write_png(&a.output)
     } else {
-        sunbeam_raster::render_with(&scene, &opts)?.write_png(&a.output)
+        sunbeam_raster::render_prepared(prepared, opts).write_png(&a.output)
     }
 }
 

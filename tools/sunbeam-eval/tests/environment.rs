@@ -268,3 +268,38 @@ fn turntable_writes_an_animated_png() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("FILE.png"));
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// A real HDRI with lossy-compression negatives (../shared/data/hdri/night.exr:
+/// 829 values in 596 texels, from the data's README): counted in the `--json`
+/// report, reported in exactly one warning line, none with `-q`.
+#[test]
+fn real_hdri_negatives_are_counted_and_warned_once() {
+    let Some(night) = sunbeam_common::testdata::shared_file("hdri/night.exr") else {
+        return;
+    };
+    let d = std::env::temp_dir().join(format!("sb-eval-hdri-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let s = d.join("night.json");
+    let env = format!(r#"{{ "map": "{}" }}"#, night.display());
+    std::fs::write(&s, scene(&env)).unwrap();
+    let o = render(&s, &d.join("n.png"), &["--samples", "1", "--json"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let z = &r["environment_negatives_zeroed"];
+    assert_eq!(
+        (z["values"].as_u64(), z["texels"].as_u64()),
+        (Some(829), Some(596)),
+        "{r}"
+    );
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("warning:")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].contains("night.exr") && warnings[0].contains("829"),
+        "{err}"
+    );
+    let o = render(&s, &d.join("q.png"), &["--samples", "1", "-q"]);
+    assert!(o.status.success());
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("warning"));
+    let _ = std::fs::remove_dir_all(&d);
+}

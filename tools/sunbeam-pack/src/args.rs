@@ -82,9 +82,15 @@ pub(crate) struct Cli {
     #[arg(long)]
     pub(crate) threads: Option<usize>,
     /// Also write the response map the player and engines read (docs/PACK_FORMAT.md
-    /// "Response map"): beside the pack as NAME.response.ktx2, or to --response-out.
+    /// "Response map"): beside the pack as NAME.response.ktx2, or to --response-out;
+    /// and the environment's maps beside it as NAME.env-response.ktx2.
     #[arg(long)]
     pub(crate) response: bool,
+    /// The scene whose sky's sun the environment's maps (NAME.env-response.ktx2,
+    /// written with --response) hold the sun's map for (implies --response;
+    /// default: the sky of `sunbeam-play --mesh M --pack P`).
+    #[arg(long, value_name = "SCENE.json")]
+    pub(crate) response_sky: Option<PathBuf>,
     /// Where to write the response map (implies --response).
     #[arg(long, value_name = "FILE.ktx2")]
     pub(crate) response_out: Option<PathBuf>,

@@ -149,9 +149,13 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     let pack = build::run(fr, &plan, o.threads, &mut progress)?;
     let pack_secs = t0.elapsed().as_secs_f64();
     let response_path = cli.response_out.clone().or_else(|| {
-        (cli.response || cli.response_exr.is_some())
+        (cli.response || cli.response_exr.is_some() || cli.response_sky.is_some())
             .then(|| sunbeam_response::sidecar_path(&cli.output))
     });
+    let sky = match &response_path {
+        Some(_) => response_sky(&cli, &mut inputs)?,
+        None => None,
+    };
     let response = match &response_path {
         Some(_) => {
             let t = Instant::now();
@@ -161,15 +165,22 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
                 grid: None,
             };
             let r = sunbeam_response::build(&pack, &ro);
-            Some((r, t.elapsed().as_secs_f64()))
+            let t_point = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let e = sunbeam_response::env_file::build(&pack, sky.as_ref(), &ro);
+            Some((r, t_point, e, t.elapsed().as_secs_f64()))
         }
         None => None,
     };
     let mut files = write_pack(&pack, &cli.output, kind)?;
-    if let (Some(rp), Some((r, _))) = (&response_path, &response) {
+    if let (Some(rp), Some((r, _, e, _))) = (&response_path, &response) {
         let bytes = sunbeam_response::ktx2::encode(r);
         sunbeam_common::output::write_atomic(rp, &bytes)?;
         files.push((rp.clone(), bytes.len() as u64));
+        let ep = env_maps_path(rp);
+        let bytes = sunbeam_response::env_file::encode(e);
+        sunbeam_common::output::write_atomic(&ep, &bytes)?;
+        files.push((ep, bytes.len() as u64));
         if let Some(ep) = &cli.response_exr {
             let bytes = sunbeam_response::exr::encode(r)?;
             sunbeam_common::output::write_atomic(ep, &bytes)?;
@@ -211,12 +222,16 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             "bytes_written": bytes,
             "time_s": secs,
             "pack_time_s": pack_secs,
-            "response": response.as_ref().map(|(r, t)| serde_json::json!({
+            "response": response.as_ref().map(|(r, t, e, te)| serde_json::json!({
                 "grid": [r.info.grid.n_theta, r.info.grid.n_rho, r.info.grid.n_s],
                 "r0": r.info.grid.r0,
                 "lambda_samples": r.info.lambda_samples,
                 "bytes": r.byte_len(),
                 "time_s": t,
+                "environment_maps": e.maps.len(),
+                "environment_sun": e.info.sun_key.is_some(),
+                "environment_bytes": e.maps.iter().map(|m| m.byte_len()).sum::<usize>(),
+                "environment_time_s": te,
             })),
             "warnings": warnings,
             "notes": m.notes,
@@ -231,4 +246,42 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The sky whose sun's map the environment's maps hold: `--response-sky`'s
+/// scene's (None for a map or no environment), else the default scene's.
+fn response_sky(
+    cli: &Cli,
+    inputs: &mut Vec<std::path::PathBuf>,
+) -> Result<Option<sunbeam_light::sky::Sky>> {
+    let env = match &cli.response_sky {
+        Some(p) => {
+            inputs.push(p.clone());
+            sunbeam_scene::Scene::load(p)?.environment
+        }
+        None => Some(sunbeam_scene::Scene::default_sky()),
+    };
+    Ok(env.and_then(|e| {
+        e.sky.map(|s| {
+            sunbeam_light::sky::Sky::new(
+                s.sun_elevation_deg,
+                s.sun_azimuth_deg,
+                s.turbidity,
+                e.intensity,
+            )
+        })
+    }))
+}
+
+/// Where the environment's maps go: beside the point map `dir/NAME.response.ktx2`
+/// as `dir/NAME.env-response.ktx2` (for another name `dir/X.ktx2`, `dir/X.env-response.ktx2`).
+fn env_maps_path(point_map: &Path) -> std::path::PathBuf {
+    let name = point_map
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    match name.strip_suffix(".response.ktx2") {
+        Some(stem) => point_map.with_file_name(format!("{stem}.env-response.ktx2")),
+        None => sunbeam_response::env_file::sidecar_path(point_map),
+    }
 }

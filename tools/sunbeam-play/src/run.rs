@@ -129,11 +129,13 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     let scene = load_scene(&cli)?;
     let st = settings(&cli, &scene)?;
     let backend: Backend = cli.backend;
-    // The default mode draws with the response maps: a pack with a current map
+    // The default mode draws with the response maps: a pack with current maps
     // beside it is read as its manifest only (the CPU renderer needs the terms,
-    // and so does building the environment's maps).
+    // and so does building the environment's maps when they are not current).
     let prepared = if st.mode == Mode::Default && !cli.cpu && scene.environment.is_none() {
         sunbeam_frame::prepare_with(&scene, &sunbeam_render::response::load_pack)?
+    } else if st.mode == Mode::Default && !cli.cpu {
+        sunbeam_frame::prepare_with(&scene, &sunbeam_render::response::load_pack_for_environment)?
     } else {
         sunbeam_frame::prepare(&scene)?
     };
@@ -163,6 +165,12 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         "mode": format!("{:?}", st.mode).to_lowercase(),
         "msaa": st.msaa,
     });
+    if let Some((line, c)) = sunbeam_frame::environment_clamped_warning(&prepared) {
+        if !cli.quiet {
+            eprintln!("sunbeam-play: warning: {line}");
+        }
+        report["environment_negatives_zeroed"] = serde_json::json!({"values": c.values, "texels": c.texels, "min": c.min, "bound": c.bound});
+    }
     let image: LinearImage = if cli.cpu {
         let t = std::time::Instant::now();
         let k = cli.supersample.max(1);

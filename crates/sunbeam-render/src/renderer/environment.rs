@@ -1,15 +1,18 @@
 //! Sky and map lighting in the player (docs/PLAY.md "Environment"): which
 //! modes shade a scene's environment, and the extended-light maps of each
-//! pack under it (sunbeam-response's `build_env`, uploaded by
+//! pack under it (read from the pack's `NAME.env-response.ktx2` or built by
+//! sunbeam-response's `build_env`, uploaded by
 //! [`crate::env::EnvMaps`]). The progressive estimator itself is
 //! [`crate::env`] and shaders/environment.wgsl.
 
 use super::Mode;
+use std::path::Path;
 use std::sync::Arc;
 use sunbeam_common::{Error, Result};
 use sunbeam_frame::Prepared;
 use sunbeam_light::Environment;
 use sunbeam_pack::Pack;
+use sunbeam_response::env_file;
 
 /// The environment a mode shades: the scene's in the default mode, none for
 /// the Lambert baseline; the other baselines refuse a scene with one.
@@ -32,12 +35,17 @@ pub(super) fn of_scene(p: &Prepared, mode: Mode) -> Result<Option<Arc<Environmen
 /// The environment's maps already built, per pack (the same `Arc`).
 pub(super) type BuiltMaps = Vec<(*const Pack, Arc<crate::env::EnvMaps>)>;
 
-/// The extended-light maps of `pack` (meshes[`mi`]) under `env`, built once
-/// per pack (`built`); what the build took goes to `notes`.
+/// The extended-light maps of `pack` (meshes[`mi`], read from `path`) under
+/// `env`, once per pack (`built`): read from the pack's
+/// `NAME.env-response.ktx2` (`sunbeam-pack --response`) when it serves this
+/// pack and environment, else built (what the build took, and why, goes to
+/// `notes`). A file that cannot be read is an input error naming it.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn maps(
     gpu: &crate::gpu::Gpu,
     env: &Environment,
     pack: &Arc<Pack>,
+    path: Option<&Path>,
     mi: usize,
     opts: &sunbeam_response::Options,
     built: &mut BuiltMaps,
@@ -47,16 +55,54 @@ pub(super) fn maps(
     if let Some((_, m)) = built.iter().find(|(k, _)| *k == key) {
         return Ok(m.clone());
     }
-    if !pack.has_terms() {
-        return Err(Error::internal(format!(
-            "meshes[{mi}].pack: the environment's maps need the pack's terms (read it whole)"
-        )));
-    }
     let t0 = std::time::Instant::now();
-    let er = sunbeam_response::env::build_env(pack, env, opts);
+    let side = path.map(env_file::sidecar_path).filter(|p| p.is_file());
+    let mut stale = None;
+    if let Some(side) = &side {
+        match env_file::read_for(side, &pack.manifest, env, opts)? {
+            Ok(er) => {
+                log::info!(
+                    "read the environment's response maps of meshes[{mi}].pack from {} in {:.2?}",
+                    side.display(),
+                    t0.elapsed()
+                );
+                let m = Arc::new(crate::env::EnvMaps::new(gpu, &er)?);
+                built.push((key, m.clone()));
+                return Ok(m);
+            }
+            Err(why) => stale = Some(format!("{} {why}; ", side.display())),
+        }
+    }
+    // A manifest-only pack (read so because its maps looked current) has no
+    // terms to build from: read it whole.
+    let full;
+    let pack_terms = if pack.has_terms() {
+        pack
+    } else {
+        match path {
+            Some(p) => {
+                full =
+                    Arc::new(Pack::read(p).map_err(|e| e.context(format!("meshes[{mi}].pack")))?);
+                &full
+            }
+            None => {
+                return Err(Error::internal(format!(
+                "meshes[{mi}].pack: the environment's maps need the pack's terms (read it whole)"
+            )))
+            }
+        }
+    };
+    let t0 = std::time::Instant::now();
+    let er = sunbeam_response::env::build_env(pack_terms, env, opts);
+    let hint = if side.is_some() {
+        " (rebuild it: sunbeam-pack --response)"
+    } else {
+        " (write them once with `sunbeam-pack --response` to open instantly)"
+    };
     notes.push(format!(
-        "built the environment's response maps for meshes[{mi}].pack ({} x {} x {} texels, {} maps, \
-         {} pyramid levels) in {:.2} s",
+        "{}built the environment's response maps for meshes[{mi}].pack ({} x {} x {} texels, {} maps, \
+         {} pyramid levels) in {:.2} s{hint}",
+        stale.unwrap_or_default(),
         er.grid.n_theta,
         er.grid.n_rho,
         er.grid.n_s,

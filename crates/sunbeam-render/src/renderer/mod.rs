@@ -393,6 +393,7 @@ impl Renderer {
                     gpu,
                     env,
                     pack,
+                    p.scene.meshes.get(mi).and_then(|m| m.pack.as_deref()),
                     mi,
                     &settings.response,
                     &mut env_maps,

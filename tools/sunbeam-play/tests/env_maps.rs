@@ -1,0 +1,111 @@
+//! The environment's maps from the pipeline (`sunbeam-pack --response` writes
+//! `NAME.env-response.ktx2`, docs/PACK_FORMAT.md "Environment maps file"): the
+//! player draws with them when they serve the scene (no build at start, the
+//! same frame bit for bit as with the maps built in memory), rebuilds them in
+//! memory with a note for another sun or another pack (no line that says
+//! error), and refuses a damaged file naming it (exit 2, no panic).
+
+mod common;
+
+use common::{gpu_available, pack, scratch, BIN};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A sky-lit sphere with `x.ktx2`, the sun `elevation` degrees up at 70
+/// degrees azimuth, turbidity 3 (the pack tool's default sky at 35).
+fn sky_scene(dir: &Path, name: &str, elevation: f64) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(
+        &p,
+        format!(
+            r#"{{ "camera": {{ "eye": [0, 0.3, 2], "target": [0, 0, 0] }},
+  "meshes": [ {{ "mesh": "builtin:sphere", "pack": "x.ktx2" }} ],
+  "environment": {{ "sky": {{ "sun_elevation_deg": {elevation}, "sun_azimuth_deg": 70, "turbidity": 3 }} }} }}"#
+        ),
+    )
+    .unwrap();
+    p
+}
+
+fn render(scene: &Path, out: &str) -> Output {
+    Command::new(BIN)
+        .arg(scene)
+        .args(["--headless", "--size", "24x24", "--frames", "2", "-o"])
+        .arg(scene.with_file_name(out))
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const BUILT: &str = "built the environment's response maps";
+
+#[test]
+fn the_pipelines_environment_maps_are_read_rebuilt_when_stale_refused_when_damaged() {
+    if !gpu_available() {
+        return;
+    }
+    let d = scratch("play-env-maps");
+    pack(&d, "x", "xenopeltis");
+    let other = pack(&d, "y", "elaphe");
+    let maps = d.join("x.env-response.ktx2");
+    assert!(maps.is_file(), "sunbeam-pack --response wrote {maps:?}");
+    let scene = sky_scene(&d, "sky.json", 35.0);
+
+    // Current: read, not built.
+    let o = render(&scene, "read.exr");
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(!err.contains(BUILT), "maps built although current: {err}");
+
+    // Without the file the player builds them: the same frame, bit for bit.
+    std::fs::rename(&maps, d.join("aside.ktx2")).unwrap();
+    let o = render(&scene, "built.exr");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains(BUILT), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read(d.join("read.exr")).unwrap(),
+        std::fs::read(d.join("built.exr")).unwrap(),
+        "the frame from the file's maps differs from the one from maps built in memory"
+    );
+    std::fs::rename(d.join("aside.ktx2"), &maps).unwrap();
+
+    // Another sun: rebuilt with a note naming the file, no error line.
+    let low = sky_scene(&d, "low.json", 20.0);
+    let o = render(&low, "low.exr");
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains(BUILT) && err.contains("another sky"), "{err}");
+    assert!(err.contains("x.env-response.ktx2"), "{err}");
+    assert!(!err.to_lowercase().contains("error"), "{err}");
+
+    // Another pack's maps: rebuilt (the pack read whole), no error line.
+    std::fs::copy(other.with_extension("env-response.ktx2"), &maps).unwrap();
+    let o = render(&scene, "stale.exr");
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains(BUILT) && err.contains("another pack"), "{err}");
+    assert!(!err.to_lowercase().contains("error"), "{err}");
+    assert_eq!(
+        std::fs::read(d.join("read.exr")).unwrap(),
+        std::fs::read(d.join("stale.exr")).unwrap(),
+        "rebuilt maps give another frame"
+    );
+
+    // Damaged: cut short, or its JSON broken: an input error naming the file.
+    let good = std::fs::read(other.with_extension("env-response.ktx2")).unwrap();
+    let brace = good.windows(9).position(|w| w == b"{\"format\"").unwrap();
+    let mut broken = good.clone();
+    broken[brace] = b'[';
+    for bytes in [good[..good.len() / 2].to_vec(), broken] {
+        std::fs::write(&maps, &bytes).unwrap();
+        let o = render(&scene, "bad.exr");
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains("x.env-response.ktx2"), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
