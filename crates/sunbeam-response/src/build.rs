@@ -14,6 +14,11 @@
 //! radius row, the wavelength and `s`, so they are tabulated per row. Rows run
 //! in parallel (rayon); each texel's sum runs in a fixed order, so the map does
 //! not depend on the thread count.
+//!
+//! One file of about 900 lines on purpose: the tap tables, the terms' layout
+//! and the two sweeps (`window_by_rays`, `tiled_by_rows`) share private
+//! fields inside the build's inner loops; split into modules they would have
+//! to be made visible to the whole crate.
 
 use crate::grid::Grid;
 use crate::{Info, Response, FORMAT, VERSION};
