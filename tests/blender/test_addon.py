@@ -469,6 +469,189 @@ class OperatorTest(unittest.TestCase):
                 self.assertTrue((out.parent / pack).is_file(), f"{pack} from {out}")
 
 
+def glb_json(path):
+    """The JSON chunk of a GLB and its binary chunk (read here, not by the add-on)."""
+    data = Path(path).read_bytes()
+    assert data[:4] == b"glTF", path
+    (json_len,) = struct.unpack_from("<I", data, 12)
+    doc = json.loads(data[20:20 + json_len])
+    bin_start = 20 + json_len
+    (bin_len,) = struct.unpack_from("<I", data, bin_start)
+    return doc, data[bin_start + 8:bin_start + 8 + bin_len]
+
+
+def png_size(doc, blob, texture_index):
+    """Width and height (the PNG's IHDR) of a texture embedded in a GLB."""
+    image = doc["images"][doc["textures"][texture_index]["source"]]
+    view = doc["bufferViews"][image["bufferView"]]
+    png = blob[view.get("byteOffset", 0):view.get("byteOffset", 0) + view["byteLength"]]
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and png[12:16] == b"IHDR"
+    return struct.unpack(">II", png[16:24])
+
+
+def scale_maps(test, glb):
+    """The material's normalTexture and SUNBEAM_materials_diffraction orientationTexture (both
+    must be there): (normal size, orientation size, the extension)."""
+    doc, blob = glb_json(glb)
+    mats = [m for m in doc.get("materials", []) if "normalTexture" in m]
+    test.assertTrue(mats, f"no material with a normalTexture in {glb}")
+    ext = mats[0].get("extensions", {}).get("SUNBEAM_materials_diffraction", {})
+    test.assertIn("orientationTexture", ext, f"no orientationTexture in {glb}")
+    return (png_size(doc, blob, mats[0]["normalTexture"]["index"]),
+            png_size(doc, blob, ext["orientationTexture"]["index"]), ext)
+
+
+# The object settings of sunbeam-bake's scale flags: written out here (not the add-on's table)
+SCALE_PROPS = {"--scale-rows": "scale_rows", "--scale-length": "scale_length",
+               "--scale-overlap": "scale_overlap", "--scale-dome": "scale_dome",
+               "--scale-tilt": "scale_tilt", "--scale-tilt-jitter": "scale_tilt_jitter",
+               "--scale-ridge-jitter": "scale_ridge_jitter", "--scale-texels": "scale_texels",
+               "--scale-seed": "scale_seed"}
+REPORT_KEYS = {"scale_rows": "rows", "scale_length": "length", "scale_overlap": "overlap",
+               "scale_dome": "dome", "scale_tilt": "tilt_deg", "scale_tilt_jitter": "tilt_jitter_deg",
+               "scale_ridge_jitter": "ridge_jitter_deg", "scale_texels": "texels_per_scale",
+               "scale_seed": "seed"}
+
+
+class ScalesTest(unittest.TestCase):
+    """sunbeam-bake --scales from the object's Scales settings, in the operator and the render."""
+
+    def scaled_sphere(self, uvs=True):
+        scene = empty_scene(32, 32)
+        sphere = add_sphere(uvs)
+        sunbeam_skin(sphere)
+        add_camera(scene, (0, -3, 0), (0, 0, 0))
+        o = sphere.sunbeam
+        o.use_scales = True
+        o.scale_rows, o.scale_texels, o.scale_length, o.scale_overlap = 7, 8, 1.5, 0.45
+        o.scale_dome, o.scale_tilt, o.scale_tilt_jitter, o.scale_ridge_jitter = 0.1, -12.0, 3.0, 20.0
+        o.scale_seed = 12345
+        return scene, sphere
+
+    def test_operator_writes_the_maps_with_the_panel_values(self):
+        from sunbeam_blender import tools
+        _, sphere = self.scaled_sphere()
+        calls = []
+        real_run = tools.run
+
+        def recording_run(name, args, *rest, **kw):
+            args = [str(a) for a in args]
+            if name == "sunbeam-bake":  # keep the exported mesh: its temporary folder goes
+                shutil.copy(args[0], WORK / "scaled-input.glb")
+                calls.append((name, [str(WORK / "scaled-input.glb"), *args[1:]]))
+            return real_run(name, args, *rest, **kw)
+
+        out = WORK / "scaled.glb"
+        tools.run = recording_run
+        try:
+            bpy.ops.sunbeam.bake_orientation(filepath=str(out))
+        finally:
+            tools.run = real_run
+        normal, orientation, ext = scale_maps(self, out)
+        o = sphere.sunbeam
+        # 7 rows of 8 texels around v; ceil(along x 1.5 x 8) along u (docs/BAKE.md "Resolution")
+        self.assertEqual(ext["scales"]["rows"], 7)
+        self.assertEqual(ext["scales"]["seed"], 12345)
+        along = ext["scales"]["along"]
+        self.assertEqual(normal, (math.ceil(along * 1.5 * 8), 7 * 8))
+        self.assertEqual(orientation, normal)
+        # the flags given to sunbeam-bake, run again with --json: its report has the panel values
+        [args] = [a for name, a in calls if name == "sunbeam-bake"]
+        self.assertIn("--scales", args)
+        args[args.index("-o") + 1] = str(WORK / "scaled-again.glb")
+        report = json.loads(tool("sunbeam-bake", *[a for a in args if a not in ("-q", "--json")], "--json"))
+        params = report["scales"]["params"]
+        for prop, key in REPORT_KEYS.items():
+            self.assertAlmostEqual(params[key], getattr(o, prop), places=5, msg=key)
+        self.assertEqual(report["scales"]["texture_size"], list(normal))
+
+    def test_the_render_bakes_the_scales(self):
+        """The engine's export path: its baked GLB carries the maps, and the frame changes."""
+        from sunbeam_blender import export
+        scene, sphere = self.scaled_sphere()
+        tmp = WORK / "scaled-export"
+        tmp.mkdir()
+        warnings = []
+        doc = export.build_scene(bpy.context.evaluated_depsgraph_get(), str(tmp), "sunbeam-eval",
+                                 lambda: False, lambda *_: None, warnings)
+        # the sphere's field (the z axis) runs across u: the bake's warning reaches Blender
+        self.assertTrue([w for w in warnings if w.startswith("Object 'Sphere': sunbeam-bake: --scales")],
+                        warnings)
+        normal, _, ext = scale_maps(self, doc["meshes"][0]["mesh"])
+        self.assertEqual(normal[1], 7 * 8)
+        self.assertEqual(ext["scales"]["seed"], 12345)
+        sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+        scene.collection.objects.link(sun)
+        sun.rotation_euler = (1.2, 0.0, 0.4)
+        frames = []
+        for use in (True, False):
+            sphere.sunbeam.use_scales = use
+            render_to(scene, WORK / f"scales-{use}.exr")
+            frames.append(linear_pixels(WORK / f"scales-{use}.exr"))
+        self.assertGreater(frames[0].sum(), 0.0)
+        diff = np.abs(frames[0] - frames[1]).sum() / frames[1].sum()
+        self.assertGreater(diff, 0.05, "the scales do not change the rendered frame")
+
+    def test_defaults_are_the_tools(self):
+        props = bpy.types.Object.bl_rna.properties["sunbeam"].fixed_type.properties
+        help_text = tool("sunbeam-bake", "--help")
+        for flag, prop in SCALE_PROPS.items():
+            m = re.search(re.escape(flag) + r" <[^>]*>\s*\n[^\[]*\[default: ([^\]]+)\]", help_text)
+            self.assertIsNotNone(m, f"{flag} has no default in sunbeam-bake --help")
+            self.assertAlmostEqual(props[prop].default, float(m.group(1)), places=6, msg=flag)
+        self.assertFalse(props["use_scales"].default)
+
+    def test_the_limits_are_the_tools(self):
+        """Blender clamps a value out of range to the tool's limit: bakes at every maximum and at
+        every minimum succeed, and the tool refuses a value just beyond each limit."""
+        _, sphere = self.scaled_sphere()
+        o = sphere.sunbeam
+        props = o.bl_rna.properties
+        for prop in SCALE_PROPS.values():
+            if prop == "scale_seed":
+                continue  # a u64 in the tool, Blender's 32-bit int here
+            setattr(o, prop, 10 ** 6)
+            self.assertEqual(getattr(o, prop), props[prop].hard_max, prop)
+            setattr(o, prop, -10 ** 6)
+            self.assertEqual(getattr(o, prop), props[prop].hard_min, prop)
+        o.scale_seed = -5
+        self.assertEqual(o.scale_seed, 0)
+        for end in ("hard_max", "hard_min"):
+            for prop in SCALE_PROPS.values():
+                if prop != "scale_seed":
+                    setattr(o, prop, getattr(props[prop], end))
+            o.scale_texels = 4  # the largest maps take long to write; 4..256 is checked below
+            out = WORK / f"scales-{end}.glb"
+            bpy.ops.sunbeam.bake_orientation(filepath=str(out))
+            scale_maps(self, out)
+        for flag, prop in SCALE_PROPS.items():
+            if prop == "scale_seed":
+                continue
+            p = props[prop]
+            step = 1 if p.type == "INT" else 1e-3
+            for value, ok in ((p.hard_max, True), (p.hard_min, True),
+                              (p.hard_max + step, False), (p.hard_min - step, False)):
+                # no input file: a value the tool accepts fails later, on the input (exit 2)
+                run = subprocess.run([str(BIN / "sunbeam-bake"), str(WORK / "absent.glb"), "-o",
+                                      str(WORK / "x.glb"), "--scales", flag, f"{value:.6g}"],
+                                     capture_output=True, text=True)
+                self.assertEqual(run.returncode, 2 if ok else 1, f"{flag} {value}: {run.stderr}")
+
+    def test_scales_without_uvs_name_the_object_and_field(self):
+        scene, sphere = self.scaled_sphere(uvs=False)
+        sphere.sunbeam.source = "AXIS"
+        out = WORK / "scaled-bad.glb"
+        with self.assertRaises(RuntimeError) as caught:
+            bpy.ops.sunbeam.bake_orientation(filepath=str(out))
+        for needle in ("Object 'Sphere'", "Sunbeam Orientation > Scales", "no UV map 0"):
+            self.assertIn(needle, str(caught.exception))
+        self.assertFalse(out.exists())
+        with self.assertRaises(RuntimeError) as caught:
+            render_to(scene, WORK / "scaled-bad.exr")
+        self.assertIn("Sunbeam Orientation > Scales", str(caught.exception))
+        self.assertFalse((WORK / "scaled-bad.exr").exists())
+
+
 class ViewportTest(unittest.TestCase):
     def test_the_viewport_path_renders_the_export_with_the_player(self):
         """The viewport's export (what view_update's timer runs) and its sunbeam-play run (what

@@ -9,6 +9,7 @@ exporter's "+Y Up", so the exported meshes, the camera, the lights and the World
 import json
 import math
 import os
+import struct
 from array import array
 
 import bpy
@@ -314,7 +315,37 @@ def bake_source(depsgraph, obj):
         args = ["--uv-direction", o.uv_direction, "--uv-set", str(o.uv_set)]
     if o.rotate_deg:
         args += ["--rotate-deg", f"{o.rotate_deg:.9g}"]
+    if o.use_scales:
+        uv_layers = obj.data.uv_layers
+        if len(uv_layers) <= o.uv_set:
+            raise SunbeamError(f"{what} > Scales: the mesh has no UV map {o.uv_set} "
+                               f"({len(uv_layers)} UV maps; scales need UVs)")
+        if o.source != "UV":
+            args += ["--uv-set", str(o.uv_set)]
+        args += ["--scales"]
+        for flag, name in SCALE_FLAGS:
+            value = getattr(o, name)
+            args += [flag, str(value) if isinstance(value, int) else _float32_text(value)]
     return args, spine
+
+
+# sunbeam-bake's scale flags and the object settings that give them (properties.py)
+SCALE_FLAGS = (("--scale-rows", "scale_rows"), ("--scale-length", "scale_length"),
+               ("--scale-overlap", "scale_overlap"), ("--scale-dome", "scale_dome"),
+               ("--scale-tilt", "scale_tilt"), ("--scale-tilt-jitter", "scale_tilt_jitter"),
+               ("--scale-ridge-jitter", "scale_ridge_jitter"), ("--scale-texels", "scale_texels"),
+               ("--scale-seed", "scale_seed"))
+
+
+def _float32_text(value):
+    """The shortest decimal that reads back as the same float32 (Blender's FloatProperty): a
+    limit such as 0.6 is written "0.6", not "0.600000024", which the tool's range refuses."""
+    stored = struct.unpack("<f", struct.pack("<f", value))[0]
+    for digits in range(1, 10):
+        near = float(f"{stored:.{digits}g}")
+        if struct.unpack("<f", struct.pack("<f", near))[0] == stored:
+            return repr(near)
+    return repr(stored)
 
 
 def mesh_jobs(depsgraph, warnings):
@@ -368,10 +399,11 @@ def _export_glb(depsgraph, obj, path):
         raise SunbeamError(f"Object '{obj.name}': the glTF exporter wrote nothing")
 
 
-def bake(depsgraph, job, tmp, index, cancelled, out=None):
+def bake(depsgraph, job, tmp, index, cancelled, out=None, warnings=None):
     """Export `job`'s object into `tmp` and, with bake flags, bake its orientation field (into
     `out` if given: sunbeam-bake writes atomically, and paths it writes are relative to the
-    output): the GLB's path."""
+    output): the GLB's path. The bake's own warnings (its --json report's, e.g. a UV layout
+    that does not fit the scales) go to `warnings`."""
     exported = os.path.join(tmp, f"mesh{index}.glb")
     _export_glb(depsgraph, job.obj, exported)
     if job.bake_args is None:
@@ -384,9 +416,15 @@ def bake(depsgraph, job, tmp, index, cancelled, out=None):
         args[args.index(SPINE)] = spine
     baked = out or os.path.join(tmp, f"mesh{index}-baked.glb")
     try:
-        tools.run("sunbeam-bake", [exported, "-o", baked, "-q", *args], cancelled)
+        report = tools.run("sunbeam-bake", [exported, "-o", baked, "-q", "--json", *args], cancelled)
     except SunbeamError as e:
         raise SunbeamError(f"Object '{job.obj.name}': Sunbeam Orientation: {e}") from None
+    if warnings is not None:
+        try:
+            found = json.loads(report).get("warnings", [])
+        except ValueError:
+            found = []
+        warnings.extend(f"Object '{job.obj.name}': sunbeam-bake: {w}" for w in found)
     return baked
 
 
@@ -438,7 +476,8 @@ def build_scene(depsgraph, tmp, renderer, cancelled, progress, warnings):
         doc["environment"] = environment
     for i, job in enumerate(jobs):
         progress(0.5 * i / len(jobs), f"Exporting and baking {job.obj.name}")
-        doc["meshes"].append(mesh_entry(job, bake(depsgraph, job, tmp, i, cancelled)))
+        doc["meshes"].append(mesh_entry(job, bake(depsgraph, job, tmp, i, cancelled,
+                                                  warnings=warnings)))
     return doc
 
 

@@ -177,11 +177,14 @@ class SUNBEAM_OT_bake_orientation(bpy.types.Operator, ExportHelper):
                          "--diffuse-weight", f"{mat.sunbeam.diffuse_weight:.9g}"]
             job = export.MeshJob(obj, mat, args, spine)
             tools.find_tool("sunbeam-bake")
+            warnings = []
             with tempfile.TemporaryDirectory(prefix="sunbeam-bake-") as tmp:
-                export.bake(depsgraph, job, tmp, 0, lambda: False, out)
+                export.bake(depsgraph, job, tmp, 0, lambda: False, out, warnings)
         except (SunbeamError, OSError) as e:
             self.report({"ERROR"}, str(e) if str(e).startswith("Object") else f"Object '{obj.name}': {e}")
             return {"CANCELLED"}
+        for w in warnings:
+            self.report({"WARNING"}, w)
         self.report({"INFO"}, f"Wrote {out}")
         return {"FINISHED"}
 

@@ -56,10 +56,41 @@ class SunbeamObjectSettings(bpy.types.PropertyGroup):
     uv_direction: EnumProperty(name="UV Direction", default="u",
                                items=[("u", "U", "Increasing u"), ("v", "V", "Increasing v")])
     uv_set: IntProperty(name="UV Map Index", min=0, default=0,
-                        description="Which UV map (glTF TEXCOORD_N) the UV source reads")
+                        description="Which UV map (glTF TEXCOORD_N) the UV source and the "
+                        "scales read (--uv-set)")
     rotate_deg: FloatProperty(name="Rotate", default=0.0, subtype="NONE",
                               description="Extra rotation about the normal, degrees, "
                               "counter-clockwise seen from outside (--rotate-deg)")
+    # sunbeam-bake --scales (docs/BAKE.md "Scales"): the same ranges and defaults as the tool's,
+    # as hard limits, so Blender clamps what the tool would refuse. The seed is a u64 in the
+    # tool; Blender's integers are 32-bit.
+    use_scales: BoolProperty(name="Scales", default=False,
+                             description="Bake scales: a normal map and a ridge-orientation map "
+                             "in the GLB (--scales); needs UVs, u along the body, v around it")
+    scale_rows: IntProperty(name="Rows", min=3, max=200, default=20,
+                            description="Scale rows around the body, one turn of v (--scale-rows)")
+    scale_length: FloatProperty(name="Length", min=0.25, max=4.0, default=1.0,
+                                description="Scale length along the body, in scale widths "
+                                "(--scale-length)")
+    scale_overlap: FloatProperty(name="Overlap", min=0.0, max=0.6, default=0.3,
+                                 description="Overlap of a scale's free edge over the scale behind "
+                                 "it, in scale lengths (--scale-overlap)")
+    scale_dome: FloatProperty(name="Dome", min=0.0, max=0.3, default=0.06, precision=3,
+                              description="Dome height of a scale, in scale widths (--scale-dome)")
+    scale_tilt: FloatProperty(name="Tilt", min=-30.0, max=30.0, default=6.0,
+                              description="Tilt of the free edge, degrees: the scale's normal turns "
+                              "toward the head (--scale-tilt)")
+    scale_tilt_jitter: FloatProperty(name="Tilt Jitter", min=0.0, max=20.0, default=4.0,
+                                     description="Per-scale jitter of the tilt, uniform in +-degrees "
+                                     "(--scale-tilt-jitter)")
+    scale_ridge_jitter: FloatProperty(name="Ridge Jitter", min=0.0, max=45.0, default=6.0,
+                                      description="Per-scale jitter of the ridge angle about the "
+                                      "normal, uniform in +-degrees (--scale-ridge-jitter)")
+    scale_texels: IntProperty(name="Texels per Scale", min=4, max=256, default=32,
+                              description="Texels across one scale width, reduced when a side would "
+                              "pass 8192 (--scale-texels)")
+    scale_seed: IntProperty(name="Seed", min=0, default=1,
+                            description="Seed of the per-scale jitter (--scale-seed)")
 
 
 class SunbeamRenderSettings(bpy.types.PropertyGroup):

@@ -61,6 +61,35 @@ class SUNBEAM_PT_orientation(bpy.types.Panel):
         layout.operator("sunbeam.bake_orientation", text="Bake to GLB...", icon="EXPORT")
 
 
+class SUNBEAM_PT_orientation_scales(bpy.types.Panel):
+    """sunbeam-bake --scales: a sub-panel of the orientation, ticked in its header."""
+
+    bl_label = "Scales"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "object"
+    bl_parent_id = "SUNBEAM_PT_orientation"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.object is not None and context.object.type == "MESH"
+
+    def draw_header(self, context):
+        self.layout.prop(context.object.sunbeam, "use_scales", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        o = context.object.sunbeam
+        layout.active = o.use_scales
+        if o.source != "UV":
+            layout.prop(o, "uv_set")
+        for name in ("scale_rows", "scale_length", "scale_overlap", "scale_dome", "scale_tilt",
+                     "scale_tilt_jitter", "scale_ridge_jitter", "scale_texels", "scale_seed"):
+            layout.prop(o, name)
+
+
 class SUNBEAM_PT_render(bpy.types.Panel):
     bl_label = "Sunbeam"
     bl_space_type = "PROPERTIES"
@@ -79,7 +108,8 @@ class SUNBEAM_PT_render(bpy.types.Panel):
         layout.operator("sunbeam.import_scan", text="Import AFM Scan...", icon="IMPORT")
 
 
-classes = (SUNBEAM_PT_material, SUNBEAM_PT_orientation, SUNBEAM_PT_render)
+classes = (SUNBEAM_PT_material, SUNBEAM_PT_orientation, SUNBEAM_PT_orientation_scales,
+           SUNBEAM_PT_render)
 
 
 def register():
