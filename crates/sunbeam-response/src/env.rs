@@ -126,7 +126,7 @@ pub fn env_weights(pack: &Pack, env: &Environment, n: usize) -> build::WeightSet
 /// The weight sets of [`env_weights`] for several bases at once (three sets
 /// each, in order), then the sun's set when `sun` is given: what
 /// `sunbeam-pack --response` builds in one pass for every sky and every map
-/// ([`crate::env_file`]).
+/// (written and read by the `env_file` module).
 pub fn weight_sets(
     pack: &Pack,
     n: usize,
