@@ -189,3 +189,59 @@ fn player_background_matches_reference() {
         assert!(s.p99 < 1.0, "{s}");
     }
 }
+
+/// The sky (its table in the player, its model in the reference), the sun in
+/// view: the player's frame against the reference's over the whole frame.
+#[test]
+fn player_sky_background_matches_reference() {
+    let Some(gpu) = gpu::gpu() else { return };
+    let mut p = scene();
+    let env = sunbeam_scene::Environment {
+        sky: Some(sunbeam_scene::Sky {
+            sun_elevation_deg: 12.0,
+            sun_azimuth_deg: 95.0,
+            turbidity: 3.0,
+        }),
+        map: None,
+        rotation_deg: 0.0,
+        intensity: 0.5,
+    };
+    p.scene.environment = Some(env);
+    p.environment =
+        Some(sunbeam_frame::load_environment(p.scene.environment.as_ref().unwrap()).unwrap());
+    let reference = sunbeam_raster::render_prepared(
+        &p,
+        &Options {
+            samples: 16,
+            ..Default::default()
+        },
+    );
+    let frame = sunbeam_render::render_headless(&gpu, &p, &Settings::default(), None, 16).unwrap();
+    let d = sunbeam_frame::compare(&frame, &reference).unwrap();
+    // The table holds the sky at its texels' centres (0.7 degree rows): the
+    // horizon's row, where the sky model is steepest, is compared apart.
+    let (mut d_sky, mut d_horizon) = (Vec::new(), Vec::new());
+    for (k, (a, b)) in frame.rgb.iter().zip(&reference.rgb).enumerate() {
+        let (x, y) = ((k as u32 % W) as f64, (k as u32 / W) as f64);
+        let near_horizon = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+            .iter()
+            .any(|(dx, dy)| camera_ray(&p, x + dx, y + dy)[1].abs() < 1.5f64.to_radians().sin());
+        let e = sunbeam_optics::colour::ciede2000_xyz(
+            sunbeam_frame::image::display_to_xyz(*a),
+            sunbeam_frame::image::display_to_xyz(*b),
+        );
+        if near_horizon {
+            d_horizon.push(e)
+        } else {
+            d_sky.push(e)
+        }
+    }
+    let (s, h) = (
+        sunbeam_frame::diff::stats(&mut d_sky),
+        sunbeam_frame::diff::stats(&mut d_horizon),
+    );
+    eprintln!("player sky background: {s}; within 1.5 degrees of the horizon {h}; whole frame {d}");
+    assert!(s.pixels > (W * H * 3 / 4) as usize);
+    assert!(s.p99 < 1.0, "{s}");
+    assert!(h.p99 < 6.0, "{h}");
+}
