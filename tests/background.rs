@@ -190,8 +190,9 @@ fn player_background_matches_reference() {
     }
 }
 
-/// The sky (its table in the player, its model in the reference), the sun in
-/// view: the player's frame against the reference's over the whole frame.
+/// The sky (its table in the player, its model in the reference), the sun's
+/// disc in view (14 degrees above the view direction): the player's frame
+/// against the reference's, the pixels near the horizon apart.
 #[test]
 fn player_sky_background_matches_reference() {
     let Some(gpu) = gpu::gpu() else { return };
