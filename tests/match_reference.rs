@@ -269,7 +269,7 @@ fn response_map_20um_patch_matches_antialiased_reference() {
 fn background_matches_reference() {
     let Some(gpu) = gpu() else { return };
     let (mut scene, mesh) = fixtures::quad_scene([16, 16]);
-    scene.background = [0.004, 0.004, 0.005];
+    scene.background = sunbeam_scene::Background::Colour([0.004, 0.004, 0.005]);
     scene.exposure = 1.5;
     scene.camera.eye = [0.0, 0.0, -5.0]; // behind the quad: back face culled, background only
     let p = fixtures::prepared(scene, mesh, None);

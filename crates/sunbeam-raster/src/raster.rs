@@ -11,7 +11,8 @@ use sunbeam_scene::camera::transform;
 pub struct Fragment {
     /// Index into `Prepared::meshes`; None for the background.
     pub mesh: Option<u32>,
-    /// World position.
+    /// World position; for the background (no mesh), the point at unit
+    /// distance from the eye along the sample's view ray.
     pub pos: [f64; 3],
     /// Interpolated (not normalised) normal; on a mesh with scale maps, the
     /// normal map's normal (unit, `sunbeam_frame::MeshScales::perturb`).
@@ -156,9 +157,21 @@ pub fn rasterise_rows_at(
             }
         }
     }
-    for f in &mut buf {
+    let eye = p.scene.camera.eye;
+    for (k, f) in buf.iter_mut().enumerate() {
         if f.mesh.is_none() {
             f.depth = 1.0;
+            let (i, j) = (
+                (k % w as usize) as i64,
+                (k / w as usize) as i64 + rows.start as i64,
+            );
+            let o = at.offset(i, j);
+            let (x, y) = (
+                (i * ONE + o[0]) as f64 / ONE as f64,
+                (j * ONE + o[1]) as f64 / ONE as f64,
+            );
+            let d = p.scene.camera.ray(w, h, x, y);
+            f.pos = std::array::from_fn(|c| eye[c] + d[c]);
         }
     }
     buf

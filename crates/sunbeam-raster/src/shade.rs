@@ -11,7 +11,9 @@
 //! `sunbeam_optics::gain`) times its masking, `R_U` the reflectance with the
 //! window's exact grazing term (`Pack::shading_reflectance`, PHYSICS.md 2b),
 //! `dw` the mesh's diffuse weight (1 and no `(1 - F)` for a mesh without a
-//! pack: base colour only). The background is its linear colour.
+//! pack: base colour only). The background is its linear colour, or under
+//! `"background": "environment"` the environment's radiance along the
+//! sample's view ray (`Environment::rgb`: rotation and intensity applied).
 //! Display value = sRGB OETF(tone curve(2^exposure * rgb)).
 
 use crate::raster::Fragment;
@@ -19,6 +21,7 @@ use crate::spectral::Samples;
 use crate::{Options, Prepared};
 use sunbeam_optics::cie;
 use sunbeam_optics::colour::{self, ToneMap};
+use sunbeam_scene::Background;
 
 pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -100,7 +103,16 @@ impl<'a> Shader<'a> {
     /// Linear sRGB radiance of a fragment (the background colour for none).
     pub fn linear(&self, f: &Fragment) -> [f64; 3] {
         let Some(mi) = f.mesh else {
-            return self.p.scene.background;
+            return match (self.p.scene.background, &self.p.environment) {
+                (Background::Colour(c), _) => c,
+                (Background::Environment, Some(env)) => {
+                    let eye = self.p.scene.camera.eye;
+                    normalize(std::array::from_fn(|k| f.pos[k] - eye[k]))
+                        .map_or([0.0; 3], |d| env.rgb(d))
+                }
+                // refused by Scene::validate
+                (Background::Environment, None) => [0.0; 3],
+            };
         };
         let mi = mi as usize;
         let mat = &self.p.meshes[mi].1;

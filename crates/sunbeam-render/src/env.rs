@@ -207,6 +207,11 @@ impl EnvScene {
         }
     }
 
+    /// The coefficient table (also the background pass's environment).
+    pub(crate) fn table(&self) -> &wgpu::TextureView {
+        &self.table
+    }
+
     /// Set the frame index (the random numbers' seed) for the next frame.
     pub(crate) fn set_frame(&self, gpu: &Gpu, frame: u32) {
         let mut v = self.values;

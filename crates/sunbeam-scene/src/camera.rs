@@ -96,6 +96,30 @@ impl Camera {
         ]
     }
 
+    /// The view rays of a `width x height` image: `(o, rx, ry)` with the
+    /// (unnormalised) world direction through NDC `(x, y)` equal to
+    /// `o + x rx + y ry` (`o` the view direction, `rx`, `ry` the image's axes
+    /// scaled by the projection; the inverse of [`Camera::view_proj`]).
+    pub fn ray_basis(&self, width: u32, height: u32) -> ([f64; 3], [f64; 3], [f64; 3]) {
+        let aspect = width.max(1) as f64 / height.max(1) as f64;
+        let v = self.view();
+        let t = 1.0 / (self.fov_y_deg.to_radians() / 2.0).tan();
+        // rows of the view matrix: s, u, -f
+        let s = [v[0][0], v[1][0], v[2][0]];
+        let u = [v[0][1], v[1][1], v[2][1]];
+        let f = [-v[0][2], -v[1][2], -v[2][2]];
+        (f, s.map(|c| c * aspect / t), u.map(|c| c / t))
+    }
+
+    /// Unit world direction of the view ray through pixel position `(x, y)`
+    /// (pixels, y down, `(i + 0.5, j + 0.5)` the centre of pixel `(i, j)`).
+    pub fn ray(&self, width: u32, height: u32, x: f64, y: f64) -> [f64; 3] {
+        let (o, rx, ry) = self.ray_basis(width, height);
+        let nx = 2.0 * x / width.max(1) as f64 - 1.0;
+        let ny = 1.0 - 2.0 * y / height.max(1) as f64;
+        normalize(std::array::from_fn(|k| o[k] + nx * rx[k] + ny * ry[k]))
+    }
+
     /// World -> clip for an image of `width x height` pixels.
     pub fn view_proj(&self, width: u32, height: u32) -> Mat4 {
         let aspect = width.max(1) as f64 / height.max(1) as f64;

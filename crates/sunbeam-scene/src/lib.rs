@@ -23,15 +23,70 @@ pub struct Scene {
     /// Exposure in stops (EV): linear colour is multiplied by 2^exposure before tone mapping.
     #[serde(default)]
     pub exposure: f64,
-    /// Background, linear sRGB.
-    #[serde(default = "default_background")]
-    pub background: [f64; 3],
+    /// Background: a linear sRGB colour, or `"environment"` (the scene's
+    /// environment seen along each view ray).
+    #[serde(default)]
+    pub background: Background,
     /// Output size in pixels (width, height) for headless renders.
     #[serde(default = "default_size")]
     pub size: [u32; 2],
     /// Extended light around the scene: a built-in sky or an equirectangular map.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub environment: Option<Environment>,
+}
+
+/// `"background"`: what a pixel that sees no mesh shows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Background {
+    /// A constant linear sRGB colour (`[r, g, b]`).
+    Colour([f64; 3]),
+    /// The scene's environment (sky or map, rotated, times its intensity)
+    /// along the pixel's view ray (`"environment"`).
+    Environment,
+}
+
+impl Default for Background {
+    fn default() -> Self {
+        Background::Colour([0.0; 3])
+    }
+}
+
+impl Background {
+    /// The constant colour, or None for `"environment"`.
+    pub fn colour(&self) -> Option<[f64; 3]> {
+        match self {
+            Background::Colour(c) => Some(*c),
+            Background::Environment => None,
+        }
+    }
+}
+
+impl Serialize for Background {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        match self {
+            Background::Colour(c) => c.serialize(s),
+            Background::Environment => s.serialize_str("environment"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Background {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        const WANT: &str =
+            "background: expected an [r, g, b] array of 3 numbers (linear sRGB) or \"environment\"";
+        match serde_json::Value::deserialize(d)? {
+            serde_json::Value::String(s) if s == "environment" => Ok(Background::Environment),
+            serde_json::Value::Array(a) if a.len() == 3 => {
+                let mut c = [0.0; 3];
+                for (k, v) in a.iter().enumerate() {
+                    c[k] = v.as_f64().ok_or_else(|| D::Error::custom(WANT))?;
+                }
+                Ok(Background::Colour(c))
+            }
+            _ => Err(D::Error::custom(WANT)),
+        }
+    }
 }
 
 /// `"environment"`: exactly one of `sky` or `map`, scaled by `intensity`.
@@ -309,9 +364,6 @@ fn default_base() -> [f64; 3] {
 fn default_diffuse_weight() -> f64 {
     0.2
 }
-fn default_background() -> [f64; 3] {
-    [0.0, 0.0, 0.0]
-}
 fn default_size() -> [u32; 2] {
     [512, 512]
 }
@@ -420,7 +472,7 @@ impl Scene {
                 reflectance: ReflectanceMode::Absolute,
             }],
             exposure: 0.0,
-            background: default_background(),
+            background: Background::default(),
             size: default_size(),
             environment: None,
         };
@@ -508,6 +560,16 @@ impl Scene {
         }
         if let Some(env) = &self.environment {
             env.validate()?;
+        }
+        if self.background == Background::Environment && self.environment.is_none() {
+            return Err(Error::input(
+                "background \"environment\" needs an \"environment\" (sky or map) in the scene",
+            ));
+        }
+        if let Some(c) = self.background.colour() {
+            if !c.iter().all(|v| v.is_finite()) {
+                return Err(Error::input("background must be finite"));
+            }
         }
         Ok(())
     }
@@ -602,6 +664,48 @@ mod tests {
         let mut s = env_scene(r#"{"map":"a.hdr"}"#).unwrap();
         s.environment.as_mut().unwrap().intensity = f64::NAN;
         assert!(s.validate().is_err());
+    }
+
+    #[test]
+    fn background_colour_or_environment() {
+        let parse = |bg: &str, env: &str| -> Result<Scene> {
+            let text = format!(
+                r#"{{"camera":{{"eye":[0,0,3],"target":[0,0,0]}},"meshes":[{{"mesh":"a.glb"}}]{bg}{env}}}"#
+            );
+            let mut s: Scene =
+                serde_json::from_str(&text).map_err(|e| Error::input(e.to_string()))?;
+            s.validate()?;
+            Ok(s)
+        };
+        let env = r#","environment":{"map":"a.hdr"}"#;
+        assert_eq!(
+            parse("", "").unwrap().background,
+            Background::Colour([0.0; 3])
+        );
+        assert_eq!(
+            parse(r#","background":[0.1,0.2,0.3]"#, "")
+                .unwrap()
+                .background,
+            Background::Colour([0.1, 0.2, 0.3])
+        );
+        let s = parse(r#","background":"environment""#, env).unwrap();
+        assert_eq!(s.background, Background::Environment);
+        // round trip
+        let again: Scene = serde_json::from_str(&serde_json::to_string(&s).unwrap()).unwrap();
+        assert_eq!(again.background, Background::Environment);
+        let msg = parse(r#","background":"environment""#, "")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("background") && msg.contains("environment"),
+            "{msg}"
+        );
+        for bad in [r#""sky""#, "[1,2]", r#"[1,2,"x"]"#, "1", "{}"] {
+            let msg = parse(&format!(r#","background":{bad}"#), env)
+                .unwrap_err()
+                .to_string();
+            assert!(msg.contains("background"), "{bad}: {msg}");
+        }
     }
 
     #[test]

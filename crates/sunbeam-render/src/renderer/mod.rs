@@ -13,6 +13,7 @@
 //! the WGSL), [`pipeline`] (layouts, buffers, the render pipeline),
 //! [`targets`] (depth, colour and offscreen targets, readback).
 
+pub mod background;
 pub mod baselines;
 pub mod environment;
 pub mod pipeline;
@@ -31,7 +32,7 @@ use std::sync::Arc;
 use sunbeam_common::{Error, Result};
 use sunbeam_frame::Prepared;
 use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
-use sunbeam_scene::{camera, Camera, Light};
+use sunbeam_scene::{camera, Background, Camera, Light};
 use uniforms::{pack_uniforms, spectral_samples, spectrum_table, Globals, MaterialU};
 use wgpu::util::DeviceExt;
 
@@ -146,7 +147,7 @@ pub struct FrameState {
     pub camera: Camera,
     pub lights: Vec<Light>,
     pub exposure: f64,
-    pub background: [f64; 3],
+    pub background: Background,
 }
 
 impl FrameState {
@@ -169,6 +170,8 @@ pub struct Renderer {
     settings: Settings,
     n_lambda: u32,
     env: crate::env::EnvScene,
+    /// The pass of `"background": "environment"`.
+    background: Option<background::Background>,
     /// Colour target format the pipeline writes.
     pub format: wgpu::TextureFormat,
     /// Notes for the user (packs cut to MAX_TERMS, ...).
@@ -417,8 +420,29 @@ impl Renderer {
             format,
             settings.msaa,
         )?;
+        // `"background": "environment"`: the lighting's table and sun (or,
+        // in the Lambert mode, which lights without them, the same built here).
+        let background = match (&p.scene.background, &p.environment) {
+            (Background::Environment, Some(e)) => {
+                let own;
+                let es = if env_scene.env.is_some() {
+                    &env_scene
+                } else {
+                    own = crate::env::EnvScene::new(gpu, Some(e.clone()), 1);
+                    &own
+                };
+                Some(background::Background::new(gpu, es, format, settings.msaa)?)
+            }
+            (Background::Environment, None) => {
+                return Err(Error::input(
+                    "background \"environment\" needs an \"environment\" in the scene",
+                ))
+            }
+            _ => None,
+        };
         Ok(Renderer {
             pipeline,
+            background,
             globals,
             global_bind,
             meshes,
@@ -495,12 +519,10 @@ impl Renderer {
             ],
             lights,
             xyz_to_rgb: [row(0), row(1), row(2)],
-            background: [
-                state.background[0] as f32,
-                state.background[1] as f32,
-                state.background[2] as f32,
-                1.0,
-            ],
+            background: {
+                let b = state.background.colour().unwrap_or([0.0; 3]);
+                [b[0] as f32, b[1] as f32, b[2] as f32, 1.0]
+            },
             n_lights: n as u32,
             mode: match self.settings.mode {
                 Mode::Default | Mode::Table => 0,
@@ -524,20 +546,37 @@ impl Renderer {
         };
         gpu.queue
             .write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
+        if let Some(bg) = &self.background {
+            bg.update(
+                gpu,
+                &background::BgFrame {
+                    camera: &state.camera,
+                    size: [w, h],
+                    jitter,
+                    exposure_scale: g.exposure_scale,
+                    curve: g.curve,
+                    output: g.output,
+                    keep_negative: self.progressive(),
+                },
+            );
+        }
     }
 
-    /// The clear colour: the background through the display transform (linear for an sRGB target).
+    /// The clear colour: the background through the display transform (linear
+    /// for an sRGB target); black under `"background": "environment"` (its
+    /// pass draws over it).
     pub fn clear_colour(&self, state: &FrameState) -> wgpu::Color {
+        let background = state.background.colour().unwrap_or([0.0; 3]);
         let tm = ToneMap {
             exposure_ev: state.exposure,
             curve: self.settings.curve,
         };
-        let mut e = colour::display_encode(state.background, &tm);
+        let mut e = colour::display_encode(background, &tm);
         if self.format == OFFSCREEN_FORMAT {
             // Offscreen targets hold linear light times the exposure (the shader's
             // output 2); the display transform follows on the CPU.
             let k = state.exposure.exp2();
-            e = state.background.map(|v| (v * k).max(0.0));
+            e = background.map(|v| (v * k).max(0.0));
         } else if self.format.is_srgb() {
             e = e.map(colour::srgb_eotf);
         }
@@ -604,6 +643,9 @@ impl Renderer {
             rp.set_vertex_buffer(0, m.vbuf.slice(..));
             rp.set_index_buffer(m.ibuf.slice(..), wgpu::IndexFormat::Uint32);
             rp.draw_indexed(0..m.count, 0, 0..1);
+        }
+        if let Some(bg) = &self.background {
+            bg.draw(&mut rp);
         }
     }
 }

@@ -1,0 +1,107 @@
+// The background pass of `"background": "environment"` (docs/PLAY.md
+// "Background"): one full-screen triangle at the far plane, drawn after the
+// meshes with depth test `LessEqual` and no depth write, so it covers exactly
+// the samples no mesh covers. Each pixel looks up the environment along its
+// view ray as the lighting does (shaders/environment.wgsl `env_coefficients`:
+// the coefficient table's texel that contains the direction, no filtering,
+// as `EnvMap::lookup`; the basis to linear sRGB; the sun's disc), then the
+// display transform of shaders/diffraction.wgsl `display`.
+
+struct BgGlobals {
+    // world view direction through NDC (x, y): o + x rx + y ry (the frame's
+    // sub-pixel jitter folded into o)
+    ray_o: vec4<f32>,
+    ray_x: vec4<f32>,
+    ray_y: vec4<f32>,
+    basis_to_rgb: array<vec4<f32>, 3>,
+    // xyz: towards the sun's centre; w: cos of its angular radius
+    sun_dir: vec4<f32>,
+    // xyz: the sun's radiance, linear sRGB
+    sun_rgb: vec4<f32>,
+    size: vec2<f32>,
+    table_w: u32,
+    table_h: u32,
+    has_sun: u32,
+    exposure_scale: f32,
+    curve: u32,
+    output: u32,
+    // 1: keep negative linear values (a Monte Carlo frame of a running mean)
+    keep_negative: u32,
+    _b0: u32,
+    _b1: u32,
+    _b2: u32,
+};
+
+@group(0) @binding(0) var<uniform> bg: BgGlobals;
+@group(0) @binding(1) var bg_table: texture_2d<f32>;
+
+const BG_PI: f32 = 3.14159265358979;
+const BG_TAU: f32 = 6.28318530717959;
+
+@vertex
+fn vs_bg(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let x = f32((i << 1u) & 2u) * 2.0 - 1.0;
+    let y = f32(i & 2u) * 2.0 - 1.0;
+    return vec4<f32>(x, y, 1.0, 1.0);
+}
+
+fn bg_coefficients(d: vec3<f32>) -> vec3<f32> {
+    let w = bg.table_w;
+    let h = bg.table_h;
+    let theta = acos(clamp(d.y, -1.0, 1.0));
+    var phi = atan2(d.z, d.x);
+    if (phi < 0.0) {
+        phi = phi + BG_TAU;
+    }
+    let i = min(u32(phi / BG_TAU * f32(w)), w - 1u);
+    let j = min(u32(theta / BG_PI * f32(h)), h - 1u);
+    return textureLoad(bg_table, vec2<u32>(i, j), 0).xyz;
+}
+
+fn bg_oetf(c: f32) -> f32 {
+    if (c <= 0.0031308) {
+        return 12.92 * c;
+    }
+    return 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+}
+
+fn bg_eotf(c: f32) -> f32 {
+    if (c <= 0.04045) {
+        return c / 12.92;
+    }
+    return pow((c + 0.055) / 1.055, 2.4);
+}
+
+@fragment
+fn fs_bg(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
+    let ndc = vec2<f32>(2.0 * p.x / bg.size.x - 1.0, 1.0 - 2.0 * p.y / bg.size.y);
+    let d = normalize(bg.ray_o.xyz + ndc.x * bg.ray_x.xyz + ndc.y * bg.ray_y.xyz);
+    let c = bg_coefficients(d);
+    var rgb = vec3<f32>(dot(bg.basis_to_rgb[0].xyz, c), dot(bg.basis_to_rgb[1].xyz, c), dot(bg.basis_to_rgb[2].xyz, c));
+    if (bg.has_sun == 1u && dot(d, bg.sun_dir.xyz) >= bg.sun_dir.w) {
+        rgb = rgb + bg.sun_rgb.xyz;
+    }
+    var lin = rgb * bg.exposure_scale;
+    lin = select(lin, vec3<f32>(0.0), lin != lin);
+    if (bg.output == 2u) {
+        if (bg.keep_negative == 1u) {
+            return vec4<f32>(lin, 1.0);
+        }
+        return vec4<f32>(max(lin, vec3<f32>(0.0)), 1.0);
+    }
+    var out = vec3<f32>(0.0);
+    for (var k = 0; k < 3; k = k + 1) {
+        var x = max(lin[k], 0.0);
+        if (bg.curve == 0u) {
+            x = min(x, 1.0);
+        } else {
+            x = x / (1.0 + x);
+        }
+        var e = bg_oetf(x);
+        if (bg.output == 1u) {
+            e = bg_eotf(e);
+        }
+        out[k] = e;
+    }
+    return vec4<f32>(out, 1.0);
+}

@@ -1,0 +1,248 @@
+//! `"background": "environment"` (docs/SCENE.md, docs/PLAY.md "Background"):
+//! the pixels that see no mesh show the scene's environment along their view
+//! ray, rotated, times its intensity, with the exposure, in the reference
+//! (`sunbeam-raster`) and in the player (headless, against the reference).
+//!
+//! The expectations come from the documented camera model (computed here, not
+//! with the renderers' ray code) and `EnvMap::lookup`: a pixel whose four
+//! corners and centre see the same map texel shows that texel whatever its
+//! sub-pixel sample positions are.
+
+mod gpu;
+
+use std::sync::Arc;
+use sunbeam_frame::{fixtures, Prepared};
+use sunbeam_light::{EnvMap, Environment};
+use sunbeam_raster::Options;
+use sunbeam_render::Settings;
+use sunbeam_scene::Background;
+
+const W: u32 = 48;
+const H: u32 = 32;
+const ROTATION_DEG: f64 = 45.0; // a multiple of 360 / 64: the player's table is exact
+const INTENSITY: f64 = 0.7;
+const EXPOSURE: f64 = -0.5;
+
+/// A 64 x 32 map: a gradient across both axes and a sparse set of bright
+/// texels (so texel edges and the rotation show).
+fn map() -> EnvMap {
+    let (mw, mh) = (64usize, 32usize);
+    let rgb = (0..mw * mh)
+        .map(|k| {
+            let (i, j) = (k % mw, k / mw);
+            if (i * 7 + j * 3) % 11 == 0 {
+                [4.0, 2.5, 0.5]
+            } else {
+                [i as f32 / mw as f32, j as f32 / mh as f32, 0.2]
+            }
+        })
+        .collect();
+    EnvMap::new(mw, mh, rgb, ROTATION_DEG, INTENSITY).unwrap()
+}
+
+/// A scene whose one mesh (the quad) faces away from the camera (back face
+/// culled): every pixel is background.
+fn scene() -> Prepared {
+    let (mut scene, mesh) = fixtures::quad_scene([W, H]);
+    scene.camera.eye = [0.3, 0.4, -5.0];
+    scene.camera.target = [0.0, 0.2, 0.0];
+    scene.camera.fov_y_deg = 40.0;
+    scene.exposure = EXPOSURE;
+    scene.lights.clear();
+    scene.background = Background::Environment;
+    scene.environment = Some(sunbeam_scene::Environment {
+        sky: None,
+        map: Some("map.hdr".into()),
+        rotation_deg: ROTATION_DEG,
+        intensity: INTENSITY,
+    });
+    let mut p = fixtures::prepared(scene, mesh, None);
+    p.environment = Some(Arc::new(Environment::Map(map())));
+    p
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    a.map(|v| v / l)
+}
+
+/// The camera model of docs/SCENE.md: a pinhole at `eye` looking at
+/// `target`, `fov_y_deg` vertically, square pixels, (x, y) in pixels from the
+/// top left corner.
+fn camera_ray(p: &Prepared, x: f64, y: f64) -> [f64; 3] {
+    let c = &p.scene.camera;
+    let f = unit(sub(c.target, c.eye));
+    let s = unit(cross(f, c.up));
+    let u = cross(s, f);
+    let t = (c.fov_y_deg.to_radians() / 2.0).tan();
+    let a = (2.0 * x / W as f64 - 1.0) * t * W as f64 / H as f64;
+    let b = (1.0 - 2.0 * y / H as f64) * t;
+    unit(std::array::from_fn(|k| f[k] + a * s[k] + b * u[k]))
+}
+
+/// The expected linear value of pixel (i, j) when its corners and centre all
+/// see the same texel, else None.
+fn expected(p: &Prepared, m: &EnvMap, i: u32, j: u32) -> Option<[f64; 3]> {
+    let (x, y) = (i as f64, j as f64);
+    let at = [(0.5, 0.5), (0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+        .map(|(dx, dy)| m.lookup(camera_ray(p, x + dx, y + dy)));
+    let scale = EXPOSURE.exp2();
+    at.iter()
+        .all(|v| *v == at[0])
+        .then(|| at[0].map(|v| v as f64 * scale))
+}
+
+#[test]
+fn reference_background_is_the_environment_along_each_ray() {
+    let p = scene();
+    let m = map();
+    for samples in [1, 4] {
+        let opts = Options {
+            samples,
+            ..Default::default()
+        };
+        let img = sunbeam_raster::render_prepared_linear(&p, &opts).unwrap();
+        let (mut uniform, mut bright) = (0, 0);
+        for j in 0..H {
+            for i in 0..W {
+                let Some(e) = expected(&p, &m, i, j) else {
+                    continue;
+                };
+                uniform += 1;
+                bright += usize::from(e[0] > 1.0);
+                let got = img.rgb[(j * W + i) as usize];
+                for k in 0..3 {
+                    assert!(
+                        (got[k] as f64 - e[k]).abs() <= 1e-6 * e[k].abs().max(1.0),
+                        "samples {samples}, pixel ({i}, {j}): {got:?}, expected {e:?}"
+                    );
+                }
+            }
+        }
+        // the comparison covers most of the frame and some bright texels
+        assert!(uniform > (W * H / 2) as usize, "{uniform} uniform pixels");
+        assert!(bright > 4, "{bright} bright pixels");
+    }
+}
+
+#[test]
+fn environment_background_needs_an_environment() {
+    let mut p = scene();
+    p.scene.environment = None;
+    let msg = p.scene.validate().unwrap_err().to_string();
+    assert!(msg.contains("background"), "{msg}");
+}
+
+#[test]
+fn player_background_matches_reference() {
+    let Some(gpu) = gpu::gpu() else { return };
+    let p = scene();
+    let m = map();
+    let reference = sunbeam_raster::render_prepared(
+        &p,
+        &Options {
+            samples: 4,
+            ..Default::default()
+        },
+    );
+    for (frames, st) in [
+        (
+            1,
+            Settings {
+                msaa: 1,
+                ..Default::default()
+            },
+        ),
+        (4, Settings::default()),
+    ] {
+        let frame = sunbeam_render::render_headless(&gpu, &p, &st, None, frames).unwrap();
+        let mut d = Vec::new();
+        for j in 0..H {
+            for i in 0..W {
+                if expected(&p, &m, i, j).is_none() {
+                    continue;
+                }
+                let k = (j * W + i) as usize;
+                d.push(sunbeam_optics::colour::ciede2000_xyz(
+                    sunbeam_frame::image::display_to_xyz(frame.rgb[k]),
+                    sunbeam_frame::image::display_to_xyz(reference.rgb[k]),
+                ));
+            }
+        }
+        let s = sunbeam_frame::diff::stats(&mut d);
+        let all = sunbeam_frame::compare(&frame, &reference).unwrap();
+        eprintln!(
+            "player background ({frames} frames, msaa {}): {s}; whole frame {all}",
+            st.msaa
+        );
+        assert!(s.pixels > (W * H / 2) as usize);
+        assert!(s.p99 < 1.0, "{s}");
+    }
+}
+
+/// The sky (its table in the player, its model in the reference), the sun's
+/// disc in view (14 degrees above the view direction): the player's frame
+/// against the reference's, the pixels near the horizon apart.
+#[test]
+fn player_sky_background_matches_reference() {
+    let Some(gpu) = gpu::gpu() else { return };
+    let mut p = scene();
+    let env = sunbeam_scene::Environment {
+        sky: Some(sunbeam_scene::Sky {
+            sun_elevation_deg: 12.0,
+            sun_azimuth_deg: 95.0,
+            turbidity: 3.0,
+        }),
+        map: None,
+        rotation_deg: 0.0,
+        intensity: 0.5,
+    };
+    p.scene.environment = Some(env);
+    p.environment =
+        Some(sunbeam_frame::load_environment(p.scene.environment.as_ref().unwrap()).unwrap());
+    let reference = sunbeam_raster::render_prepared(
+        &p,
+        &Options {
+            samples: 16,
+            ..Default::default()
+        },
+    );
+    let frame = sunbeam_render::render_headless(&gpu, &p, &Settings::default(), None, 16).unwrap();
+    let d = sunbeam_frame::compare(&frame, &reference).unwrap();
+    // The table holds the sky at its texels' centres (0.7 degree rows): the
+    // horizon's row, where the sky model is steepest, is compared apart.
+    let (mut d_sky, mut d_horizon) = (Vec::new(), Vec::new());
+    for (k, (a, b)) in frame.rgb.iter().zip(&reference.rgb).enumerate() {
+        let (x, y) = ((k as u32 % W) as f64, (k as u32 / W) as f64);
+        let near_horizon = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+            .iter()
+            .any(|(dx, dy)| camera_ray(&p, x + dx, y + dy)[1].abs() < 1.5f64.to_radians().sin());
+        let e = sunbeam_optics::colour::ciede2000_xyz(
+            sunbeam_frame::image::display_to_xyz(*a),
+            sunbeam_frame::image::display_to_xyz(*b),
+        );
+        if near_horizon {
+            d_horizon.push(e)
+        } else {
+            d_sky.push(e)
+        }
+    }
+    let (s, h) = (
+        sunbeam_frame::diff::stats(&mut d_sky),
+        sunbeam_frame::diff::stats(&mut d_horizon),
+    );
+    eprintln!("player sky background: {s}; within 1.5 degrees of the horizon {h}; whole frame {d}");
+    assert!(s.pixels > (W * H * 3 / 4) as usize);
+    assert!(s.p99 < 1.0, "{s}");
+    assert!(h.p99 < 6.0, "{h}");
+}
