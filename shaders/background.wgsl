@@ -58,20 +58,6 @@ fn bg_coefficients(d: vec3<f32>) -> vec3<f32> {
     return textureLoad(bg_table, vec2<u32>(i, j), 0).xyz;
 }
 
-fn bg_oetf(c: f32) -> f32 {
-    if (c <= 0.0031308) {
-        return 12.92 * c;
-    }
-    return 1.055 * pow(c, 1.0 / 2.4) - 0.055;
-}
-
-fn bg_eotf(c: f32) -> f32 {
-    if (c <= 0.04045) {
-        return c / 12.92;
-    }
-    return pow((c + 0.055) / 1.055, 2.4);
-}
-
 @fragment
 fn fs_bg(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
     let ndc = vec2<f32>(2.0 * p.x / bg.size.x - 1.0, 1.0 - 2.0 * p.y / bg.size.y);
@@ -91,17 +77,7 @@ fn fs_bg(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
     }
     var out = vec3<f32>(0.0);
     for (var k = 0; k < 3; k = k + 1) {
-        var x = max(lin[k], 0.0);
-        if (bg.curve == 0u) {
-            x = min(x, 1.0);
-        } else {
-            x = x / (1.0 + x);
-        }
-        var e = bg_oetf(x);
-        if (bg.output == 1u) {
-            e = bg_eotf(e);
-        }
-        out[k] = e;
+        out[k] = sb_display_channel(lin[k], bg.curve, bg.output);
     }
     return vec4<f32>(out, 1.0);
 }

@@ -480,22 +480,6 @@ fn masking(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     return sb_masking(wi, wr, vec2<f32>(mat.mask_sx, mat.mask_sy));
 }
 
-fn srgb_oetf(y: f32) -> f32 {
-    let c = clamp(y, 0.0, 1.0);
-    if (c <= 0.0031308) {
-        return 12.92 * c;
-    }
-    return 1.055 * pow(c, 1.0 / 2.4) - 0.055;
-}
-
-fn srgb_eotf(v: f32) -> f32 {
-    let c = clamp(v, 0.0, 1.0);
-    if (c <= 0.04045) {
-        return c / 12.92;
-    }
-    return pow((c + 0.055) / 1.055, 2.4);
-}
-
 // sunbeam_optics::colour::display_encode
 fn display(rgb: vec3<f32>) -> vec4<f32> {
     if (g.output == 2u) {
@@ -513,21 +497,7 @@ fn display(rgb: vec3<f32>) -> vec4<f32> {
     }
     var out = vec3<f32>(0.0);
     for (var k = 0; k < 3; k = k + 1) {
-        var x = rgb[k] * g.exposure_scale;
-        if (x != x) {
-            x = 0.0;
-        }
-        x = max(x, 0.0);
-        if (g.curve == 0u) {
-            x = min(x, 1.0);
-        } else {
-            x = x / (1.0 + x);
-        }
-        var e = srgb_oetf(x);
-        if (g.output == 1u) {
-            e = srgb_eotf(e);
-        }
-        out[k] = e;
+        out[k] = sb_display_channel(rgb[k] * g.exposure_scale, g.curve, g.output);
     }
     return vec4<f32>(out, 1.0);
 }

@@ -23,43 +23,13 @@ fn vs_full(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
     return vec4<f32>(x, y, 0.0, 1.0);
 }
 
-fn oetf(y: f32) -> f32 {
-    let c = clamp(y, 0.0, 1.0);
-    if (c <= 0.0031308) {
-        return 12.92 * c;
-    }
-    return 1.055 * pow(c, 1.0 / 2.4) - 0.055;
-}
-
-fn eotf(v: f32) -> f32 {
-    let c = clamp(v, 0.0, 1.0);
-    if (c <= 0.04045) {
-        return c / 12.92;
-    }
-    return pow((c + 0.055) / 1.055, 2.4);
-}
-
 @fragment
 fn fs_resolve(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
     let i = u32(p.y) * res_u.width + u32(p.x);
     let lin = res_sum[i].xyz * res_u.inv_n;
     var out = vec3<f32>(0.0);
     for (var k = 0; k < 3; k = k + 1) {
-        var x = lin[k];
-        if (x != x) {
-            x = 0.0;
-        }
-        x = max(x, 0.0);
-        if (res_u.curve == 0u) {
-            x = min(x, 1.0);
-        } else {
-            x = x / (1.0 + x);
-        }
-        var e = oetf(x);
-        if (res_u.output == 1u) {
-            e = eotf(e);
-        }
-        out[k] = e;
+        out[k] = sb_display_channel(lin[k], res_u.curve, res_u.output);
     }
     return vec4<f32>(out, 1.0);
 }

@@ -34,7 +34,10 @@ pub(crate) struct ResolveU {
 }
 
 pub(crate) const ACCUMULATE_WGSL: &str = include_str!("../../../shaders/accumulate.wgsl");
-pub(crate) const RESOLVE_WGSL: &str = include_str!("../../../shaders/resolve.wgsl");
+pub(crate) const RESOLVE_WGSL: &str = concat!(
+    include_str!("../../../shaders/display.wgsl"),
+    include_str!("../../../shaders/resolve.wgsl")
+);
 
 /// An RGBA32F running sum of frames of one size.
 pub struct Accumulator {

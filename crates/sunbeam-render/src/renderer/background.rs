@@ -12,7 +12,10 @@ use sunbeam_scene::Camera;
 use wgpu::util::DeviceExt;
 
 /// The WGSL of the pass.
-pub const BACKGROUND_WGSL: &str = include_str!("../../../../shaders/background.wgsl");
+pub const BACKGROUND_WGSL: &str = concat!(
+    include_str!("../../../../shaders/display.wgsl"),
+    include_str!("../../../../shaders/background.wgsl")
+);
 
 /// shaders/background.wgsl `BgGlobals`.
 #[repr(C)]

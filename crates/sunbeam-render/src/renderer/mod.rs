@@ -43,6 +43,7 @@ use wgpu::util::DeviceExt;
 /// environment's estimator (shaders/environment.wgsl).
 pub const SHADER: &str = concat!(
     include_str!("../../../../shaders/material.wgsl"),
+    include_str!("../../../../shaders/display.wgsl"),
     include_str!("../../../../shaders/response_map.wgsl"),
     include_str!("../../../../shaders/diffraction.wgsl"),
     include_str!("../../../../shaders/environment.wgsl")
