@@ -35,8 +35,6 @@ struct BgGlobals {
 @group(0) @binding(0) var<uniform> bg: BgGlobals;
 @group(0) @binding(1) var bg_table: texture_2d<f32>;
 
-const BG_PI: f32 = 3.14159265358979;
-const BG_TAU: f32 = 6.28318530717959;
 
 @vertex
 fn vs_bg(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
@@ -46,16 +44,7 @@ fn vs_bg(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
 }
 
 fn bg_coefficients(d: vec3<f32>) -> vec3<f32> {
-    let w = bg.table_w;
-    let h = bg.table_h;
-    let theta = acos(clamp(d.y, -1.0, 1.0));
-    var phi = atan2(d.z, d.x);
-    if (phi < 0.0) {
-        phi = phi + BG_TAU;
-    }
-    let i = min(u32(phi / BG_TAU * f32(w)), w - 1u);
-    let j = min(u32(theta / BG_PI * f32(h)), h - 1u);
-    return textureLoad(bg_table, vec2<u32>(i, j), 0).xyz;
+    return sb_env_texel(bg_table, bg.table_w, bg.table_h, d);
 }
 
 @fragment

@@ -148,16 +148,7 @@ fn env_map(tex: texture_3d<f32>, c: vec3<f32>, gr: SbGrid) -> vec3<f32> {
 // Coefficients c_k of the radiance from world direction d: the texel that
 // contains it (no filtering, as EnvMap::lookup).
 fn env_coefficients(d: vec3<f32>) -> vec3<f32> {
-    let w = envg.table_w;
-    let h = envg.table_h;
-    let theta = acos(clamp(d.y, -1.0, 1.0));
-    var phi = atan2(d.z, d.x);
-    if (phi < 0.0) {
-        phi = phi + SB_TAU;
-    }
-    let i = min(u32(phi / SB_TAU * f32(w)), w - 1u);
-    let j = min(u32(theta / ENV_PI * f32(h)), h - 1u);
-    return textureLoad(env_table, vec2<u32>(i, j), 0).xyz;
+    return sb_env_texel(env_table, envg.table_w, envg.table_h, d);
 }
 
 fn env_basis_rgb(c: vec3<f32>) -> vec3<f32> {

@@ -14,6 +14,7 @@ use wgpu::util::DeviceExt;
 /// The WGSL of the pass.
 pub const BACKGROUND_WGSL: &str = concat!(
     include_str!("../../../../shaders/display.wgsl"),
+    include_str!("../../../../shaders/env_table.wgsl"),
     include_str!("../../../../shaders/background.wgsl")
 );
 

@@ -44,6 +44,7 @@ use wgpu::util::DeviceExt;
 pub const SHADER: &str = concat!(
     include_str!("../../../../shaders/material.wgsl"),
     include_str!("../../../../shaders/display.wgsl"),
+    include_str!("../../../../shaders/env_table.wgsl"),
     include_str!("../../../../shaders/response_map.wgsl"),
     include_str!("../../../../shaders/diffraction.wgsl"),
     include_str!("../../../../shaders/environment.wgsl")
