@@ -50,8 +50,15 @@ struct EnvGlobals {
     has_sun: u32,
     // proposal samples per pixel per frame
     samples: u32,
+    // 0: the cells (first-frame estimator), 1: Monte Carlo
+    estimator: u32,
+    // levels of the prefiltered chain env_chain
+    chain_levels: u32,
+    // the skin index of the transmitted irradiance table
+    irr_ior: f32,
     _e0: u32,
     _e1: u32,
+    _e2: u32,
 };
 
 struct EnvProposal {
@@ -72,7 +79,8 @@ struct EnvProposal {
     on: u32,
     // 1: E_sun is bound
     has_sun: u32,
-    _p0: u32,
+    // cells of the top cut in env_cells (0: none)
+    n_cells: u32,
 };
 
 @group(2) @binding(0) var<uniform> envg: EnvGlobals;
@@ -87,6 +95,14 @@ struct EnvProposal {
 @group(2) @binding(7) var env_smp: sampler;
 // coefficients c_0..c_2 per texel (equirectangular, theta from +y, phi = atan2(z, x))
 @group(2) @binding(8) var env_table: texture_2d<f32>;
+// the table prefiltered by solid angle (sunbeam_light::prefilter, f16, mips)
+@group(2) @binding(9) var env_chain: texture_2d<f32>;
+// irradiance per normal without the sun (sunbeam_light::irradiance, linear
+// sRGB): transmitted through the skin (weight cos (1 - F)), and plain
+@group(2) @binding(10) var env_irr_skin: texture_2d<f32>;
+@group(2) @binding(11) var env_irr_plain: texture_2d<f32>;
+// the maps' cells (sunbeam_response::cells::Cells::gpu_data)
+@group(2) @binding(12) var<storage, read> cells: array<f32>;
 
 const ENV_PI: f32 = 3.141592653589793;
 
@@ -449,6 +465,109 @@ fn env_descend(wr: vec3<f32>, u: vec3<f32>, q: u32) -> EnvDraw {
     return out;
 }
 
+// ---------------------------------------------------------------- the cells
+// Equirectangular coordinates of world direction d (theta from +y, phi =
+// atan2(z, x)), as sb_env_texel and sunbeam_light::prefilter.
+fn env_equirect(d: vec3<f32>) -> vec2<f32> {
+    var phi = atan2(d.z, d.x);
+    if (phi < 0.0) {
+        phi = phi + SB_TAU;
+    }
+    return vec2<f32>(phi / SB_TAU, acos(clamp(d.y, -1.0, 1.0)) / ENV_PI);
+}
+
+// The coefficients at d averaged over about omega steradians
+// (Prefiltered::lookup: the level whose texel's polar extent squared is omega).
+fn env_prefiltered(d: vec3<f32>, omega: f32) -> vec3<f32> {
+    let texel = ENV_PI / f32(envg.table_h);
+    let level = clamp(0.5 * log2(max(omega, 1e-30) / (texel * texel)), 0.0, f32(envg.chain_levels - 1u));
+    return textureSampleLevel(env_chain, env_smp, env_equirect(d), level).xyz;
+}
+
+// Cells refine near the horizon while their spread times this reaches it
+// (sunbeam_response::cells::REFINE).
+const ENV_REFINE: f32 = 2.0;
+
+fn env_erf(x: f32) -> f32 {
+    let a = abs(x);
+    let t = 1.0 / (1.0 + 0.3275911 * a);
+    let y = 1.0 - ((((1.061405429 * t - 1.453152027) * t + 1.421413741) * t - 0.284496736) * t + 0.254829592) * t * exp(-a * a);
+    return select(y, -y, x < 0.0);
+}
+
+// The diffraction part (XYZ) of the environment without the sun at local
+// view wr, frame (t, b, n): each cell's mass at its layer times G / cos and
+// the prefiltered coefficients at its centroid (Cells::estimate, the CPU
+// twin; docs/LIGHTING.md "The first frame").
+fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    var xyz = vec3<f32>(0.0);
+    let ns = envp.n_s;
+    let stride = 4u + 9u * ns;
+    for (var top = 0u; top < envp.n_cells; top = top + 1u) {
+        var stack: array<u32, 12>;
+        stack[0] = top;
+        var sp = 1u;
+        loop {
+            if (sp == 0u) {
+                break;
+            }
+            sp = sp - 1u;
+            let o = stack[sp] * stride;
+            let uv = vec2<f32>(cells[o], cells[o + 1u]);
+            let spread = cells[o + 2u];
+            let first = bitcast<u32>(cells[o + 3u]);
+            let wxy = -uv - wr.xy;
+            let l = length(wxy);
+            let dist = 1.0 - l;
+            if (first != 0xffffffffu && dist < ENV_REFINE * spread && sp + 2u <= 12u) {
+                stack[sp] = first;
+                stack[sp + 1u] = first + 1u;
+                sp = sp + 2u;
+                continue;
+            }
+            var inside = select(0.0, 1.0, dist > 0.0);
+            if (spread > 0.0) {
+                inside = 0.5 * (1.0 + env_erf(dist / (1.4142135623730951 * spread)));
+            }
+            if (inside <= 0.0 || dist <= -0.5) {
+                continue;
+            }
+            var w2 = wxy;
+            if (l > 0.999) {
+                w2 = wxy * (0.999 / l);
+            }
+            let wi = vec3<f32>(w2, sqrt(max(1.0 - dot(w2, w2), 0.0)));
+            let r = length(uv);
+            let s = clamp((wi.z + wr.z) / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
+            let sc = s * f32(ns - 1u);
+            let k0 = min(u32(floor(sc)), ns - 2u);
+            let f = sc - f32(k0);
+            let gw = gain(wi, wr) / wi.z * inside;
+            if (!(gw > 0.0)) {
+                continue;
+            }
+            let omega = max(SB_TAU * spread * spread / wi.z, 1e-9);
+            let c = env_prefiltered(wi.x * t + wi.y * b + wi.z * n, omega);
+            let m0 = o + 4u + k0 * 9u;
+            let m1 = m0 + 9u;
+            var e = vec3<f32>(0.0);
+            for (var bb = 0u; bb < 3u; bb = bb + 1u) {
+                let a0 = vec3<f32>(cells[m0 + 3u * bb], cells[m0 + 3u * bb + 1u], cells[m0 + 3u * bb + 2u]);
+                let a1 = vec3<f32>(cells[m1 + 3u * bb], cells[m1 + 3u * bb + 1u], cells[m1 + 3u * bb + 2u]);
+                e = e + c[bb] * mix(a0, a1, f);
+            }
+            xyz = xyz + gw * e;
+        }
+    }
+    return xyz;
+}
+
+// Irradiance (linear sRGB, without the sun) at world normal n from a table
+// over normals (Irradiance::at: bilinear, azimuth wraps).
+fn env_irradiance(tex: texture_2d<f32>, n: vec3<f32>) -> vec3<f32> {
+    return textureSampleLevel(tex, env_smp, env_equirect(n), 0.0).xyz;
+}
+
 // ---------------------------------------------------------------- the estimator
 // Linear sRGB leaving the surface towards the viewer under the environment (both
 // parts, dw applied): frame (t, b, n), local view wr, base colour, diffuse weight
@@ -461,7 +580,21 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     var rgb = vec3<f32>(0.0);
     // Diffuse: one cosine-weighted direction (pdf cos / pi) plus the sun's
     // disc, each times the share the skin transmits at its incidence.
-    if (dw > 0.0) {
+    let tabled = envg.estimator == 0u && (!diffract || abs(mat.ior - envg.irr_ior) < 1e-6);
+    if (dw > 0.0 && tabled) {
+        // The first-frame estimator: the tabulated (transmitted) irradiance.
+        var irr = env_irradiance(env_irr_plain, n);
+        if (diffract) {
+            irr = env_irradiance(env_irr_skin, n);
+        }
+        var irr_over_pi = irr / ENV_PI;
+        if (envg.has_sun == 1u) {
+            let cs = max(dot(envg.sun_dir.xyz, n), 0.0);
+            irr_over_pi = irr_over_pi
+                + envg.sun_rgb.xyz * envg.sun_rgb.w * cs / ENV_PI * sb_base_transmission(cs, mat.ior, diffract);
+        }
+        rgb = rgb + dw * base * irr_over_pi;
+    } else if (dw > 0.0) {
         let r = sqrt(env_qmc(envg.frame + 1u, 23u));
         let phi = SB_TAU * env_qmc(envg.frame + 1u, 29u);
         let wl = vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(1.0 - r * r, 0.0)));
@@ -479,6 +612,9 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     }
     let gr = env_grid();
     var xyz = vec3<f32>(0.0);
+    if (envg.estimator == 0u) {
+        xyz = env_cells(t, b, n, wr);
+    } else {
     // The first frame after a reset (every frame while the view moves) is the
     // preview: one direction uniform over the hemisphere, no descent (the
     // descent costs ~10x a Lambert frame on lavapipe). Unbiased as well, so
@@ -547,6 +683,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
         xyz = xyz + e * wgt;
     }
     xyz = xyz / f32(ns);
+    }
     if (envg.has_sun == 1u && envp.has_sun == 1u) {
         // Uniform on the disc (Sky::sample_sun).
         let ct = 1.0 - env_qmc(envg.frame + 1u, 17u) * (1.0 - envg.sun_dir.w);

@@ -120,6 +120,20 @@ impl Irradiance {
         Irradiance { weight, table, sun }
     }
 
+    /// The table without the sun (the player's texture, read bilinearly as
+    /// [`Irradiance::at`]; the sun's disc is added in the shader):
+    /// `(width, height, rgba)` over normals, rows from `n_y = 1` down,
+    /// columns `phi = atan2(z, x)`, texel centres at `(i + 0.5) / W`.
+    pub fn table_rgba(&self) -> (usize, usize, Vec<f32>) {
+        let (nw, nh) = (NORMALS_W, NORMALS_W / 2);
+        let data = self
+            .table
+            .iter()
+            .flat_map(|e| [e[0] as f32, e[1] as f32, e[2] as f32, 0.0])
+            .collect();
+        (nw, nh, data)
+    }
+
     /// Irradiance at world normal `n` (unit).
     pub fn at(&self, n: [f64; 3]) -> [f64; 3] {
         let (nw, nh) = (NORMALS_W, NORMALS_W / 2);

@@ -25,6 +25,7 @@ pub mod daylight;
 pub mod environment;
 pub mod io;
 pub mod irradiance;
+pub mod prefilter;
 pub mod rgb_spectrum;
 pub mod sky;
 

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::Kirchhoff;
+use common::{narrow_flat_pack, Kirchhoff};
 use std::f64::consts::PI;
 use std::sync::Arc;
 use sunbeam_light::{sky::Sky, EnvMap, Environment};
@@ -74,37 +74,6 @@ fn mean_y(img: &LinearImage, x0: u32, x1: u32) -> f64 {
         }
     }
     s / n
-}
-
-/// A flat patch whose lobe is narrow (`sigma_u` about 0.0015 at 550 nm): the
-/// furnace's `F(theta)` is the narrow-lobe limit of `int G R A / l^2 dw`;
-/// a lobe `sigma_u` wide adds about `(G / cos(theta_i))'' sigma_u^2 / 2`,
-/// which at 80 degrees is large (+1.2 / +2.8 / +3.3 % for `sigma_u` 0.004 /
-/// 0.0054 / 0.007, a Gaussian average of `G / cos(theta_i)`): a 6.4 um
-/// tiled patch at the default coherence (65 um) gives 0.3983 there.
-/// Window: 256 um at 1 um (a flat field needs no finer sampling), coherence
-/// 400 um (`sigma` = 42.7 um), frequencies stored up to 0.1 / 380 nm; tiled:
-/// 6.4 um, coherence 400 um.
-fn narrow_flat_pack(model: Model) -> Arc<Pack> {
-    let (n, dx) = match model {
-        Model::Window => (256usize, 1e-6),
-        Model::Tiled => (64, 100e-9),
-    };
-    let data = vec![0.0; n * n];
-    let f = FieldRef {
-        width: n,
-        height: n,
-        dx,
-        dy: dx,
-        data: &data,
-    };
-    let opts = BuildOptions {
-        model,
-        coherence_m: 400e-6,
-        freq_limit_per_m: (model == Model::Window).then_some([0.1 / 380e-9; 2]),
-        ..BuildOptions::default()
-    };
-    Arc::new(sunbeam_pack::build(f, &opts, &mut |_, _| {}).unwrap())
 }
 
 /// The oblique furnace (PHYSICS.md 5 item 11): a flat patch under a constant

@@ -20,6 +20,11 @@ pub const MAX_LEVELS: usize = 16;
 /// Proposal samples per pixel per frame (the sun and the diffuse part take one each).
 pub const DEFAULT_ENV_SAMPLES: u32 = 1;
 
+/// Cells of the first-frame estimator's top cut (`--env-cells`).
+pub const DEFAULT_ENV_CELLS: u64 = sunbeam_response::cells::DEFAULT_TOP as u64;
+/// Levels kept below the top cut for views whose horizon a cell reaches.
+pub const ENV_CELLS_DEPTH: usize = sunbeam_response::cells::DEFAULT_DEPTH;
+
 /// shaders/environment.wgsl `EnvGlobals`.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
@@ -35,8 +40,27 @@ pub(crate) struct EnvGlobals {
     pub(crate) on: u32,
     pub(crate) has_sun: u32,
     pub(crate) samples: u32,
+    /// 0: the cells (first-frame estimator), 1: Monte Carlo.
+    pub(crate) estimator: u32,
+    /// Levels of the prefiltered chain (binding 9).
+    pub(crate) chain_levels: u32,
+    /// The skin index the transmitted irradiance table was built for.
+    pub(crate) irr_ior: f32,
     pub(crate) _e0: u32,
     pub(crate) _e1: u32,
+    pub(crate) _e2: u32,
+}
+
+/// How the player integrates an environment (`sunbeam-play --env-estimator`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EnvEstimator {
+    /// Close in the first frame: the maps' cells against the prefiltered
+    /// environment, the diffuse part from the irradiance tables; frames
+    /// accumulate for anti-aliasing only (docs/LIGHTING.md "The first frame").
+    Cells,
+    /// Progressive Monte Carlo: unbiased, settles over thousands of frames.
+    #[default]
+    MonteCarlo,
 }
 
 /// shaders/environment.wgsl `EnvProposal`.
@@ -55,7 +79,8 @@ pub(crate) struct EnvProposalU {
     pub(crate) rho_scale: f32,
     pub(crate) on: u32,
     pub(crate) has_sun: u32,
-    pub(crate) _p0: u32,
+    /// Cells of the top cut (shaders/environment.wgsl env_cells).
+    pub(crate) n_cells: u32,
 }
 
 /// XYZ (scene units, the response maps' normalisation: 1 nm sums over
@@ -117,6 +142,8 @@ pub(crate) struct EnvScene {
     pub(crate) globals: wgpu::Buffer,
     pub(crate) values: EnvGlobals,
     table: wgpu::TextureView,
+    chain: wgpu::TextureView,
+    irradiance: [wgpu::TextureView; 2],
     sampler: wgpu::Sampler,
     dummy_map: wgpu::TextureView,
     dummy_buf: wgpu::Buffer,
@@ -124,11 +151,22 @@ pub(crate) struct EnvScene {
 }
 
 impl EnvScene {
-    pub(crate) fn new(gpu: &Gpu, env: Option<Arc<Environment>>, samples: u32) -> EnvScene {
+    pub(crate) fn new(
+        gpu: &Gpu,
+        env: Option<Arc<Environment>>,
+        samples: u32,
+        estimator: EnvEstimator,
+        ior: f64,
+    ) -> EnvScene {
         let device = &gpu.device;
         let layout = layout(device);
         let mut values = EnvGlobals {
             samples: samples.max(1),
+            estimator: match estimator {
+                EnvEstimator::Cells => 0,
+                EnvEstimator::MonteCarlo => 1,
+            },
+            irr_ior: ior as f32,
             table_w: 1,
             table_h: 1,
             ..Default::default()
@@ -155,6 +193,33 @@ impl EnvScene {
         };
         values.table_w = tw as u32;
         values.table_h = th as u32;
+        // The prefiltered chain and the irradiance tables (the first-frame
+        // estimator's; one texel stand-ins for Monte Carlo).
+        let cells = estimator == EnvEstimator::Cells && env.is_some();
+        let chain_levels = if cells {
+            sunbeam_light::prefilter::Prefiltered::new(tw, th, tdata.clone()).levels
+        } else {
+            vec![(1, 1, vec![0.0f32; 4])]
+        };
+        values.chain_levels = chain_levels.len() as u32;
+        let chain = texture_2d_f16(gpu, "prefiltered environment", &chain_levels);
+        let irradiance = match (&env, cells) {
+            (Some(e), true) => {
+                let tr = sunbeam_light::irradiance::Irradiance::transmitted(e, ior).table_rgba();
+                let plain = sunbeam_light::irradiance::Irradiance::new(e).table_rgba();
+                [
+                    texture_2d_f16(gpu, "transmitted irradiance", &[tr]),
+                    texture_2d_f16(gpu, "irradiance", &[plain]),
+                ]
+            }
+            _ => {
+                let one = [(1, 1, vec![0.0f32; 4])];
+                [
+                    texture_2d_f16(gpu, "no irradiance", &one),
+                    texture_2d_f16(gpu, "no irradiance", &one),
+                ]
+            }
+        };
         let globals = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("environment globals"),
             contents: bytemuck::bytes_of(&values),
@@ -188,6 +253,7 @@ impl EnvScene {
             address_mode_w: wgpu::AddressMode::ClampToEdge,
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
             ..Default::default()
         });
         let dummy_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -200,6 +266,8 @@ impl EnvScene {
             globals,
             values,
             table,
+            chain,
+            irradiance,
             sampler,
             dummy_map: crate::response::texture_3d(gpu, [1, 1, 1], &[0; 4]),
             dummy_buf,
@@ -224,10 +292,17 @@ impl EnvScene {
     /// diffuse part only).
     pub(crate) fn bind(&self, gpu: &Gpu, maps: Option<&EnvMaps>) -> wgpu::BindGroup {
         let device = &gpu.device;
-        let (u, pyr, views): (EnvProposalU, &wgpu::Buffer, [&wgpu::TextureView; 4]) = match maps {
+        type Parts<'a> = (
+            EnvProposalU,
+            &'a wgpu::Buffer,
+            &'a wgpu::Buffer,
+            [&'a wgpu::TextureView; 4],
+        );
+        let (u, pyr, cells, views): Parts<'_> = match maps {
             Some(m) => (
                 m.uniform,
                 &m.pyramid,
+                &m.cells,
                 [
                     &m.views[0],
                     &m.views[1],
@@ -237,6 +312,7 @@ impl EnvScene {
             ),
             None => (
                 EnvProposalU::default(),
+                &self.dummy_buf,
                 &self.dummy_buf,
                 [&self.dummy_map; 4],
             ),
@@ -277,6 +353,13 @@ impl EnvScene {
                     resource: wgpu::BindingResource::Sampler(&self.sampler),
                 },
                 tex(8, &self.table),
+                tex(9, &self.chain),
+                tex(10, &self.irradiance[0]),
+                tex(11, &self.irradiance[1]),
+                wgpu::BindGroupEntry {
+                    binding: 12,
+                    resource: cells.as_entire_binding(),
+                },
             ],
         })
     }
@@ -286,12 +369,13 @@ impl EnvScene {
 pub(crate) struct EnvMaps {
     uniform: EnvProposalU,
     pyramid: wgpu::Buffer,
+    cells: wgpu::Buffer,
     views: [wgpu::TextureView; 3],
     sun: Option<wgpu::TextureView>,
 }
 
 impl EnvMaps {
-    pub(crate) fn new(gpu: &Gpu, r: &EnvResponse) -> Result<EnvMaps> {
+    pub(crate) fn new(gpu: &Gpu, r: &EnvResponse, cells: (usize, usize)) -> Result<EnvMaps> {
         let p = &r.proposal;
         let g = r.grid;
         if p.offsets.is_empty() || p.offsets.len() > MAX_LEVELS || r.basis.len() != 3 {
@@ -325,8 +409,31 @@ impl EnvMaps {
             rho_scale: g.rho_scale() as f32,
             on: 1,
             has_sun: u32::from(r.sun.is_some()),
-            _p0: 0,
+            n_cells: 0,
         };
+        let t0 = std::time::Instant::now();
+        let (top, depth) = cells;
+        let cells = sunbeam_response::cells::Cells::build(&r.basis, top, depth);
+        log::info!(
+            "clustered the environment maps into {} cells ({} nodes) in {:.2?}",
+            cells.n_top,
+            cells.nodes.len(),
+            t0.elapsed()
+        );
+        let mut uniform = uniform;
+        uniform.n_cells = cells.n_top as u32;
+        let cell_data = cells.gpu_data();
+        let cells = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("response cells"),
+                contents: bytemuck::cast_slice(if cell_data.is_empty() {
+                    &[0.0f32; 4][..]
+                } else {
+                    &cell_data
+                }),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
         let pyramid = gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -342,6 +449,7 @@ impl EnvMaps {
         Ok(EnvMaps {
             uniform,
             pyramid,
+            cells,
             views: [view(&r.basis[0]), view(&r.basis[1]), view(&r.basis[2])],
             sun: r.sun.as_ref().map(view),
         })
@@ -357,6 +465,16 @@ fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             ty: wgpu::BufferBindingType::Uniform,
             has_dynamic_offset: false,
             min_binding_size: None,
+        },
+        count: None,
+    };
+    let plain_2d = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
         },
         count: None,
     };
@@ -405,6 +523,69 @@ fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
                 },
                 count: None,
             },
+            plain_2d(9),
+            plain_2d(10),
+            plain_2d(11),
+            wgpu::BindGroupLayoutEntry {
+                binding: 12,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
         ],
     })
+}
+
+/// A filterable 2D texture in f16 from `(width, height, rgba f32)` levels
+/// (level 0 first; each half the one before).
+fn texture_2d_f16(
+    gpu: &Gpu,
+    label: &str,
+    levels: &[(usize, usize, Vec<f32>)],
+) -> wgpu::TextureView {
+    let (w, h, _) = &levels[0];
+    let tex = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: *w as u32,
+            height: *h as u32,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: levels.len() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba16Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (m, (lw, lh, data)) in levels.iter().enumerate() {
+        let bits: Vec<u16> = data
+            .iter()
+            .map(|&v| half::f16::from_f32(v.clamp(-65504.0, 65504.0)).to_bits())
+            .collect();
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &tex,
+                mip_level: m as u32,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(&bits),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(8 * *lw as u32),
+                rows_per_image: Some(*lh as u32),
+            },
+            wgpu::Extent3d {
+                width: *lw as u32,
+                height: *lh as u32,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+    tex.create_view(&Default::default())
 }

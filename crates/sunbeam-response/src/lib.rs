@@ -17,6 +17,7 @@
 //! texels for DCC tools, see [`exr`].
 
 pub mod build;
+pub mod cells;
 pub mod env;
 pub mod env_file;
 pub mod exr;

@@ -67,6 +67,17 @@ pub(crate) struct Cli {
     /// frame (the sun and the diffuse part take one each).
     #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_SAMPLES)]
     pub(crate) env_samples: u32,
+    /// Environment scenes: `monte-carlo` (progressive, unbiased, settles over
+    /// thousands of frames) or `cells` (close in the first frame, frames only
+    /// anti-alias; on a CPU rasteriser tens of times a Lambert frame).
+    /// docs/LIGHTING.md "The first frame".
+    #[arg(long, value_enum, default_value_t = EnvEstimatorArg::MonteCarlo)]
+    pub(crate) env_estimator: EnvEstimatorArg,
+    /// Environment scenes, `--env-estimator cells`: cells every view visits
+    /// (1..4096; more: closer to the reference, slower; docs/LIGHTING.md
+    /// "The first frame").
+    #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_CELLS, value_parser = clap::value_parser!(u64).range(1..=4096))]
+    pub(crate) env_cells: u64,
     /// Wavelength samples of the default mode.
     #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES)]
     pub(crate) lambda_samples: usize,
@@ -102,4 +113,11 @@ pub(crate) struct Cli {
     /// Less output.
     #[arg(short, long)]
     pub(crate) quiet: bool,
+}
+
+/// `--env-estimator` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum EnvEstimatorArg {
+    Cells,
+    MonteCarlo,
 }

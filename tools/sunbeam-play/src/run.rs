@@ -92,6 +92,12 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
     }
     Ok(Settings {
         env_samples: cli.env_samples,
+        env_estimator: match cli.env_estimator {
+            crate::args::EnvEstimatorArg::Cells => sunbeam_render::env::EnvEstimator::Cells,
+            crate::args::EnvEstimatorArg::MonteCarlo => {
+                sunbeam_render::env::EnvEstimator::MonteCarlo
+            }
+        },
         mode,
         lambda_samples: cli.lambda_samples,
         curve,

@@ -48,6 +48,7 @@ pub(super) fn maps(
     path: Option<&Path>,
     mi: usize,
     opts: &sunbeam_response::Options,
+    cells: (usize, usize),
     built: &mut BuiltMaps,
     notes: &mut Vec<String>,
 ) -> Result<Arc<crate::env::EnvMaps>> {
@@ -66,7 +67,7 @@ pub(super) fn maps(
                     side.display(),
                     t0.elapsed()
                 );
-                let m = Arc::new(crate::env::EnvMaps::new(gpu, &er)?);
+                let m = Arc::new(crate::env::EnvMaps::new(gpu, &er, cells)?);
                 built.push((key, m.clone()));
                 return Ok(m);
             }
@@ -110,7 +111,7 @@ pub(super) fn maps(
         er.proposal.offsets.len(),
         t0.elapsed().as_secs_f64()
     ));
-    let m = Arc::new(crate::env::EnvMaps::new(gpu, &er)?);
+    let m = Arc::new(crate::env::EnvMaps::new(gpu, &er, cells)?);
     built.push((key, m.clone()));
     Ok(m)
 }

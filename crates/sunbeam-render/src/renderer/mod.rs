@@ -122,6 +122,11 @@ pub struct Settings {
     pub footprint: bool,
     /// Environment: proposal samples per pixel per frame (crate::env).
     pub env_samples: u32,
+    /// Environment: the first-frame cells or progressive Monte Carlo.
+    pub env_estimator: crate::env::EnvEstimator,
+    /// Environment, cells estimator: the top cut's cells and the levels kept
+    /// below it (sunbeam_response::cells).
+    pub env_cells: (usize, usize),
 }
 
 /// Default wavelength sample count (docs/PLAY.md: chosen by measurement).
@@ -139,6 +144,11 @@ impl Default for Settings {
             msaa: 4,
             footprint: true,
             env_samples: crate::env::DEFAULT_ENV_SAMPLES,
+            env_estimator: crate::env::EnvEstimator::default(),
+            env_cells: (
+                sunbeam_response::cells::DEFAULT_TOP,
+                sunbeam_response::cells::DEFAULT_DEPTH,
+            ),
         }
     }
 }
@@ -226,7 +236,22 @@ impl Renderer {
         // The environment (docs/PLAY.md "Environment"): the default mode shades
         // it progressively; the Lambert baseline ignores it.
         let environment = environment::of_scene(p, settings.mode)?;
-        let env_scene = crate::env::EnvScene::new(gpu, environment.clone(), settings.env_samples);
+        // The transmitted irradiance table is built for the first skin's index
+        // (meshes with another index shade their diffuse part by Monte Carlo).
+        let skin_ior = p
+            .meshes
+            .iter()
+            .find(|(_, m)| m.pack.is_some())
+            .map_or(sunbeam_optics::gain::Material::default().ior, |(_, m)| {
+                m.skin.ior
+            });
+        let env_scene = crate::env::EnvScene::new(
+            gpu,
+            environment.clone(),
+            settings.env_samples,
+            settings.env_estimator,
+            skin_ior,
+        );
         let mut notes = Vec::new();
         let mut env_maps: environment::BuiltMaps = Vec::new();
         // Response maps: angle repeats, radius and s clamp, trilinear.
@@ -401,6 +426,7 @@ impl Renderer {
                     p.scene.meshes.get(mi).and_then(|m| m.pack.as_deref()),
                     mi,
                     &settings.response,
+                    settings.env_cells,
                     &mut env_maps,
                     &mut notes,
                 )?),
@@ -430,7 +456,13 @@ impl Renderer {
                 let es = if env_scene.env.is_some() {
                     &env_scene
                 } else {
-                    own = crate::env::EnvScene::new(gpu, Some(e.clone()), 1);
+                    own = crate::env::EnvScene::new(
+                        gpu,
+                        Some(e.clone()),
+                        1,
+                        crate::env::EnvEstimator::MonteCarlo,
+                        1.5,
+                    );
                     &own
                 };
                 Some(background::Background::new(gpu, es, format, settings.msaa)?)

@@ -1,0 +1,218 @@
+//! The first-frame cells against the reference's quadrature at single
+//! shading points (docs/LIGHTING.md "The first frame"): CIEDE2000 over random
+//! frames and views for several cell counts. Prints; asserts nothing.
+//!
+//! `cargo bench -p sunbeam-response --bench cells [-- PATCH]`
+
+use std::time::Instant;
+use sunbeam_common::rng::SplitMix64;
+use sunbeam_frame::fixtures;
+use sunbeam_light::prefilter::Prefiltered;
+use sunbeam_light::{sky::Sky, Environment};
+use sunbeam_optics::colour;
+use sunbeam_optics::gain::Material;
+use sunbeam_optics::masking::Masking;
+use sunbeam_pack::build::BuildOptions;
+use sunbeam_response::cells::Cells;
+use sunbeam_response::env::build_env;
+use sunbeam_response::quadrature::{EnvQuadrature, Query};
+use sunbeam_response::Options;
+
+fn main() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/snake");
+    let which = std::env::args().nth(1).unwrap_or_else(|| "xeno".into());
+    let patch = if which == "elaphe" {
+        fixtures::ELAPHE
+    } else {
+        fixtures::XENO
+    };
+    let pack = fixtures::pack(&patch, &dir, &BuildOptions::default()).expect("pack");
+    let envs: Vec<(&str, Environment)> = vec![
+        (
+            "sky",
+            Environment::Sky(Box::new(Sky::new(40.0, 30.0, 3.0, 1.0))),
+        ),
+        (
+            "studio",
+            Environment::Map(
+                sunbeam_light::io::load(
+                    &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                        .join("../../../shared/data/hdri/studio.exr"),
+                    0.0,
+                    1.0,
+                )
+                .expect("hdri"),
+            ),
+        ),
+    ];
+    for (name, env) in &envs {
+        let t0 = Instant::now();
+        let er = build_env(&pack, env, &Options::default());
+        let t_env = t0.elapsed();
+        let t0 = Instant::now();
+        let quad = EnvQuadrature::build(&pack, env, &EnvQuadrature::reference_options());
+        let t_quad = t0.elapsed();
+        let (w, h, table) = env.coefficient_table(256);
+        let t0 = Instant::now();
+        {
+            let mut e: Vec<(f64, f64)> = (0..w * h)
+                .map(|t| {
+                    let j = t / w;
+                    let om = ((std::f64::consts::PI * j as f64 / h as f64).cos()
+                        - (std::f64::consts::PI * (j + 1) as f64 / h as f64).cos())
+                        * std::f64::consts::TAU
+                        / w as f64;
+                    let y = table[4 * t] as f64 + table[4 * t + 1] as f64 + table[4 * t + 2] as f64;
+                    (y * om, om)
+                })
+                .collect();
+            let tot: f64 = e.iter().map(|x| x.0).sum();
+            e.sort_by(|a, b| (b.0 / b.1).total_cmp(&(a.0 / a.1)));
+            let mut acc = 0.0;
+            let mut om = 0.0;
+            for (q, x) in e.iter().enumerate() {
+                acc += x.0;
+                om += x.1;
+                if [10, 100, 1000, 10000, 50000].contains(&(q + 1)) {
+                    eprintln!(
+                        "  top {} texels: {:.1}% of the energy in {:.4} sr",
+                        q + 1,
+                        100.0 * acc / tot,
+                        om
+                    );
+                }
+            }
+        }
+        let pre = Prefiltered::new(w, h, table);
+        let t_pre = t0.elapsed();
+        eprintln!(
+            "{name}: maps {t_env:.2?}, reference {t_quad:.2?}, prefilter {:.2?} ({w} x {h})",
+            t_pre
+        );
+        let skin = Material::default();
+        let mut rng = SplitMix64::new(7);
+        let mut pts = Vec::new();
+        for _ in 0..600 {
+            // a random frame and a view with cos theta_r uniform in (0.02, 1)
+            let z = 2.0 * rng.unit() - 1.0;
+            let ph = std::f64::consts::TAU * rng.unit();
+            let s = (1.0 - z * z).sqrt();
+            let n = [s * ph.cos(), z, s * ph.sin()];
+            let a = if n[1].abs() < 0.9 {
+                [0.0, 1.0, 0.0]
+            } else {
+                [1.0, 0.0, 0.0]
+            };
+            let cross = |a: [f64; 3], b: [f64; 3]| {
+                [
+                    a[1] * b[2] - a[2] * b[1],
+                    a[2] * b[0] - a[0] * b[2],
+                    a[0] * b[1] - a[1] * b[0],
+                ]
+            };
+            let norm = |v: [f64; 3]| {
+                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                v.map(|x| x / l)
+            };
+            let t = norm(cross(a, n));
+            let b = cross(n, t);
+            let cr = 0.02 + 0.98 * rng.unit();
+            let pr = std::f64::consts::TAU * rng.unit();
+            let sr = (1.0 - cr * cr).sqrt();
+            pts.push(((t, b, n), [sr * pr.cos(), sr * pr.sin(), cr]));
+        }
+        let sun_u = [0.5, 0.5];
+        let refs: Vec<[f64; 3]> = pts
+            .iter()
+            .map(|(f, wr)| {
+                quad.integrate_many(
+                    env,
+                    &[Query {
+                        frame: *f,
+                        wr: *wr,
+                        sun_u,
+                        masking: Masking::Off,
+                        skin,
+                    }],
+                    (0, 1),
+                )[0]
+            })
+            .collect();
+        let mut ys: Vec<f64> = refs.iter().map(|x| x[1]).collect();
+        ys.sort_by(f64::total_cmp);
+        let white = ys[ys.len() * 9 / 10] * 2.0;
+        let cfgs: Vec<(usize, usize)> = std::env::var("CELLS_CFG")
+            .unwrap_or_else(|_| "16:0,64:0,64:3,64:5,256:0,1024:0".into())
+            .split(',')
+            .map(|c| {
+                let mut it = c.split(':');
+                (
+                    it.next().unwrap().parse().unwrap(),
+                    it.next().unwrap().parse().unwrap(),
+                )
+            })
+            .collect();
+        for (n_top, depth) in cfgs {
+            let cells = Cells::build(&er.basis, n_top, depth);
+            let t0 = Instant::now();
+            let mut de = Vec::new();
+            let mut bins: Vec<Vec<f64>> = vec![Vec::new(); 5];
+            for ((f, wr), r) in pts.iter().zip(&refs) {
+                let coeffs = |d: [f64; 3], om: f64| {
+                    if std::env::var("NOPRE").is_ok() {
+                        env.coefficients(d)
+                    } else {
+                        pre.lookup(
+                            d,
+                            om * std::env::var("OMS")
+                                .ok()
+                                .and_then(|s| s.parse::<f64>().ok())
+                                .unwrap_or(1.0),
+                        )
+                    }
+                };
+                let mut x = cells.estimate(*f, *wr, Masking::Off, skin, &coeffs);
+                // the sun as the player: its map at the disc's point
+                if let (Some(sky), Some(es)) = (env.sun(), &er.sun) {
+                    let (d, _) = sky.sample_sun(sun_u[0], sun_u[1]).unwrap();
+                    let (t, b, n) = *f;
+                    let dot = |a: [f64; 3]| a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
+                    let wi = [dot(t), dot(b), dot(n)];
+                    if wi[2] > 0.0 {
+                        let g = sunbeam_optics::gain::g(wi, *wr, skin);
+                        let e = es.lookup(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
+                        for a in 0..3 {
+                            x[a] += g * e[a];
+                        }
+                    }
+                }
+                let sc = |v: [f64; 3]| v.map(|c| (c / white).max(0.0));
+                de.push(colour::ciede2000_xyz(sc(x), sc(*r)));
+                let bin = ((wr[2] * 5.0) as usize).min(4);
+                bins[bin].push(*de.last().unwrap());
+            }
+            let dt = t0.elapsed();
+            de.sort_by(f64::total_cmp);
+            let binned: Vec<String> = bins
+                .iter_mut()
+                .map(|b| {
+                    b.sort_by(f64::total_cmp);
+                    format!(
+                        "{:.1}/{:.1}",
+                        b.iter().sum::<f64>() / b.len().max(1) as f64,
+                        b.get(b.len() * 95 / 100).copied().unwrap_or(0.0)
+                    )
+                })
+                .collect();
+            eprintln!("    by cos_r fifths (mean/p95): {}", binned.join("  "));
+            let mean = de.iter().sum::<f64>() / de.len() as f64;
+            eprintln!(
+                "  cells {n_top:5} depth {depth}: nodes {:6}  dE mean {mean:.3} p99 {:.3} max {:.3}  {:.1} us/point",
+                cells.nodes.len(),
+                de[de.len() * 99 / 100],
+                de[de.len() - 1],
+                dt.as_secs_f64() * 1e6 / pts.len() as f64
+            );
+        }
+    }
+}

@@ -1,0 +1,382 @@
+//! The first-frame estimator's cells: the extended-light maps' mass
+//! clustered once per pack into a few cells in `(u, v)`, so that a shading
+//! point sums a few dozen terms instead of drawing samples (docs/LIGHTING.md
+//! "The first frame").
+//!
+//! Why this works: the maps `E_k(u, v, w)` do not depend on the view; a view
+//! `wr` only shifts the disc of propagating directions (`wi_xy = -(u, v) -
+//! wr_xy`) and picks the layer `s` of each point. So the integral
+//!
+//! `XYZ(wr) = int d(u, v) [G / cos(theta_i)] sum_k c_k(wi) E_k(u, v, w)`
+//!
+//! is, cell by cell, the cell's mass `M_k(s) = int_cell E_k d(u, v)` (per
+//! layer, exact sums of the maps' texels) times the smooth factors at the
+//! cell's centroid: `G / cos(theta_i)` and the environment's coefficients
+//! averaged over the cell's footprint (`c_k` read from the prefiltered
+//! environment at the cell's solid angle, `sunbeam_light::prefilter`). The
+//! error is that of a midpoint rule per cell: the factors' curvature over the
+//! cell and the environment's correlation with the colour inside it.
+//!
+//! Clustering: the texels of the reference's quadrature (centres and areas
+//! of `EnvQuadrature`'s rows; a texel's mass is its area times its |Y|
+//! summed over the maps, averaged over the layers) are split top-down, at
+//! each step the cell with the largest `mass x spread^2` (mass-weighted
+//! variance of its position) at its mass median along its longer axis, until
+//! `n` cells: a median-cut quadtree in the mass, not the grid. The specular
+//! peak (much mass, no spread) stays one cell; the orders' rainbow streaks
+//! are cut along their length.
+//!
+//! Cells near the view's horizon: a cell is split further, per view, into the
+//! two children the clustering made (kept as a binary tree), while its spread
+//! reaches the horizon (`dist < REFINE * spread`), so that the `1 / cos` peak
+//! there is followed; leaves straddling it count the share of their spread
+//! inside the disc (a Gaussian's, along the normal to the horizon).
+
+use crate::grid::Grid;
+use crate::Response;
+use std::collections::BinaryHeap;
+use sunbeam_optics::gain;
+use sunbeam_optics::masking::Masking;
+
+/// A local frame `(t, b, n)` (world vectors).
+pub type Frame = ([f64; 3], [f64; 3], [f64; 3]);
+
+/// Cells refine near the horizon while their spread (rms radius) times this
+/// reaches it.
+pub const REFINE: f64 = 2.0;
+
+/// Cells every view visits (the top cut) in the player.
+pub const DEFAULT_TOP: usize = 256;
+/// Levels below the top cut kept for views whose horizon a cell reaches.
+pub const DEFAULT_DEPTH: usize = 4;
+/// Floats per node in [`Cells::gpu_data`] before its layers' masses.
+pub const GPU_HEADER: usize = 4;
+
+/// One node of the cells' tree.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    /// Mass-weighted centroid in `(u, v)`.
+    pub uv: [f64; 2],
+    /// Mass-weighted rms distance of the cell's texels from the centroid.
+    pub spread: f64,
+    /// Children (indices into `Cells::nodes`), or none for a leaf.
+    pub children: Option<[u32; 2]>,
+    /// Per layer `k` (the maps' `s` texels): `int_cell E_b d(u, v)`, XYZ of
+    /// `b = 0, 1, 2` (9 values).
+    pub mass: Vec<[f64; 9]>,
+}
+
+/// The cells of one pack's maps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cells {
+    pub grid: Grid,
+    /// Every node of the tree; the first `n_top` are the top cut (the cells
+    /// every view visits), the rest their descendants.
+    pub nodes: Vec<Cell>,
+    pub n_top: usize,
+}
+
+struct Texel {
+    uv: [f64; 2],
+    m: f64,
+    t: u32,
+}
+
+struct Pending {
+    cost: f64,
+    members: Vec<u32>,
+}
+
+impl PartialEq for Pending {
+    fn eq(&self, o: &Self) -> bool {
+        self.cost == o.cost
+    }
+}
+impl Eq for Pending {}
+impl PartialOrd for Pending {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Pending {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.cost.total_cmp(&o.cost)
+    }
+}
+
+impl Cells {
+    /// Cluster the three maps `basis` (on one grid) into `n_top` cells, each
+    /// split further down to `depth` levels for views that need it.
+    pub fn build(basis: &[Response], n_top: usize, depth: usize) -> Cells {
+        assert_eq!(basis.len(), 3, "three basis maps");
+        let g = basis[0].info.grid;
+        let (nt, nr, ns) = (g.n_theta, g.n_rho, g.n_s);
+        let dt = std::f64::consts::TAU / nt as f64;
+        let r_cont = |rho: f64| (g.r0 * (rho * g.rho_scale()).sinh()).clamp(0.0, 2.0);
+        let last = (nr - 1) as f64;
+        // Texels as the quadrature's: centre, area.
+        let mut texels = Vec::new();
+        let mut areas = vec![0.0; nr];
+        for (j, area) in areas.iter_mut().enumerate() {
+            let r_lo = r_cont((j as f64 - 0.5).max(0.0) / last);
+            let r_hi = r_cont((j as f64 + 0.5).min(last) / last);
+            *area = dt * (r_hi * r_hi - r_lo * r_lo) / 2.0;
+            let r = g.r_at(j);
+            for i in 0..nt {
+                let mut y = 0.0;
+                for k in 0..ns {
+                    for m in basis {
+                        y += m.texel(i, j, k)[1].abs();
+                    }
+                }
+                let m = *area * y / ns as f64;
+                if m > 0.0 {
+                    let th = g.theta_at(i);
+                    texels.push(Texel {
+                        uv: [r * th.cos(), r * th.sin()],
+                        m,
+                        t: (j * nt + i) as u32,
+                    });
+                }
+            }
+        }
+        if texels.is_empty() {
+            return Cells {
+                grid: g,
+                nodes: Vec::new(),
+                n_top: 0,
+            };
+        }
+        let mass_of = |members: &[u32]| -> Vec<[f64; 9]> {
+            let mut out = vec![[0.0; 9]; ns];
+            for &t in members {
+                let (j, i) = (
+                    texels[t as usize].t as usize / nt,
+                    texels[t as usize].t as usize % nt,
+                );
+                let a = areas[j];
+                for (k, o) in out.iter_mut().enumerate() {
+                    for (b, map) in basis.iter().enumerate() {
+                        let e = map.texel(i, j, k);
+                        for c in 0..3 {
+                            o[3 * b + c] += a * e[c];
+                        }
+                    }
+                }
+            }
+            out
+        };
+        let stats = |members: &[u32]| -> ([f64; 2], f64, f64) {
+            let (mut m, mut su, mut sv) = (0.0, 0.0, 0.0);
+            for &t in members {
+                let x = &texels[t as usize];
+                m += x.m;
+                su += x.m * x.uv[0];
+                sv += x.m * x.uv[1];
+            }
+            let c = [su / m, sv / m];
+            let mut var = 0.0;
+            for &t in members {
+                let x = &texels[t as usize];
+                var += x.m * ((x.uv[0] - c[0]).powi(2) + (x.uv[1] - c[1]).powi(2));
+            }
+            (c, m, (var / m).max(0.0))
+        };
+        let all: Vec<u32> = (0..texels.len() as u32).collect();
+        let split = |members: &[u32]| -> Option<(Vec<u32>, Vec<u32>)> {
+            if members.len() < 2 {
+                return None;
+            }
+            let (c, _, _) = stats(members);
+            let (mut vu, mut vv) = (0.0, 0.0);
+            for &t in members {
+                let x = &texels[t as usize];
+                vu += x.m * (x.uv[0] - c[0]).powi(2);
+                vv += x.m * (x.uv[1] - c[1]).powi(2);
+            }
+            let axis = usize::from(vv > vu);
+            let mut s = members.to_vec();
+            s.sort_by(|a, b| texels[*a as usize].uv[axis].total_cmp(&texels[*b as usize].uv[axis]));
+            let total: f64 = s.iter().map(|&t| texels[t as usize].m).sum();
+            let mut acc = 0.0;
+            let mut cut = 1;
+            for (q, &t) in s.iter().enumerate() {
+                acc += texels[t as usize].m;
+                if acc >= 0.5 * total {
+                    cut = (q + 1).clamp(1, s.len() - 1);
+                    break;
+                }
+            }
+            let b = s.split_off(cut);
+            Some((s, b))
+        };
+        // The top cut: repeatedly split the costliest cell.
+        let cost = |members: &[u32]| {
+            let (_, m, var) = stats(members);
+            m * var
+        };
+        let mut heap = BinaryHeap::new();
+        heap.push(Pending {
+            cost: cost(&all),
+            members: all,
+        });
+        let mut top: Vec<Vec<u32>> = Vec::new();
+        while top.len() + heap.len() < n_top.max(1) {
+            let Some(p) = heap.pop() else { break };
+            match (p.cost > 0.0).then(|| split(&p.members)).flatten() {
+                Some((a, b)) => {
+                    for half in [a, b] {
+                        heap.push(Pending {
+                            cost: cost(&half),
+                            members: half,
+                        });
+                    }
+                }
+                None => top.push(p.members),
+            }
+        }
+        top.extend(heap.into_iter().map(|p| p.members));
+        // Rebuild as a tree whose first n_top nodes are the top cut.
+        let mut out: Vec<Cell> = Vec::new();
+        let mut queue: Vec<(usize, Vec<u32>, usize)> = Vec::new();
+        for m in top {
+            out.push(Cell {
+                uv: [0.0; 2],
+                spread: 0.0,
+                children: None,
+                mass: Vec::new(),
+            });
+            queue.push((out.len() - 1, m, 0));
+        }
+        let n_top = out.len();
+        let mut q = 0;
+        while q < queue.len() {
+            let (id, members, d) = std::mem::take(&mut queue[q]);
+            q += 1;
+            let (c, _, var) = stats(&members);
+            out[id].uv = c;
+            out[id].spread = var.sqrt();
+            out[id].mass = mass_of(&members);
+            if d < depth && var > 0.0 {
+                if let Some((a, b)) = split(&members) {
+                    let ia = out.len();
+                    out.push(out[id].clone());
+                    out.push(out[id].clone());
+                    out[id].children = Some([ia as u32, ia as u32 + 1]);
+                    queue.push((ia, a, d + 1));
+                    queue.push((ia + 1, b, d + 1));
+                }
+            }
+        }
+        for c in out.iter_mut() {
+            if c.children.is_none() && c.mass.is_empty() {
+                c.mass = vec![[0.0; 9]; ns];
+            }
+        }
+        Cells {
+            grid: g,
+            nodes: out,
+            n_top,
+        }
+    }
+
+    /// The nodes for the shader (shaders/environment.wgsl `env_cells`): per
+    /// node `[u, v, spread, first child (u32 bits; u32::MAX for a leaf)]`,
+    /// then `n_s` layers of 9 masses (XYZ of `E_0, E_1, E_2`); the second
+    /// child follows the first.
+    pub fn gpu_data(&self) -> Vec<f32> {
+        let ns = self.grid.n_s;
+        let mut out = Vec::with_capacity(self.nodes.len() * (GPU_HEADER + 9 * ns));
+        for c in &self.nodes {
+            let first = c.children.map_or(u32::MAX, |ch| ch[0]);
+            out.extend([
+                c.uv[0] as f32,
+                c.uv[1] as f32,
+                c.spread as f32,
+                f32::from_bits(first),
+            ]);
+            for layer in &c.mass {
+                out.extend(layer.iter().map(|&m| m as f32));
+            }
+        }
+        out
+    }
+
+    /// The diffraction part (XYZ) towards local view `wr` (unit, `z > 0`),
+    /// `coeffs(d, omega)` the environment's coefficients at world direction
+    /// `d` averaged over `omega` steradians.
+    pub fn estimate(
+        &self,
+        frame: Frame,
+        wr: [f64; 3],
+        masking: Masking,
+        skin: gain::Material,
+        coeffs: &dyn Fn([f64; 3], f64) -> [f64; 3],
+    ) -> [f64; 3] {
+        let mut xyz = [0.0; 3];
+        if wr[2].is_nan() || wr[2] <= 0.0 {
+            return xyz;
+        }
+        let (t, b, n) = frame;
+        let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
+        let mut stack: Vec<u32> = (0..self.n_top as u32).rev().collect();
+        while let Some(id) = stack.pop() {
+            let c = &self.nodes[id as usize];
+            let wxy = [-c.uv[0] - wr[0], -c.uv[1] - wr[1]];
+            let dist = 1.0 - (wxy[0] * wxy[0] + wxy[1] * wxy[1]).sqrt();
+            if let Some(ch) = c.children {
+                if dist < REFINE * c.spread {
+                    stack.extend(ch);
+                    continue;
+                }
+            }
+            let inside = if c.spread > 0.0 {
+                0.5 * (1.0 + erf(dist / (std::f64::consts::SQRT_2 * c.spread)))
+            } else {
+                f64::from(dist > 0.0)
+            };
+            if inside <= 0.0 || dist <= -0.5 {
+                continue;
+            }
+            // the centroid, pulled inside the disc when it is not
+            let d2 = {
+                let l2 = wxy[0] * wxy[0] + wxy[1] * wxy[1];
+                l2.min(0.999 * 0.999)
+            };
+            let scale = if wxy[0] * wxy[0] + wxy[1] * wxy[1] > d2 {
+                (d2 / (wxy[0] * wxy[0] + wxy[1] * wxy[1])).sqrt()
+            } else {
+                1.0
+            };
+            let wi = [wxy[0] * scale, wxy[1] * scale, (1.0 - d2).sqrt()];
+            let r = c.uv[0].hypot(c.uv[1]);
+            let s = ((wi[2] + wr[2]) / (4.0 - r * r).max(1e-12).sqrt()).clamp(0.0, 1.0);
+            let sc = s * (self.grid.n_s - 1) as f64;
+            let k0 = (sc.floor() as usize).min(self.grid.n_s - 2);
+            let f = sc - k0 as f64;
+            let g = masking.gain(wi, wr, skin) / wi[2] * inside;
+            let omega = (std::f64::consts::TAU * c.spread * c.spread / wi[2]).max(1e-9);
+            let ck = coeffs(world(wi), omega);
+            for bb in 0..3 {
+                for a in 0..3 {
+                    let m = c.mass[k0][3 * bb + a] * (1.0 - f) + c.mass[k0 + 1][3 * bb + a] * f;
+                    xyz[a] += g * ck[bb] * m;
+                }
+            }
+        }
+        xyz
+    }
+}
+
+/// erf to 1.5e-7 (Abramowitz and Stegun 7.1.26), as the shader's.
+pub fn erf(x: f64) -> f64 {
+    let s = x.signum();
+    let x = x.abs();
+    let t = 1.0 / (1.0 + 0.3275911 * x);
+    let y = 1.0
+        - (((((1.061405429 * t - 1.453152027) * t) + 1.421413741) * t - 0.284496736) * t
+            + 0.254829592)
+            * t
+            * (-x * x).exp();
+    s * y
+}
