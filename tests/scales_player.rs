@@ -1,14 +1,22 @@
 //! The player applies the scale maps (`sunbeam-bake --scales`, docs/BAKE.md
 //! "Scales"; issue 27) as the reference does: a close-up of the procedural
 //! snake baked with scales at low detail (`--snake-detail 0.25 --scale-texels
-//! 8`), a synthetic 5 um ridge pack, one point light; both renderers at 2x and
-//! box-filtered (the player with its 4x MSAA and footprint filter, the
-//! reference with `--samples 16`), compared in linear light (CIEDE2000 over
-//! the reference's lit pixels). The same frame by the player without the maps
-//! must differ from the reference by clearly more, or the comparison would
-//! pass with the maps ignored.
+//! 8`), a synthetic 5 um ridge pack, one point light, 48 x 48, both renderers
+//! at the player's 48 wavelength samples, compared in linear light
+//! (CIEDE2000 over the reference's lit pixels):
 //!
-//! `SUNBEAM_SCALES_OUT=DIR` keeps the three 1x frames as EXR and PNG.
+//! - point-sampled (the pixel centre on both sides): the maps' lookup and
+//!   frame texel for texel, also with a 45 deg ridge jitter, where the groove
+//!   mask's weighting of the ridge vectors shows at the borders;
+//! - anti-aliased: both renderers at 2x and box-filtered (the player with its
+//!   4x MSAA and footprint filter, the reference with `--samples 16`);
+//! - the same frame by the player without the maps must differ from the
+//!   reference by far more, or the comparisons would pass with the maps
+//!   ignored.
+//!
+//! Figures: docs/bench/play.md "Scale maps under a point light".
+//! `SUNBEAM_SCALES_OUT=DIR` keeps the frames (EXR and PNG) and the
+//! difference maps, and prints the worst pixels.
 
 mod gpu;
 
