@@ -634,7 +634,13 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
     // the reference shades each covered sub-pixel position (docs/PLAY.md
     // "Where a pixel shades"; crates/sunbeam-render/tests/silhouette.rs).
     let n_cov = countOneBits(covered & 15u);
-    let at_samples = g.msaa >= 4u && n_cov > 0u && n_cov < 4u && dot(wr, n) <= ENV_GRAZING_COS;
+    // On a mesh with scale maps every pixel does so (with MSAA), each sample
+    // reading the maps at its own uv: the frame varies at the maps' texels
+    // and jumps at the scale borders, where the screen derivatives of
+    // (u, v, w), the footprint filter's linear model, fail (across a border
+    // they spread the response over both scales' lobes instead of mixing
+    // the two); the samples resolve the variation (docs/PLAY.md "Scale maps").
+    let at_samples = g.msaa >= 4u && n_cov > 0u && ((n_cov < 4u && dot(wr, n) <= ENV_GRAZING_COS) || mat.scales_on == 1u);
     var rgb = vec3<f32>(0.0);
     for (var i = 0u; i < g.n_lights; i = i + 1u) {
         let wi = g.lights[i].xyz;
