@@ -1,6 +1,7 @@
 // Sunbeam diffraction shader (PHYSICS.md 1-3, docs/PLAY.md "Shading").
 //
-// Per fragment: local frame (t, b, n) with b = n x t, (u, v, w) = -wi - wr,
+// Per fragment: local frame (t, b, n) with b = n x t (on a mesh with scale
+// maps, the frame the maps give: shaders/scales.wgsl, frame_at), (u, v, w) = -wi - wr,
 // for each wavelength sample that can reach a stored frequency:
 //   t_l = 2 pi w H / lambda, c_n(t_l) (Chebyshev: i^n eps_n J_n by Miller's
 //   backward recurrence; Taylor: (i t)^n / n!), only the terms |t_l| needs,
