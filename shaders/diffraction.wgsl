@@ -1,6 +1,7 @@
 // Sunbeam diffraction shader (PHYSICS.md 1-3, docs/PLAY.md "Shading").
 //
-// Per fragment: local frame (t, b, n) with b = n x t, (u, v, w) = -wi - wr,
+// Per fragment: local frame (t, b, n) with b = n x t (on a mesh with scale
+// maps, the frame the maps give: shaders/scales.wgsl, frame_at), (u, v, w) = -wi - wr,
 // for each wavelength sample that can reach a stored frequency:
 //   t_l = 2 pi w H / lambda, c_n(t_l) (Chebyshev: i^n eps_n J_n by Miller's
 //   backward recurrence; Taylor: (i t)^n / n!), only the terms |t_l| needs,
@@ -63,7 +64,9 @@ struct Material {
     terms: u32,       // terms stored (capped at MAX_TERMS)
     fixed_terms: u32, // thesis mode: use exactly this many; 0 = per-fragment from the bound
     n_table: u32,     // entries in term_table
-    _p0: u32,
+    // 1: the mesh's scale maps are bound (group 1, bindings 6 and 7) and
+    // perturb the frame (shaders/scales.wgsl)
+    scales_on: u32,
     // bins per (cycle per micrometre), x and y
     bin_scale_um: vec2<f32>,
     half_range_um: f32,
@@ -101,7 +104,9 @@ struct Material {
     // window model: the coherence window's sigma (manifest window_sigma_m) in
     // um, for R_U in the direct mode; 0 = plain R
     window_sigma_um: f32,
-    _s0: f32,
+    // the scale maps' wraps (sb_scale_frame): bits 0-1 the normal map's
+    // REPEAT along s and t, bits 2-3 the orientation map's
+    scales_wrap: u32,
     _s1: f32,
     _s2: f32,
 };
@@ -120,11 +125,20 @@ struct Material {
 // response map: XYZ at texel (angle, radius, s); repeat in angle, clamp elsewhere
 @group(1) @binding(4) var resp_tex: texture_3d<f32>;
 @group(1) @binding(5) var resp_smp: sampler;
+// scale maps (sunbeam-bake --scales): the normal map and the orientation map
+// (RG ridge direction, B groove mask), RGBA8 unorm, read by textureLoad
+// (shaders/scales.wgsl); 1 x 1 stand-ins when `mat.scales_on` is 0
+@group(1) @binding(6) var scale_normal: texture_2d<f32>;
+@group(1) @binding(7) var scale_orient: texture_2d<f32>;
 
 struct VsIn {
     @location(0) pos: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) tangent: vec4<f32>,
+    // TEXCOORD_0 and the glTF TANGENT (the UV frame, w = handedness) of a
+    // mesh with scale maps (zero otherwise)
+    @location(3) uv: vec2<f32>,
+    @location(4) uv_tangent: vec4<f32>,
 };
 
 struct VsOut {
@@ -132,6 +146,8 @@ struct VsOut {
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) tangent: vec3<f32>,
+    @location(3) uv: vec2<f32>,
+    @location(4) uv_tangent: vec4<f32>,
 };
 
 @vertex
@@ -141,6 +157,8 @@ fn vs_main(v: VsIn) -> VsOut {
     o.world = v.pos;
     o.normal = v.normal;
     o.tangent = v.tangent.xyz;
+    o.uv = v.uv;
+    o.uv_tangent = v.uv_tangent;
     return o;
 }
 
@@ -562,6 +580,18 @@ fn shade_light(i: u32, fr: mat3x3<f32>, wr: vec3<f32>, diffract: bool, dw: f32, 
     return g.lights[i].w * (dw * mat.base.xyz * base_in + (1.0 - dw) * diff);
 }
 
+// The shading frame (columns t, b, n) of interpolated attributes: sb_frame of
+// the normal and the orientation, or, on a mesh with scale maps, the frame the
+// maps give at `uv` (shaders/scales.wgsl, as the reference's
+// sunbeam_frame::MeshScales::perturb).
+fn frame_at(normal: vec3<f32>, tangent: vec3<f32>, uv: vec2<f32>, uv_tangent: vec4<f32>) -> mat3x3<f32> {
+    let fr = sb_frame(normal, tangent);
+    if (mat.scales_on == 0u) {
+        return fr;
+    }
+    return sb_scale_frame(scale_normal, scale_orient, mat.scales_wrap, normal, uv_tangent, uv, fr);
+}
+
 // The standard 4x MSAA sample positions (pixels from the centre; Vulkan,
 // D3D, Metal alike).
 fn msaa_position(j: u32) -> vec2<f32> {
@@ -571,7 +601,7 @@ fn msaa_position(j: u32) -> vec2<f32> {
 
 @fragment
 fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f32> {
-    let fr = sb_frame(in.normal, in.tangent);
+    let fr = frame_at(in.normal, in.tangent, in.uv, in.uv_tangent);
     let t = fr[0];
     let b = fr[1];
     let n = fr[2];
@@ -591,6 +621,10 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
     let dnormal_y = dpdy(in.normal);
     let dtangent_x = dpdx(in.tangent);
     let dtangent_y = dpdy(in.tangent);
+    let duv_tex_x = dpdx(in.uv);
+    let duv_tex_y = dpdy(in.uv);
+    let duv_tangent_x = dpdx(in.uv_tangent);
+    let duv_tangent_y = dpdy(in.uv_tangent);
     // A partly covered pixel whose centre sees the surface at a grazing angle
     // or from below (a silhouette, with MSAA) shades the point lights at each
     // of its covered samples and takes their mean: the centre lies past the
@@ -601,7 +635,13 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
     // the reference shades each covered sub-pixel position (docs/PLAY.md
     // "Where a pixel shades"; crates/sunbeam-render/tests/silhouette.rs).
     let n_cov = countOneBits(covered & 15u);
-    let at_samples = g.msaa >= 4u && n_cov > 0u && n_cov < 4u && dot(wr, n) <= ENV_GRAZING_COS;
+    // On a mesh with scale maps every pixel does so (with MSAA), each sample
+    // reading the maps at its own uv: the frame varies at the maps' texels
+    // and jumps at the scale borders, where the screen derivatives of
+    // (u, v, w), the footprint filter's linear model, fail (across a border
+    // they spread the response over both scales' lobes instead of mixing
+    // the two); the samples resolve the variation (docs/PLAY.md "Scale maps").
+    let at_samples = g.msaa >= 4u && n_cov > 0u && ((n_cov < 4u && dot(wr, n) <= ENV_GRAZING_COS) || mat.scales_on == 1u);
     var rgb = vec3<f32>(0.0);
     for (var i = 0u; i < g.n_lights; i = i + 1u) {
         let wi = g.lights[i].xyz;
@@ -624,7 +664,12 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
                 if (((covered >> j) & 1u) == 1u) {
                     let o = msaa_position(j);
                     let world_s = in.world + dworld_x * o.x + dworld_y * o.y;
-                    let fs = sb_frame(in.normal + dnormal_x * o.x + dnormal_y * o.y, in.tangent + dtangent_x * o.x + dtangent_y * o.y);
+                    let fs = frame_at(
+                        in.normal + dnormal_x * o.x + dnormal_y * o.y,
+                        in.tangent + dtangent_x * o.x + dtangent_y * o.y,
+                        in.uv + duv_tex_x * o.x + duv_tex_y * o.y,
+                        in.uv_tangent + duv_tangent_x * o.x + duv_tangent_y * o.y
+                    );
                     let wr_s = normalize(g.eye.xyz - world_s);
                     // each sample stands for a quarter of the pixel: half the
                     // footprint along each axis
@@ -671,7 +716,9 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
         let world_c = in.world + dworld_x * off.x + dworld_y * off.y;
         let normal_c = in.normal + dnormal_x * off.x + dnormal_y * off.y;
         let tangent_c = in.tangent + dtangent_x * off.x + dtangent_y * off.y;
-        let fc = sb_frame(normal_c, tangent_c);
+        let uv_c = in.uv + duv_tex_x * off.x + duv_tex_y * off.y;
+        let uv_tangent_c = in.uv_tangent + duv_tangent_x * off.x + duv_tangent_y * off.y;
+        let fc = frame_at(normal_c, tangent_c, uv_c, uv_tangent_c);
         let wr_c = normalize(g.eye.xyz - world_c);
         let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
         rgb = rgb + env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, vec2<u32>(in.clip.xy));

@@ -1,5 +1,5 @@
 //! Shared helpers for the player's tests (tests/match_reference.rs,
-//! tests/material_wgsl.rs, tests/silhouette.rs): the headless adapter
+//! tests/material_wgsl.rs, tests/silhouette.rs, tests/scales_player.rs): the headless adapter
 //! (`SUNBEAM_TEST_BACKEND`; None to skip, a failure under
 //! SUNBEAM_REQUIRE_ALL=1) and the synthetic ridge packs of the real-scale
 //! comparisons on a point-lit sphere.

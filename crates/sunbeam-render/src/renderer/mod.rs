@@ -27,7 +27,9 @@ pub use targets::{
 pub use uniforms::term_table;
 
 use crate::gpu::Gpu;
-use pipeline::{bind_group_layouts, dummy_texture, mesh_buffers, render_pipeline};
+use pipeline::{
+    bind_group_layouts, dummy_texture, mesh_buffers, render_pipeline, rgba8_texture, scale_wraps,
+};
 use std::sync::Arc;
 use sunbeam_common::{Error, Result};
 use sunbeam_frame::Prepared;
@@ -39,10 +41,12 @@ use wgpu::util::DeviceExt;
 /// The WGSL source: the skin's material functions (shaders/material.wgsl:
 /// Fresnel, G, masking, the diffuse base's share, the frame), the response-map
 /// material (shaders/response_map.wgsl; both also what `--export-shader`
-/// translates), the player's shading (shaders/diffraction.wgsl) and the
-/// environment's estimator (shaders/environment.wgsl).
+/// translates), the scale maps' frame (shaders/scales.wgsl), the player's
+/// shading (shaders/diffraction.wgsl) and the environment's estimator
+/// (shaders/environment.wgsl).
 pub const SHADER: &str = concat!(
     include_str!("../../../../shaders/material.wgsl"),
+    include_str!("../../../../shaders/scales.wgsl"),
     include_str!("../../../../shaders/display.wgsl"),
     include_str!("../../../../shaders/env_table.wgsl"),
     include_str!("../../../../shaders/response_map.wgsl"),
@@ -265,6 +269,11 @@ impl Renderer {
             ..Default::default()
         });
         let dummy_view = Arc::new(dummy_texture(gpu));
+        // Scale maps (sunbeam-bake --scales): one pair of textures per
+        // distinct maps; a 1 x 1 stand-in for meshes without.
+        let dummy_2d = Arc::new(rgba8_texture(gpu, [1, 1], &[0; 4]));
+        type ScaleViews = (Arc<wgpu::TextureView>, Arc<wgpu::TextureView>);
+        let mut scale_views: Vec<(Arc<sunbeam_frame::MeshScales>, ScaleViews)> = Vec::new();
         let mut resp_views: Vec<(Arc<sunbeam_response::Response>, Arc<wgpu::TextureView>)> =
             Vec::new();
         let global_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -286,7 +295,8 @@ impl Renderer {
         let mut pack_bufs: baselines::TermBuffers = Vec::new();
         let mut meshes = Vec::new();
         for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
-            let (vbuf, ibuf) = mesh_buffers(device, mesh);
+            let scales = mat.scales.as_deref();
+            let (vbuf, ibuf) = mesh_buffers(device, mesh, scales);
             let mut mu = MaterialU {
                 base: [
                     mat.base_color[0] as f32,
@@ -300,6 +310,8 @@ impl Renderer {
                 mask_sy: mat.masking.rms_slope()[1] as f32,
                 ior: mat.skin.ior as f32,
                 norm: mat.skin.norm() as f32,
+                scales_on: u32::from(scales.is_some()),
+                scales_wrap: scales.map_or(0, scale_wraps),
                 ..Default::default()
             };
             let mut response: Option<Vec<[f32; 4]>> = None;
@@ -388,6 +400,22 @@ impl Renderer {
                     }),
                 None => dummy_view.clone(),
             };
+            let (scale_normal, scale_orient) = match &mat.scales {
+                Some(sc) => scale_views
+                    .iter()
+                    .find(|(k, _)| Arc::ptr_eq(k, sc))
+                    .map(|(_, v)| v.clone())
+                    .unwrap_or_else(|| {
+                        let (n, o) = (&sc.maps.normal, &sc.maps.orient);
+                        let v = (
+                            Arc::new(rgba8_texture(gpu, n.size, &n.data)),
+                            Arc::new(rgba8_texture(gpu, o.size, &o.data)),
+                        );
+                        scale_views.push((sc.clone(), v.clone()));
+                        v
+                    }),
+                None => (dummy_2d.clone(), dummy_2d.clone()),
+            };
             let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("material"),
                 layout: &gl1,
@@ -415,6 +443,14 @@ impl Renderer {
                     wgpu::BindGroupEntry {
                         binding: 5,
                         resource: wgpu::BindingResource::Sampler(&resp_sampler),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: wgpu::BindingResource::TextureView(&scale_normal),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 7,
+                        resource: wgpu::BindingResource::TextureView(&scale_orient),
                     },
                 ],
             });

@@ -10,7 +10,8 @@ use sunbeam_common::{Error, Result};
 use wgpu::util::DeviceExt;
 
 /// Bind group layouts: 0 = globals and spectrum, 1 = one material (uniforms,
-/// terms, term table, response table, response map and its sampler).
+/// terms, term table, response table, response map and its sampler, the
+/// scale maps).
 pub(super) fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 2] {
     let storage_entry = |binding| wgpu::BindGroupLayoutEntry {
         binding,
@@ -59,21 +60,50 @@ pub(super) fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayou
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                 count: None,
             },
+            texture_2d_entry(6),
+            texture_2d_entry(7),
         ],
     });
     [gl0, gl1]
 }
 
-/// Vertex and index buffers of a mesh (one dummy element when empty).
+/// A 2D texture read by `textureLoad` (the scale maps).
+fn texture_2d_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// Vertex and index buffers of a mesh (one dummy element when empty); with
+/// `scales`, the vertices carry TEXCOORD_0 and the maps' TANGENT too.
 pub(super) fn mesh_buffers(
     device: &wgpu::Device,
     mesh: &sunbeam_frame::Mesh,
+    scales: Option<&sunbeam_frame::MeshScales>,
 ) -> (wgpu::Buffer, wgpu::Buffer) {
     let mut verts: Vec<Vertex> = (0..mesh.positions.len())
-        .map(|i| Vertex {
-            pos: mesh.positions[i],
-            normal: mesh.normals[i],
-            tangent: mesh.tangents[i],
+        .map(|i| {
+            let (uv, uv_tangent) = match scales {
+                Some(s) => (
+                    mesh.uvs.get(i).copied().unwrap_or_default(),
+                    s.tangents.get(i).copied().unwrap_or_default(),
+                ),
+                None => ([0.0; 2], [0.0; 4]),
+            };
+            Vertex {
+                pos: mesh.positions[i],
+                normal: mesh.normals[i],
+                tangent: mesh.tangents[i],
+                uv,
+                uv_tangent,
+            }
         })
         .collect();
     if verts.is_empty() {
@@ -116,7 +146,7 @@ pub(super) fn render_pipeline(
     let vlayout = wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<Vertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4],
+        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x2, 4 => Float32x4],
     };
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("diffraction"),
@@ -167,4 +197,37 @@ pub(super) fn render_pipeline(
 /// A 1x1x1 stand-in for materials without a response map.
 pub(super) fn dummy_texture(gpu: &Gpu) -> wgpu::TextureView {
     crate::response::texture_3d(gpu, [1, 1, 1], &[0; 4])
+}
+
+/// An RGBA8 (unorm, not sRGB: the maps hold vectors) 2D texture of a scale
+/// map, or of the 1 x 1 stand-in of meshes without maps.
+pub(super) fn rgba8_texture(gpu: &Gpu, size: [u32; 2], data: &[u8]) -> wgpu::TextureView {
+    gpu.device
+        .create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("scale map"),
+                size: wgpu::Extent3d {
+                    width: size[0].max(1),
+                    height: size[1].max(1),
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba8Unorm,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            data,
+        )
+        .create_view(&Default::default())
+}
+
+/// The scale maps' wrap bits of the material uniform (`scales_wrap`): bits
+/// 0-1 the normal map's REPEAT along s and t, bits 2-3 the orientation map's.
+pub(super) fn scale_wraps(scales: &sunbeam_frame::MeshScales) -> u32 {
+    let bits = |r: [bool; 2]| u32::from(r[0]) | (u32::from(r[1]) << 1);
+    bits(scales.maps.normal.repeat) | (bits(scales.maps.orient.repeat) << 2)
 }

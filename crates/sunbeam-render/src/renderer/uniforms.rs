@@ -16,6 +16,10 @@ pub(super) struct Vertex {
     pub(super) pos: [f32; 3],
     pub(super) normal: [f32; 3],
     pub(super) tangent: [f32; 4],
+    /// TEXCOORD_0 and the glTF TANGENT (UV frame, w = handedness) of a mesh
+    /// with scale maps; zero otherwise (the shader does not read them).
+    pub(super) uv: [f32; 2],
+    pub(super) uv_tangent: [f32; 4],
 }
 
 #[repr(C)]
@@ -52,7 +56,8 @@ pub(super) struct MaterialU {
     pub(super) terms: u32,
     pub(super) fixed_terms: u32,
     pub(super) n_table: u32,
-    pub(super) _p0: u32,
+    /// 1 when the mesh's scale maps are bound (shaders/scales.wgsl).
+    pub(super) scales_on: u32,
     pub(super) bin_scale_um: [f32; 2],
     pub(super) half_range_um: f32,
     pub(super) beta: f32,
@@ -84,7 +89,10 @@ pub(super) struct MaterialU {
     pub(super) norm: f32,
     /// The window's sigma in um (window model: R_U in the direct mode), 0 = R.
     pub(super) window_sigma_um: f32,
-    pub(super) _s: [f32; 3],
+    /// The scale maps' wraps: bits 0-1 the normal map's REPEAT along s and
+    /// t, bits 2-3 the orientation map's.
+    pub(super) scales_wrap: u32,
+    pub(super) _s: [f32; 2],
 }
 
 /// Smallest term count whose truncation bound stays below `tol` for every |t| up to `t`.
@@ -294,6 +302,7 @@ mod layout_tests {
                 terms,
                 fixed_terms,
                 n_table,
+                scales_on,
                 bin_scale_um,
                 half_range_um,
                 beta,
@@ -320,7 +329,8 @@ mod layout_tests {
                 resp_rho_scale,
                 resp_footprint,
                 norm,
-                window_sigma_um
+                window_sigma_um,
+                scales_wrap
             ),
         );
     }
