@@ -7,7 +7,8 @@
 #
 # Takes the Makefile's variables (BIN, OUT, SHARED, MATERIALS, SIZE, BRDF_SIZE,
 # SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, SKY_SAMPLES, PLAY_SKY_FRAMES,
-# TURNTABLE_MATERIAL, TURNTABLE_SIZE, TURNTABLE_FRAMES, COLUMNS, SHEET, Q)
+# TURNTABLE_MATERIAL, TURNTABLE_SIZE, TURNTABLE_FRAMES, TURNTABLE_ESTIMATOR, COLUMNS,
+# SCALE_TEXELS, SCALES_xeno, SCALES_elaphe, SHEET, Q)
 # with the same defaults, on the command line only. Paths are relative to
 # examples/ exactly as make sees them, so Ninja runs in examples/ (-C examples)
 # and the tools' depfiles are the same bytes as under make. Ninja reads each
@@ -33,14 +34,20 @@ PLAY_SKY_FRAMES=32
 TURNTABLE_MATERIAL=__default__
 TURNTABLE_SIZE=256x144
 TURNTABLE_FRAMES=24
+TURNTABLE_ESTIMATOR=monte-carlo
 COLUMNS=6
+SCALE_TEXELS=16
+# Scales per species (examples/Makefile SCALES_*; docs/BAKE.md "Scales").
+SCALES_xeno="--scale-rows 20 --scale-length 1.0 --scale-overlap 0.3 --scale-dome 0.06 --scale-tilt 6 --scale-tilt-jitter 4 --scale-ridge-jitter 6"
+SCALES_elaphe="--scale-rows 36 --scale-length 1.5 --scale-overlap 0.3 --scale-dome 0.1 --scale-tilt 6 --scale-tilt-jitter 4 --scale-ridge-jitter 4"
 SHEET=__default__
 Q=-q
 for a in "$@"; do
   case "$a" in
     BIN=* | OUT=* | SHARED=* | MATERIALS=* | SIZE=* | BRDF_SIZE=* | SYNTH_SIZE=* | SYNTH_PIXEL=* | \
       SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | SKY_SAMPLES=* | PLAY_SKY_FRAMES=* | COLUMNS=* | SHEET=* | Q=* | \
-      TURNTABLE_MATERIAL=* | TURNTABLE_SIZE=* | TURNTABLE_FRAMES=*)
+      TURNTABLE_MATERIAL=* | TURNTABLE_SIZE=* | TURNTABLE_FRAMES=* | TURNTABLE_ESTIMATOR=* | \
+      SCALE_TEXELS=* | SCALES_xeno=* | SCALES_elaphe=*)
       printf -v "${a%%=*}" '%s' "${a#*=}" ;;
     *) echo "ninja.sh: unknown argument '$a' (expected VAR=value, see the header)" >&2; exit 1 ;;
   esac
@@ -90,7 +97,7 @@ rule bake
   deps = gcc
   description = bake \${target}
 rule bake_pack
-  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-bake --generate-snake --snake-detail $(esc "$SNAKE_DETAIL") --pack \$in -o \${target} --depfile \${target}.d \$q
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-bake --generate-snake --snake-detail $(esc "$SNAKE_DETAIL") --pack \$in --scales --scale-texels $(esc "$SCALE_TEXELS") \$scales -o \${target} --depfile \${target}.d \$q
   depfile = \${target}.d
   deps = gcc
   description = bake \${target}
@@ -108,6 +115,9 @@ rule play
 rule sky_scene
   command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake.glb|' \$in > \${outdir}/.\${name}-sky.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-sky.json.tmp.\$\$\$\$ \${target}
   description = sky_scene \${target}
+rule turntable_scene
+  command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake-\${name}.glb|' \$in > \${outdir}/.\${name}-turntable.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-turntable.json.tmp.\$\$\$\$ \${target}
+  description = turntable_scene \${target}
 rule sky
   command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$SIZE") --samples $(esc "$SKY_SAMPLES") -o \${target} \$q
   description = sky \${target}
@@ -117,7 +127,7 @@ rule play_sky
   deps = gcc
   description = play_sky \${target}
 rule turntable
-  command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$TURNTABLE_SIZE") --samples $(esc "$SKY_SAMPLES") --turntable $(esc "$TURNTABLE_FRAMES") --axis 0,0,1 -o \${target} \$q
+  command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$TURNTABLE_SIZE") --samples $(esc "$SKY_SAMPLES") --env-estimator $(esc "$TURNTABLE_ESTIMATOR") --turntable $(esc "$TURNTABLE_FRAMES") --axis 0,0,1 -o \${target} \$q
   description = turntable \${target}
 rule brdf
   command = rm -f \$tidy && $(esc "$EVAL") brdf \$in --light 60deg,0deg --size $(esc "$BRDF_SIZE") -o \${target} \$q
@@ -190,11 +200,19 @@ EOF
     echo "  tidy = $(esc "$OUT/.$m-play-sky.png").tmp.*"
     echo "build $o/snake-$m.glb: bake_pack $o/$m.ktx2 | $o/$m.response.ktx2 $(path "$BIN/sunbeam-bake")"
     echo "  target = $(esc "$OUT/snake-$m.glb")"
+    case $m in
+      xeno) echo "  scales = $(esc "$SCALES_xeno")" ;;
+      elaphe) echo "  scales = $(esc "$SCALES_elaphe")" ;;
+    esac
     echo "  tidy = $(esc "$OUT/.snake-$m.glb").tmp.*"
     sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png $o/$m-play-sky.png $o/$m-sky.png"
   done
   tm=$TURNTABLE_MATERIAL
-  echo "build $o/$tm-turntable.png: turntable $o/$tm-sky.json | $o/$tm.ktx2 $o/snake.glb $(path "$EVAL")"
+  echo "build $o/$tm-turntable.json: turntable_scene sky-scene.json.in"
+  echo "  target = $o/$tm-turntable.json"
+  echo "  name = $tm"
+  echo "  tidy = $(esc "$OUT/.$tm-turntable.json").tmp.*"
+  echo "build $o/$tm-turntable.png: turntable $o/$tm-turntable.json | $o/$tm.ktx2 $o/snake-$tm.glb $(path "$EVAL")"
   echo "  target = $(esc "$OUT/$tm-turntable.png")"
   echo "  tidy = $(esc "$OUT/.$tm-turntable.png").tmp.*"
   echo "build $o/sunbeam-es.frag: export_shader | $(path "$BIN/sunbeam-play")"
