@@ -2,7 +2,9 @@
 //! shading points (docs/LIGHTING.md "The first frame"): CIEDE2000 over random
 //! frames and views for several cell counts. Prints; asserts nothing.
 //!
-//! `cargo bench -p sunbeam-response --bench cells [-- PATCH]`
+//! `cargo bench -p sunbeam-response --bench cells [-- elaphe]`; `CELLS_CFG=TOP:DEPTH,..`
+//! picks the cell counts. Also prints how much of each environment's energy
+//! its brightest texels hold.
 
 use std::time::Instant;
 use sunbeam_common::rng::SplitMix64;

@@ -357,10 +357,10 @@ impl Cells {
             let g = masking.gain(wi, wr, skin) / wi[2] * inside;
             let omega = (std::f64::consts::TAU * c.spread * c.spread / wi[2]).max(1e-9);
             let ck = coeffs(world(wi), omega);
-            for bb in 0..3 {
-                for a in 0..3 {
+            for (bb, cb) in ck.iter().enumerate() {
+                for (a, x) in xyz.iter_mut().enumerate() {
                     let m = c.mass[k0][3 * bb + a] * (1.0 - f) + c.mass[k0 + 1][3 * bb + a] * f;
-                    xyz[a] += g * ck[bb] * m;
+                    *x += g * cb * m;
                 }
             }
         }
