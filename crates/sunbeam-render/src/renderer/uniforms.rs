@@ -344,12 +344,12 @@ mod layout_tests {
         check(
             "EnvGlobals",
             size_of::<EnvGlobals>(),
-            &f!(EnvGlobals; basis_to_rgb, sun_dir, sun_rgb, sun_t, sun_b, table_w, table_h, frame, on, has_sun, samples),
+            &f!(EnvGlobals; basis_to_rgb, sun_dir, sun_rgb, sun_t, sun_b, table_w, table_h, frame, on, has_sun, samples, estimator, chain_levels, irr_ior),
         );
         check(
             "EnvProposal",
             size_of::<EnvProposalU>(),
-            &f!(EnvProposalU; offsets, pw, ph, top, n_s, n_theta, n_rho, n_s_f, r0, rho_scale, on, has_sun),
+            &f!(EnvProposalU; offsets, pw, ph, top, n_s, n_theta, n_rho, n_s_f, r0, rho_scale, on, has_sun, n_cells),
         );
     }
 
