@@ -4,14 +4,21 @@
 // sunbeam_light's EnvMap::lookup: theta = acos(y) from +y, phi = atan2(z, x)).
 
 fn sb_env_texel(table: texture_2d<f32>, w: u32, h: u32, d: vec3<f32>) -> vec3<f32> {
+    let e = sb_env_equirect(d);
+    let i = min(u32(e.x * f32(w)), w - 1u);
+    let j = min(u32(e.y * f32(h)), h - 1u);
+    return textureLoad(table, vec2<u32>(i, j), 0).xyz;
+}
+
+// Equirectangular texture coordinates in [0, 1]^2 of world direction d:
+// (phi / 2 pi, theta / pi), theta from +y, phi = atan2(z, x) (also the
+// prefiltered chain's and the irradiance tables' coordinates).
+fn sb_env_equirect(d: vec3<f32>) -> vec2<f32> {
     let tau = 6.283185307179586;
-    let theta = acos(clamp(d.y, -1.0, 1.0));
     var phi = atan2(d.z, d.x);
     if (phi < 0.0) {
         phi = phi + tau;
     }
-    let i = min(u32(phi / tau * f32(w)), w - 1u);
-    let j = min(u32(theta / 3.141592653589793 * f32(h)), h - 1u);
-    return textureLoad(table, vec2<u32>(i, j), 0).xyz;
+    return vec2<f32>(phi / tau, acos(clamp(d.y, -1.0, 1.0)) / 3.141592653589793);
 }
 

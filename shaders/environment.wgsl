@@ -466,34 +466,18 @@ fn env_descend(wr: vec3<f32>, u: vec3<f32>, q: u32) -> EnvDraw {
 }
 
 // ---------------------------------------------------------------- the cells
-// Equirectangular coordinates of world direction d (theta from +y, phi =
-// atan2(z, x)), as sb_env_texel and sunbeam_light::prefilter.
-fn env_equirect(d: vec3<f32>) -> vec2<f32> {
-    var phi = atan2(d.z, d.x);
-    if (phi < 0.0) {
-        phi = phi + SB_TAU;
-    }
-    return vec2<f32>(phi / SB_TAU, acos(clamp(d.y, -1.0, 1.0)) / ENV_PI);
-}
-
 // The coefficients at d averaged over about omega steradians
 // (Prefiltered::lookup: the level whose texel's polar extent squared is omega).
 fn env_prefiltered(d: vec3<f32>, omega: f32) -> vec3<f32> {
     let texel = ENV_PI / f32(envg.table_h);
     let level = clamp(0.5 * log2(max(omega, 1e-30) / (texel * texel)), 0.0, f32(envg.chain_levels - 1u));
-    return textureSampleLevel(env_chain, env_smp, env_equirect(d), level).xyz;
+    return textureSampleLevel(env_chain, env_smp, sb_env_equirect(d), level).xyz;
 }
 
 // Cells refine near the horizon while their spread times this reaches it
 // (sunbeam_response::cells::REFINE).
 const ENV_REFINE: f32 = 2.0;
 
-fn env_erf(x: f32) -> f32 {
-    let a = abs(x);
-    let t = 1.0 / (1.0 + 0.3275911 * a);
-    let y = 1.0 - ((((1.061405429 * t - 1.453152027) * t + 1.421413741) * t - 0.284496736) * t + 0.254829592) * t * exp(-a * a);
-    return select(y, -y, x < 0.0);
-}
 
 // The diffraction part (XYZ) of the environment without the sun at local
 // view wr, frame (t, b, n): each cell's mass at its layer times G / cos and
@@ -527,7 +511,7 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
             }
             var inside = select(0.0, 1.0, dist > 0.0);
             if (spread > 0.0) {
-                inside = 0.5 * (1.0 + env_erf(dist / (1.4142135623730951 * spread)));
+                inside = 0.5 * (1.0 + sb_erf(dist / (1.4142135623730951 * spread)));
             }
             if (inside <= 0.0 || dist <= -0.5) {
                 continue;
@@ -565,7 +549,7 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
 // Irradiance (linear sRGB, without the sun) at world normal n from a table
 // over normals (Irradiance::at: bilinear, azimuth wraps).
 fn env_irradiance(tex: texture_2d<f32>, n: vec3<f32>) -> vec3<f32> {
-    return textureSampleLevel(tex, env_smp, env_equirect(n), 0.0).xyz;
+    return textureSampleLevel(tex, env_smp, sb_env_equirect(n), 0.0).xyz;
 }
 
 // ---------------------------------------------------------------- the estimator

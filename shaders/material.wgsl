@@ -68,6 +68,14 @@ fn sb_gain(wi: vec3<f32>, wr: vec3<f32>, skin: SbSkin) -> f32 {
     return f * (0.25 * s2 * s2) / (skin.norm * c * c * cr);
 }
 
+// erf by Abramowitz & Stegun 7.1.26 (sunbeam_optics::masking::erf).
+fn sb_erf(x: f32) -> f32 {
+    let a = abs(x);
+    let t = 1.0 / (1.0 + 0.3275911 * a);
+    let y = 1.0 - ((((1.061405429 * t - 1.453152027) * t + 1.421413741) * t - 0.284496736) * t + 0.254829592) * t * exp(-a * a);
+    return select(y, -y, x < 0.0);
+}
+
 // Smith's Lambda for Beckmann slopes with rms slopes `slope` (sunbeam_optics::masking::lambda).
 fn sb_smith_lambda(w: vec3<f32>, slope: vec2<f32>) -> f32 {
     // alpha_w^2 tan^2 = 2 (wx^2 sx^2 + wy^2 sy^2) / wz^2

@@ -111,16 +111,11 @@ impl Cells {
         assert_eq!(basis.len(), 3, "three basis maps");
         let g = basis[0].info.grid;
         let (nt, nr, ns) = (g.n_theta, g.n_rho, g.n_s);
-        let dt = std::f64::consts::TAU / nt as f64;
-        let r_cont = |rho: f64| (g.r0 * (rho * g.rho_scale()).sinh()).clamp(0.0, 2.0);
-        let last = (nr - 1) as f64;
         // Texels as the quadrature's: centre, area.
         let mut texels = Vec::new();
         let mut areas = vec![0.0; nr];
         for (j, area) in areas.iter_mut().enumerate() {
-            let r_lo = r_cont((j as f64 - 0.5).max(0.0) / last);
-            let r_hi = r_cont((j as f64 + 0.5).min(last) / last);
-            *area = dt * (r_hi * r_hi - r_lo * r_lo) / 2.0;
+            *area = g.texel_extent(j).2;
             let r = g.r_at(j);
             for i in 0..nt {
                 let mut y = 0.0;
@@ -331,7 +326,8 @@ impl Cells {
                 }
             }
             let inside = if c.spread > 0.0 {
-                0.5 * (1.0 + erf(dist / (std::f64::consts::SQRT_2 * c.spread)))
+                0.5 * (1.0
+                    + sunbeam_optics::masking::erf(dist / (std::f64::consts::SQRT_2 * c.spread)))
             } else {
                 f64::from(dist > 0.0)
             };
@@ -339,16 +335,10 @@ impl Cells {
                 continue;
             }
             // the centroid, pulled inside the disc when it is not
-            let d2 = {
-                let l2 = wxy[0] * wxy[0] + wxy[1] * wxy[1];
-                l2.min(0.999 * 0.999)
-            };
-            let scale = if wxy[0] * wxy[0] + wxy[1] * wxy[1] > d2 {
-                (d2 / (wxy[0] * wxy[0] + wxy[1] * wxy[1])).sqrt()
-            } else {
-                1.0
-            };
-            let wi = [wxy[0] * scale, wxy[1] * scale, (1.0 - d2).sqrt()];
+            let l = 1.0 - dist;
+            let k = if l > 0.999 { 0.999 / l } else { 1.0 };
+            let (wx, wy) = (wxy[0] * k, wxy[1] * k);
+            let wi = [wx, wy, (1.0 - wx * wx - wy * wy).max(0.0).sqrt()];
             let r = c.uv[0].hypot(c.uv[1]);
             let s = ((wi[2] + wr[2]) / (4.0 - r * r).max(1e-12).sqrt()).clamp(0.0, 1.0);
             let sc = s * (self.grid.n_s - 1) as f64;
@@ -366,17 +356,4 @@ impl Cells {
         }
         xyz
     }
-}
-
-/// erf to 1.5e-7 (Abramowitz and Stegun 7.1.26), as the shader's.
-pub fn erf(x: f64) -> f64 {
-    let s = x.signum();
-    let x = x.abs();
-    let t = 1.0 / (1.0 + 0.3275911 * x);
-    let y = 1.0
-        - (((((1.061405429 * t - 1.453152027) * t) + 1.421413741) * t - 0.284496736) * t
-            + 0.254829592)
-            * t
-            * (-x * x).exp();
-    s * y
 }

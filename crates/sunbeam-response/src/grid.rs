@@ -42,6 +42,18 @@ impl Grid {
         (self.r0 * (rho * self.rho_scale()).sinh()).min(2.0)
     }
 
+    /// Radii of the inner and outer edges of a texel of radial row `j`
+    /// (halfway to its neighbours' centres) and its area in `(u, v)`: the
+    /// texels the reference's quadrature sums and the cells cluster.
+    pub fn texel_extent(&self, j: usize) -> (f64, f64, f64) {
+        let last = (self.n_rho - 1) as f64;
+        let r = |rho: f64| (self.r0 * (rho * self.rho_scale()).sinh()).clamp(0.0, 2.0);
+        let r_lo = r((j as f64 - 0.5).max(0.0) / last);
+        let r_hi = r((j as f64 + 0.5).min(last) / last);
+        let dt = std::f64::consts::TAU / self.n_theta as f64;
+        (r_lo, r_hi, dt * (r_hi * r_hi - r_lo * r_lo) / 2.0)
+    }
+
     /// `s` of texel `k`.
     pub fn s_at(&self, k: usize) -> f64 {
         k as f64 / (self.n_s - 1) as f64

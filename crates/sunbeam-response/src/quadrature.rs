@@ -145,17 +145,14 @@ impl EnvQuadrature {
                 (c, s)
             })
             .collect();
-        let r_cont = |rho: f64| (grid.r0 * (rho * grid.rho_scale()).sinh()).clamp(0.0, 2.0);
-        let last = (grid.n_rho - 1) as f64;
         let mut rows: Vec<Row> = (0..grid.n_rho)
             .map(|j| {
-                let r_lo = r_cont((j as f64 - 0.5).max(0.0) / last);
-                let r_hi = r_cont((j as f64 + 0.5).min(last) / last);
+                let (r_lo, r_hi, area) = grid.texel_extent(j);
                 Row {
                     r: grid.r_at(j),
                     r_lo,
                     r_hi,
-                    area: dt * (r_hi * r_hi - r_lo * r_lo) / 2.0,
+                    area,
                     extent: (r_hi * dt).max(r_hi - r_lo),
                     kept: vec![false; nt],
                 }
