@@ -598,7 +598,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     let gr = env_grid();
     var xyz = vec3<f32>(0.0);
     if (envg.estimator == 0u) {
-        xyz = env_cells(t, b, n, wr);
+        xyz = env_cells(t, b, n, wr) + env_hotspots(t, b, n, wr);
     } else {
     // The first frame after a reset (every frame while the view moves) is the
     // preview: one direction uniform over the hemisphere, no descent (the

@@ -23,6 +23,7 @@
 
 pub mod daylight;
 pub mod environment;
+pub mod hotspots;
 pub mod io;
 pub mod irradiance;
 pub mod prefilter;

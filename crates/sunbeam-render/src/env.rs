@@ -24,6 +24,8 @@ pub const DEFAULT_ENV_SAMPLES: u32 = 1;
 pub const DEFAULT_ENV_CELLS: u64 = sunbeam_response::cells::DEFAULT_TOP as u64;
 /// Levels kept below the top cut for views whose horizon a cell reaches.
 pub const ENV_CELLS_DEPTH: usize = sunbeam_response::cells::DEFAULT_DEPTH;
+/// The environment's hot spots as at most this many lights (`--env-hot-spots`).
+pub const DEFAULT_ENV_HOT_SPOTS: usize = sunbeam_light::hotspots::DEFAULT_MAX_LIGHTS;
 
 /// shaders/environment.wgsl `EnvGlobals`.
 #[repr(C)]
@@ -147,6 +149,8 @@ pub(crate) struct EnvScene {
     sampler: wgpu::Sampler,
     dummy_map: wgpu::TextureView,
     dummy_buf: wgpu::Buffer,
+    /// The hot spots as lights (shaders/env_hotspots.wgsl `env_lights`).
+    lights: wgpu::Buffer,
     pub(crate) env: Option<Arc<Environment>>,
 }
 
@@ -157,6 +161,7 @@ impl EnvScene {
         samples: u32,
         estimator: EnvEstimator,
         ior: f64,
+        hot_spots: usize,
     ) -> EnvScene {
         let device = &gpu.device;
         let layout = layout(device);
@@ -196,11 +201,40 @@ impl EnvScene {
         // The prefiltered chain and the irradiance tables (the first-frame
         // estimator's; one texel stand-ins for Monte Carlo).
         let cells = estimator == EnvEstimator::Cells && env.is_some();
+        // The first-frame estimator: the table's hot spots as lights, the rest
+        // (the residual) prefiltered for the cells.
+        let mut light_data = vec![[0.0f32; 4]; 2];
         let chain_levels = if cells {
-            sunbeam_light::prefilter::Prefiltered::new(tw, th, tdata.clone()).levels
+            let split = sunbeam_light::hotspots::split(
+                tw,
+                th,
+                &tdata,
+                sunbeam_light::hotspots::SplitOptions {
+                    max_lights: hot_spots,
+                    ..Default::default()
+                },
+            );
+            if !split.lights.is_empty() {
+                log::info!(
+                    "{} hot spots as lights ({:.1} % of the environment's energy)",
+                    split.lights.len(),
+                    100.0 * split.share
+                );
+                light_data = split
+                    .lights
+                    .iter()
+                    .flat_map(|l| [v4(l.dir, l.spread), v4(l.power, 0.0)])
+                    .collect();
+            }
+            sunbeam_light::prefilter::Prefiltered::new(tw, th, split.residual).levels
         } else {
             vec![(1, 1, vec![0.0f32; 4])]
         };
+        let lights = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("environment hot spots"),
+            contents: bytemuck::cast_slice(&light_data),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         values.chain_levels = chain_levels.len() as u32;
         let chain = texture_2d_f16(gpu, "prefiltered environment", &chain_levels);
         let irradiance = match (&env, cells) {
@@ -271,6 +305,7 @@ impl EnvScene {
             sampler,
             dummy_map: crate::response::texture_3d(gpu, [1, 1, 1], &[0; 4]),
             dummy_buf,
+            lights,
             env,
         }
     }
@@ -359,6 +394,10 @@ impl EnvScene {
                 wgpu::BindGroupEntry {
                     binding: 12,
                     resource: cells.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 13,
+                    resource: self.lights.as_entire_binding(),
                 },
             ],
         })
@@ -528,6 +567,16 @@ fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             plain_2d(11),
             wgpu::BindGroupLayoutEntry {
                 binding: 12,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 13,
                 visibility: wgpu::ShaderStages::FRAGMENT,
                 ty: wgpu::BindingType::Buffer {
                     ty: wgpu::BufferBindingType::Storage { read_only: true },

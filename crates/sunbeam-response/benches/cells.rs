@@ -3,8 +3,9 @@
 //! frames and views for several cell counts. Prints; asserts nothing.
 //!
 //! `cargo bench -p sunbeam-response --bench cells [-- elaphe]`; `CELLS_CFG=TOP:DEPTH,..`
-//! picks the cell counts. Also prints how much of each environment's energy
-//! its brightest texels hold.
+//! picks the cell counts; `HOT=THRESHOLD:MAX` pulls the hot spots out as lights
+//! first (`sunbeam_light::hotspots`, through `sunbeam_response::hotspots`). Also prints how much of each environment's energy its
+//! brightest texels hold.
 
 use std::time::Instant;
 use sunbeam_common::rng::SplitMix64;
@@ -85,6 +86,26 @@ fn main() {
                 }
             }
         }
+        let hot: Option<sunbeam_light::hotspots::SplitOptions> =
+            std::env::var("HOT").ok().map(|v| {
+                let mut it = v.split(':');
+                sunbeam_light::hotspots::SplitOptions {
+                    threshold: it.next().unwrap().parse().unwrap(),
+                    max_lights: it.next().unwrap_or("16").parse().unwrap(),
+                }
+            });
+        let (table, lights) = match hot {
+            Some(o) => {
+                let s = sunbeam_light::hotspots::split(w, h, &table, o);
+                eprintln!(
+                    "  hot spots: {} lights, {:.1}% of the energy",
+                    s.lights.len(),
+                    100.0 * s.share
+                );
+                (s.residual, s.lights)
+            }
+            None => (table, Vec::new()),
+        };
         let pre = Prefiltered::new(w, h, table);
         let t_pre = t0.elapsed();
         eprintln!(
@@ -174,6 +195,18 @@ fn main() {
                     }
                 };
                 let mut x = cells.estimate(*f, *wr, Masking::Off, skin, &coeffs);
+                // the hot spots: each a small light through the basis maps
+                let hx = sunbeam_response::hotspots::estimate(
+                    &lights,
+                    &er.basis,
+                    *f,
+                    *wr,
+                    Masking::Off,
+                    skin,
+                );
+                for a in 0..3 {
+                    x[a] += hx[a];
+                }
                 // the sun as the player: its map at the disc's point
                 if let (Some(sky), Some(es)) = (env.sun(), &er.sun) {
                     let (d, _) = sky.sample_sun(sun_u[0], sun_u[1]).unwrap();
@@ -190,6 +223,15 @@ fn main() {
                 }
                 let sc = |v: [f64; 3]| v.map(|c| (c / white).max(0.0));
                 de.push(colour::ciede2000_xyz(sc(x), sc(*r)));
+                if std::env::var("WORST").is_ok() && *de.last().unwrap() > 8.0 {
+                    eprintln!(
+                        "    dE {:.1} cos_r {:.3} est {:?} ref {:?}",
+                        de.last().unwrap(),
+                        wr[2],
+                        sc(x).map(|v| (v * 1000.0).round() / 1000.0),
+                        sc(*r).map(|v| (v * 1000.0).round() / 1000.0)
+                    );
+                }
                 let bin = ((wr[2] * 5.0) as usize).min(4);
                 bins[bin].push(*de.last().unwrap());
             }

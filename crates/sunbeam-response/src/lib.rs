@@ -22,6 +22,7 @@ pub mod env;
 pub mod env_file;
 pub mod exr;
 pub mod grid;
+pub mod hotspots;
 pub mod ktx2;
 pub mod nvr;
 pub mod proposal;

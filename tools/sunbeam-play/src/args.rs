@@ -78,6 +78,12 @@ pub(crate) struct Cli {
     /// "The first frame").
     #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_CELLS, value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub(crate) env_cells: u64,
+    /// Environment scenes, `--env-estimator cells`: the map's hot spots (its
+    /// lamps, softboxes) as at most this many small lights through the maps,
+    /// the rest for the cells (0..=256; 0: none; docs/LIGHTING.md "The first
+    /// frame"). The engines' export does not carry them yet.
+    #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_HOT_SPOTS as u64, value_parser = clap::value_parser!(u64).range(0..=256))]
+    pub(crate) env_hot_spots: u64,
     /// Wavelength samples of the default mode.
     #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES)]
     pub(crate) lambda_samples: usize,

@@ -104,6 +104,7 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
         term_tolerance: cli.term_tolerance,
         msaa,
         footprint: !cli.no_footprint,
+        env_hot_spots: cli.env_hot_spots as usize,
         ..Default::default()
     })
 }

@@ -42,8 +42,9 @@ use wgpu::util::DeviceExt;
 /// Fresnel, G, masking, the diffuse base's share, the frame), the response-map
 /// material (shaders/response_map.wgsl; both also what `--export-shader`
 /// translates), the scale maps' frame (shaders/scales.wgsl), the player's
-/// shading (shaders/diffraction.wgsl) and the environment's estimator
-/// (shaders/environment.wgsl).
+/// shading (shaders/diffraction.wgsl) and the environment's estimators
+/// (shaders/environment.wgsl, with the hot spots' lights in
+/// shaders/env_hotspots.wgsl).
 pub const SHADER: &str = concat!(
     include_str!("../../../../shaders/material.wgsl"),
     include_str!("../../../../shaders/scales.wgsl"),
@@ -51,7 +52,8 @@ pub const SHADER: &str = concat!(
     include_str!("../../../../shaders/env_table.wgsl"),
     include_str!("../../../../shaders/response_map.wgsl"),
     include_str!("../../../../shaders/diffraction.wgsl"),
-    include_str!("../../../../shaders/environment.wgsl")
+    include_str!("../../../../shaders/environment.wgsl"),
+    include_str!("../../../../shaders/env_hotspots.wgsl")
 );
 
 /// shaders/material.wgsl alone: the skin's functions every shader calls
@@ -131,6 +133,9 @@ pub struct Settings {
     /// Environment, cells estimator: the top cut's cells and the levels kept
     /// below it (sunbeam_response::cells).
     pub env_cells: (usize, usize),
+    /// Environment, cells estimator: the map's hot spots pulled out as at most
+    /// this many lights (sunbeam_light::hotspots; 0: none).
+    pub env_hot_spots: usize,
 }
 
 /// Default wavelength sample count (docs/PLAY.md: chosen by measurement).
@@ -153,6 +158,7 @@ impl Default for Settings {
                 sunbeam_response::cells::DEFAULT_TOP,
                 sunbeam_response::cells::DEFAULT_DEPTH,
             ),
+            env_hot_spots: crate::env::DEFAULT_ENV_HOT_SPOTS,
         }
     }
 }
@@ -255,6 +261,7 @@ impl Renderer {
             settings.env_samples,
             settings.env_estimator,
             skin_ior,
+            settings.env_hot_spots,
         );
         let mut notes = Vec::new();
         let mut env_maps: environment::BuiltMaps = Vec::new();
@@ -498,6 +505,7 @@ impl Renderer {
                         1,
                         crate::env::EnvEstimator::MonteCarlo,
                         1.5,
+                        0,
                     );
                     &own
                 };
