@@ -42,8 +42,9 @@ use wgpu::util::DeviceExt;
 /// Fresnel, G, masking, the diffuse base's share, the frame), the response-map
 /// material (shaders/response_map.wgsl; both also what `--export-shader`
 /// translates), the scale maps' frame (shaders/scales.wgsl), the player's
-/// shading (shaders/diffraction.wgsl) and the environment's estimator
-/// (shaders/environment.wgsl).
+/// shading (shaders/diffraction.wgsl) and the environment's estimators
+/// (shaders/environment.wgsl, and shaders/env_cells.wgsl: the cells, shared
+/// with the export).
 pub const SHADER: &str = concat!(
     include_str!("../../../../shaders/material.wgsl"),
     include_str!("../../../../shaders/scales.wgsl"),
@@ -51,7 +52,8 @@ pub const SHADER: &str = concat!(
     include_str!("../../../../shaders/env_table.wgsl"),
     include_str!("../../../../shaders/response_map.wgsl"),
     include_str!("../../../../shaders/diffraction.wgsl"),
-    include_str!("../../../../shaders/environment.wgsl")
+    include_str!("../../../../shaders/environment.wgsl"),
+    include_str!("../../../../shaders/env_cells.wgsl")
 );
 
 /// shaders/material.wgsl alone: the skin's functions every shader calls
