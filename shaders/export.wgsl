@@ -6,13 +6,13 @@
 // Bindings (group 0): 0 the material's numbers, 1 the response map (3D texture,
 // RGBA16F from NAME.response.ktx2), 2 its sampler (linear; repeat in x,
 // clamp-to-edge in y and z).
-// Bindings 3 to 8 are the environment's (shaders/export_env.wgsl).
+// Bindings 3 to 9 are the environment's (shaders/export_env.wgsl).
 // Call sunbeam_shade(t, b, n, wi, wr) per light: linear sRGB for a light of
 // intensity 1 (multiply by the light's colour and intensity, sum over lights,
 // then expose and tone-map as the engine does); sb_frame(normal, orientation)
 // gives (t, b, n) from the interpolated attributes as the player does;
-// sunbeam_shade_environment(t, b, n, wr) adds an environment (without its
-// sun, which is a light through sunbeam_shade_sun). The entry point
+// sunbeam_shade_environment(t, b, n, wr) adds an environment without its
+// sun, sunbeam_shade_sun(t, b, n, wi, wr) the sky's sun (shaders/export_env.wgsl). The entry point
 // sunbeam_fragment shows the calls with the attributes and the two
 // directions as varyings.
 
@@ -50,20 +50,6 @@ fn sb_xyz_to_linear_srgb(c: vec3<f32>) -> vec3<f32> {
 // patch's +x), n: the normal, b = n x t; wi towards the light, wr towards the
 // viewer; all unit, any common space (world space in a forward pass).
 fn sunbeam_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
-    return sb_shade_light(t, b, n, wi, wr, 1.0);
-}
-
-// An environment's sun (a small disc of radiance L and solid angle Omega,
-// called with its colour Omega L as the light's): as sunbeam_shade, but the
-// base lit by the disc's irradiance, dw * base * Omega L cos (1 - F) / pi,
-// where a scene light of intensity I lights it as pi I (docs/SCENE.md
-// "lights"); the diffraction part is the same (docs/ENGINES.md "Environment").
-fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
-    return sb_shade_light(t, b, n, wi, wr, 0.3183098861837907);
-}
-
-// sunbeam_shade with the Lambert part scaled by `lambert`.
-fn sb_shade_light(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>, lambert: f32) -> vec3<f32> {
     let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
     let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
     let gr = SbGrid(sunbeam.grid.xyz, sunbeam.warp.x, sunbeam.warp.y);
@@ -75,7 +61,7 @@ fn sb_shade_light(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: v
         diff = sb_xyz_to_linear_srgb(xyz);
     }
     let cos_i = max(wi_l.z, 0.0);
-    return lambert * dw * sunbeam.base.rgb * cos_i * sb_base_transmission(cos_i, skin.ior, true) + (1.0 - dw) * diff;
+    return dw * sunbeam.base.rgb * cos_i * sb_base_transmission(cos_i, skin.ior, true) + (1.0 - dw) * diff;
 }
 
 struct SunbeamVaryings {
@@ -90,6 +76,7 @@ struct SunbeamVaryings {
 fn sunbeam_fragment(v: SunbeamVaryings) -> @location(0) vec4<f32> {
     let f = sb_frame(v.normal, v.orientation);
     let wr = normalize(v.wr);
-    let c = sunbeam_shade(f[0], f[1], f[2], normalize(v.wi), wr) + sunbeam_shade_environment(f[0], f[1], f[2], wr);
+    let c = sunbeam_shade(f[0], f[1], f[2], normalize(v.wi), wr) + sunbeam_shade_environment(f[0], f[1], f[2], wr)
+        + sunbeam_shade_sun(f[0], f[1], f[2], sunbeam_env.sun_dir.xyz, wr);
     return vec4<f32>(c, 1.0);
 }

@@ -13,13 +13,23 @@
 //   6 env_smp: linear, linear between mip levels, repeat in u, clamp in v;
 //   7 env_cells_tex: the cells, 2D R32UI, float i of Cells::gpu_data (its
 //     bits) at texel (i % width, i / width) (cells.ktx2);
-//   8 sunbeam_env: the numbers (environment.json).
+//   8 sunbeam_env: the numbers (environment.json);
+//   9 env_sun_map: the sky's sun, Omega_sun E_sun over directions: a
+//     response map of the sun's spectrum (sun-I.ktx2, read like the material's
+//     map, with its sampler 2), for sunbeam_shade_sun.
 
 struct SunbeamEnvironment {
     // x: cells of the top cut (cells.n_top), y: the maps' s layers
     // (cells.n_s), z: the chain's level-0 height (chain.height), w: its
     // levels (chain.levels)
     counts: vec4<f32>,
+    // xyz: towards the sun's centre (world, unit); w: 1 when the sky's sun
+    // is up (sun.direction), else 0
+    sun_dir: vec4<f32>,
+    // rgb: the sun's Omega L, linear sRGB (sun.rgb); a: unused
+    sun_rgb: vec4<f32>,
+    // the sun map's grid: n_theta, n_rho, n_s, r0 (meshes[].sun_grid)
+    sun_grid: vec4<f32>,
 };
 
 @group(0) @binding(3) var env_chain: texture_2d<f32>;
@@ -28,6 +38,7 @@ struct SunbeamEnvironment {
 @group(0) @binding(6) var env_smp: sampler;
 @group(0) @binding(7) var env_cells_tex: texture_2d<u32>;
 @group(0) @binding(8) var<uniform> sunbeam_env: SunbeamEnvironment;
+@group(0) @binding(9) var env_sun_map: texture_3d<f32>;
 
 fn env_cell_u32(i: u32) -> u32 {
     let w = u32(textureDimensions(env_cells_tex, 0).x);
@@ -88,3 +99,31 @@ fn sunbeam_shade_environment(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<
     return base + (1.0 - dw) * sb_xyz_to_linear_srgb(env_cells(t, b, n, wr_l));
 }
 
+
+// The sky's sun from direction wi (towards a point of its disc, e.g. its
+// centre sun_dir; an engine's directional light, with its shadows), linear
+// sRGB towards wr: as the player's sun, (1 - dw) G G2 Omega E_sun read from
+// the sun's own map (the sun's spectrum: a white light tinted by its RGB
+// would not do, a diffraction colour is nearly monochromatic) plus the base
+// lit by the disc, dw * base * Omega L cos (1 - F) / pi. 0 without a sun.
+fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    if (sunbeam_env.sun_dir.w <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
+    let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
+    let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw);
+    let dw = sunbeam.warp.z;
+    var diff = vec3<f32>(0.0);
+    if (wi_l.z > 0.0 && wr_l.z > 0.0 && sunbeam_env.sun_grid.x > 0.0) {
+        let r0 = sunbeam_env.sun_grid.w;
+        let gr = SbGrid(sunbeam_env.sun_grid.xyz, r0, asinh(2.0 / r0));
+        let c = sb_resp_coords(-wi_l - wr_l, gr);
+        let cc = vec3<f32>(c.x, clamp(c.y, 0.0, gr.n.y - 1.0), clamp(c.z, 0.0, gr.n.z - 1.0));
+        let e = textureSampleLevel(env_sun_map, resp_smp, (cc + 0.5) / gr.n, 0.0).xyz;
+        diff = sb_xyz_to_linear_srgb(e * sb_gain(wi_l, wr_l, skin) * sb_masking(wi_l, wr_l, skin.slope));
+    }
+    let cos_i = max(wi_l.z, 0.0);
+    let lit = sunbeam_env.sun_rgb.rgb * cos_i * sb_base_transmission(cos_i, skin.ior, true) / ENV_PI;
+    return dw * sunbeam.base.rgb * lit + (1.0 - dw) * diff;
+}

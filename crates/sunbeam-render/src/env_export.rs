@@ -12,7 +12,8 @@
 //!   skin of the first mesh with a pack and plain, 2D RGBA16F;
 //! - `cells-I.ktx2` for each mesh I with a pack (one per distinct pack, the
 //!   others naming the same file): Cells::gpu_data as 2D R32_UINT (the floats'
-//!   bits), [`CELLS_WIDTH`] wide;
+//!   bits), [`CELLS_WIDTH`] wide; with the sky's sun up, `sun-I.ktx2`: the
+//!   pack's `Omega_sun E_sun` map (a response map, RGBA16F 3D);
 //! - `environment.json`: what the uniforms need (docs/ENGINES.md).
 //!
 //! f16, as the player uploads them, so an engine reads the player's numbers.
@@ -132,6 +133,16 @@ pub fn export(
         )?;
         let mut v = info;
         v["file"] = file.into();
+        // The sky's sun through its own map (the sun's spectrum), as the player's.
+        if let Some(sun) = &er.sun {
+            let g = &sun.info.grid;
+            v["sun"] = put(
+                &format!("sun-{mi}.ktx2"),
+                sunbeam_response::ktx2::encode(sun),
+            )?
+            .into();
+            v["sun_grid"] = serde_json::json!([g.n_theta, g.n_rho, g.n_s, g.r0]);
+        }
         done.push((key, v.clone()));
         v["mesh"] = mi.into();
         meshes.push(v);

@@ -104,10 +104,7 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
         term_tolerance: cli.term_tolerance,
         msaa,
         footprint: !cli.no_footprint,
-        env_cells: (
-            cli.env_cells as usize,
-            sunbeam_render::env::ENV_CELLS_DEPTH,
-        ),
+        env_cells: (cli.env_cells as usize, sunbeam_render::env::ENV_CELLS_DEPTH),
         ..Default::default()
     })
 }
@@ -335,7 +332,12 @@ fn export_shader(lang: sunbeam_render::export::Lang, cli: &Cli) -> Result<()> {
 
 /// `SCENE.json --export-environment DIR`: the environment's files for engines
 /// (sunbeam_render::env_export, docs/ENGINES.md "Environment").
-fn export_environment(scene: &Scene, st: &Settings, dir: &std::path::Path, quiet: bool) -> Result<()> {
+fn export_environment(
+    scene: &Scene,
+    st: &Settings,
+    dir: &std::path::Path,
+    quiet: bool,
+) -> Result<()> {
     let prepared =
         sunbeam_frame::prepare_with(scene, &sunbeam_render::response::load_pack_for_environment)?;
     if let Some((line, _)) = sunbeam_frame::environment_clamped_warning(&prepared) {

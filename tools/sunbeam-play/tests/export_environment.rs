@@ -136,7 +136,13 @@ fn writes_the_players_data_deterministically() {
     let cells = std::fs::read(a.join("cells-0.ktx2")).unwrap();
     let (fmt, w, h, levels) = ktx2_head(&cells);
     assert_eq!(fmt, 98, "R32_UINT");
-    assert_eq!((w as u64, h as u64), (meshes[0]["width"].as_u64().unwrap(), meshes[0]["height"].as_u64().unwrap()));
+    assert_eq!(
+        (w as u64, h as u64),
+        (
+            meshes[0]["width"].as_u64().unwrap(),
+            meshes[0]["height"].as_u64().unwrap()
+        )
+    );
     let (off, len) = levels[0];
     let words: Vec<u32> = cells[off..off + len]
         .chunks_exact(4)
