@@ -106,7 +106,8 @@ fn writes_the_players_data_deterministically() {
             "chain.ktx2",
             "environment.json",
             "irradiance-skin.ktx2",
-            "irradiance.ktx2"
+            "irradiance.ktx2",
+            "sun-0.ktx2"
         ]
     );
     for n in &names {
@@ -125,9 +126,15 @@ fn writes_the_players_data_deterministically() {
     for (m, (_, len)) in levels.iter().enumerate() {
         assert_eq!(*len, (512 >> m) * (256 >> m) * 8, "level {m}");
     }
-    // The sky's sun is a light of its own; the skin's index is the first mesh's.
+    // The sky's sun: its colour for the base, its spectral map (a response
+    // map on the cells' grid) for the diffraction; the skin's index is the
+    // first mesh's.
     assert_eq!(json["irradiance"]["ior"], 1.4);
     assert!(json["sun"]["rgb"][1].as_f64().unwrap() > 0.0, "{json}");
+    let sun = std::fs::read(a.join("sun-0.ktx2")).unwrap();
+    let (fmt, w, _, _) = ktx2_head(&sun);
+    assert_eq!(fmt, 97);
+    assert_eq!(json["meshes"][0]["sun_grid"][0], w);
     // One cells file for the pack both meshes share; 32 cells of the pack's layers.
     let meshes = json["meshes"].as_array().unwrap();
     assert_eq!(meshes.len(), 2);
