@@ -399,3 +399,76 @@ fn threejs_renders_a_sky_lit_sphere_like_the_reference() {
 /// reference, the player's cells first frame 2.44, three.js against the
 /// player 1.53; plus 25 %. The issue's goal is 2: the cells' own error.
 const SKY_P99: f64 = 2.9;
+
+/// A real HDR image (../shared/data/hdri/studio.exr): render.mjs against the
+/// reference and against the player's cells frame (the same functions and
+/// data: they must agree, whatever the cells' own error under this map), and
+/// `"background": "environment"`: a far, small sphere in front of the map,
+/// so that the background decides the p99.
+#[test]
+fn threejs_renders_an_hdr_image_and_its_background() {
+    let d = scratch("threejs-hdri");
+    let Some(render) = example(&d) else { return };
+    let Some(map) = testdata::shared_file("hdri/studio.exr") else {
+        return;
+    };
+    ridge_pack(&d, "ridges", "256", "20nm");
+    let scene = |eye: &str, background: &str| {
+        format!(
+            r#"{{ "camera": {{ "eye": {eye}, "target": [0, 0, 0], "fov_y_deg": 35 }},
+  "meshes": [ {{ "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1 }} ],
+  "environment": {{ "map": "{}", "rotation_deg": 30 }},{background}
+  "exposure": 4.64, "size": [40, 40] }}"#,
+            map.display()
+        )
+    };
+    let studio = scene("[0, 0.25, 1.2]", "");
+    let c = measure(&render, &d, &studio, &studio, "studio");
+    assert!(c.p99 < STUDIO_P99, "three.js under studio.exr: {c}");
+    let far = scene("[0, 0.25, 20]", "\n  \"background\": \"environment\",");
+    let c = measure(&render, &d, &far, &far, "background");
+    assert!(c.p99 < BACKGROUND_P99, "background: {c}");
+    // The player's cells frame of both scenes: the same functions and data.
+    if gpu::gpu().is_some() {
+        for (name, bound) in [("studio", SKY_P99), ("background", BACKGROUND_PLAYER_P99)] {
+            let o = run_ok(
+                Command::new(tool("sunbeam-play"))
+                    .arg(d.join(format!("{name}.json")))
+                    .args([
+                        "--headless",
+                        "--env-estimator",
+                        "cells",
+                        "--supersample",
+                        "4",
+                        "--json",
+                        "-q",
+                        "-o",
+                    ])
+                    .arg(d.join(format!("{name}-player.exr")))
+                    .arg("--compare")
+                    .arg(d.join(format!("{name}-ref.exr"))),
+            );
+            let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            eprintln!("player cells, {name}, first frame: {}", r["ciede2000"]);
+            let p = LinearImage::read_exr(&d.join(format!("{name}-player.exr"))).unwrap();
+            let t = LinearImage::read_exr(&d.join(format!("{name}.exr"))).unwrap();
+            let pt = compare_linear(&t, &p).unwrap();
+            eprintln!("three.js vs player, {name}: {pt}");
+            assert!(pt.p99 < bound, "three.js vs player cells, {name}: {pt}");
+        }
+    }
+}
+
+/// Bounds of [`threejs_renders_an_hdr_image_and_its_background`], measured
+/// plus 25 % (docs/ENGINES.md "Environment", 2026-11-26): under studio.exr
+/// the cells are far from the reference, p99 37.1 (the player's 37.4: their
+/// known limit, the map's softboxes); the background p99 15.5 (the
+/// player's own background pass 13.9: the map's sharp edges sampled by 16
+/// rays per pixel in each).
+const STUDIO_P99: f64 = 46.0;
+const BACKGROUND_P99: f64 = 19.5;
+/// three.js against the player's frame with the background: mean 0.29, p99
+/// 4.17, max 34: a few pixels on the map's sharp edges differ (not traced:
+/// the nearest texel of f16 level 0 of the chain against the player's f32
+/// table, or the sub-pixel positions), plus 25 %.
+const BACKGROUND_PLAYER_P99: f64 = 5.2;
