@@ -480,6 +480,10 @@ fn env_cells_top() -> u32 {
     return envp.n_cells;
 }
 
+fn env_cells_nodes() -> u32 {
+    return arrayLength(&cells) / (ENV_CELL_HEADER + 9u * envp.n_s);
+}
+
 fn env_cells_layers() -> u32 {
     return envp.n_s;
 }

@@ -19,10 +19,12 @@
 //     map, with its sampler 2), for sunbeam_shade_sun.
 
 struct SunbeamEnvironment {
-    // x: cells of the top cut (cells.n_top), y: the maps' s layers
-    // (cells.n_s), z: the chain's level-0 height (chain.height), w: its
-    // levels (chain.levels)
-    counts: vec4<f32>,
+    // the mesh's cells: x the top cut (meshes[].n_top; 0: none), y the maps'
+    // s layers (n_s), z every node (nodes); w unused
+    cells: vec4<f32>,
+    // x: the chain's level-0 height (chain.height), y: its levels
+    // (chain.levels); zw unused
+    chain: vec4<f32>,
     // xyz: towards the sun's centre (world, unit); w: 1 when the sky's sun
     // is up (sun.direction), else 0
     sun_dir: vec4<f32>,
@@ -50,11 +52,15 @@ fn env_cell_f32(i: u32) -> f32 {
 }
 
 fn env_cells_top() -> u32 {
-    return u32(sunbeam_env.counts.x);
+    return u32(sunbeam_env.cells.x);
+}
+
+fn env_cells_nodes() -> u32 {
+    return u32(sunbeam_env.cells.z);
 }
 
 fn env_cells_layers() -> u32 {
-    return u32(sunbeam_env.counts.y);
+    return u32(sunbeam_env.cells.y);
 }
 
 fn env_cells_gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
@@ -62,11 +68,11 @@ fn env_cells_gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
 }
 
 fn env_chain_height() -> u32 {
-    return u32(sunbeam_env.counts.z);
+    return u32(sunbeam_env.chain.x);
 }
 
 fn env_chain_levels() -> u32 {
-    return u32(sunbeam_env.counts.w);
+    return u32(sunbeam_env.chain.y);
 }
 
 fn env_chain_read(uv: vec2<f32>, level: f32) -> vec3<f32> {

@@ -4,10 +4,13 @@
 // The shading code is not a port: it is the GLSL ES 3.00 that
 // `sunbeam-play --export-shader glsl-es` writes from the player's own WGSL
 // (shaders/material.wgsl: the frame, exact Fresnel, G, Smith masking, the
-// diffuse base's share; shaders/response_map.wgsl: the map), adapted here only
-// in its declarations (a plain struct uniform instead of a uniform block, our
-// varyings and light loop instead of its demo entry point). docs/ENGINES.md
-// documents the interface.
+// diffuse base's share; shaders/response_map.wgsl: the map; and the
+// environment: shaders/env_cells.wgsl, the player's first-frame cells, with
+// shaders/export_env.wgsl), adapted here only in its declarations (plain
+// struct uniforms instead of uniform blocks, our varyings and light loop
+// instead of its demo entry point). docs/ENGINES.md documents the interface.
+// An environment comes as the files of `sunbeam-play SCENE
+// --export-environment DIR` (parseEnvironment).
 //
 // The response map (NAME.response.ktx2, docs/PACK_FORMAT.md "Response map") is
 // read with ktx-parse (shipped with three) into a Data3DTexture: RGBA half
@@ -128,7 +131,7 @@ export function parseEnvironment({ json, chain, irradianceSkin, irradiance, cell
     if (!m) return null;
     const sun = m.sun ? sunMaps[m.sun] : null;
     if (m.sun && !sun) throw new Error(`environment: ${m.sun} not given`);
-    return { texture: out.cells[m.file], nTop: m.n_top, nS: m.n_s, sun, sunGrid: m.sun_grid };
+    return { texture: out.cells[m.file], nTop: m.n_top, nS: m.n_s, nodes: m.nodes, sun, sunGrid: m.sun_grid };
   };
   return out;
 }
@@ -331,7 +334,8 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
       _group_0_binding_9_fs: { value: envCells?.sun ? envCells.sun.texture : placeholder },
       _group_0_binding_8_fs: {
         value: {
-          counts: new THREE.Vector4(envCells ? envCells.nTop : 0, envCells ? envCells.nS : 2, env ? env.json.chain.height : 1, env ? env.json.chain.levels : 1),
+          cells: new THREE.Vector4(envCells ? envCells.nTop : 0, envCells ? envCells.nS : 2, envCells ? envCells.nodes : 0, 0),
+          chain: new THREE.Vector4(env ? env.json.chain.height : 1, env ? env.json.chain.levels : 1, 0, 0),
           sun_dir: sun ? new THREE.Vector4(...sun.direction, 1) : new THREE.Vector4(),
           sun_rgb: sun ? new THREE.Vector4(...sun.rgb, 0) : new THREE.Vector4(),
           // a mesh without its sun map: n_theta 0 (no diffraction from the sun)

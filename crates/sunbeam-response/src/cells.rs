@@ -50,7 +50,9 @@ pub const DEFAULT_TOP: usize = 256;
 /// Levels below the top cut kept for views whose horizon a cell reaches.
 pub const DEFAULT_DEPTH: usize = 4;
 /// Floats per node in [`Cells::gpu_data`] before its layers' masses.
-pub const GPU_HEADER: usize = 4;
+pub const GPU_HEADER: usize = 5;
+/// "No node" in [`Cells::gpu_data`]'s links.
+pub const GPU_NONE: u32 = u32::MAX;
 
 /// One node of the cells' tree.
 #[derive(Debug, Clone, PartialEq)]
@@ -276,19 +278,40 @@ impl Cells {
     }
 
     /// The nodes for the shader (shaders/environment.wgsl `env_cells`): per
-    /// node `[u, v, spread, first child (u32 bits; u32::MAX for a leaf)]`,
-    /// then `n_s` layers of 9 masses (XYZ of `E_0, E_1, E_2`); the second
-    /// child follows the first.
+    /// node `[u, v, spread, first child, next]` (links as u32 bits,
+    /// [`GPU_NONE`] for none), then `n_s` layers of 9 masses (XYZ of `E_0,
+    /// E_1, E_2`); the second child follows the first.
+    ///
+    /// `next` threads the tree: the node a depth-first walk visits after this
+    /// one and its subtree (the next top cell, or the sibling, or the
+    /// parent's `next`). With it the shader walks the tree with one index and
+    /// no stack: a dynamically indexed private array costs a GPU local memory
+    /// round trip per access (on an NVIDIA H200 it made a 1080p frame 7x
+    /// slower, docs/bench/play.md "Real GPU").
     pub fn gpu_data(&self) -> Vec<f32> {
         let ns = self.grid.n_s;
+        let mut next = vec![GPU_NONE; self.nodes.len()];
+        for (i, n) in next.iter_mut().enumerate().take(self.n_top) {
+            if i + 1 < self.n_top {
+                *n = i as u32 + 1;
+            }
+        }
+        // children come after their parent, so a parent's next is known first
+        for (i, c) in self.nodes.iter().enumerate() {
+            if let Some([a, b]) = c.children {
+                next[a as usize] = b;
+                next[b as usize] = next[i];
+            }
+        }
         let mut out = Vec::with_capacity(self.nodes.len() * (GPU_HEADER + 9 * ns));
-        for c in &self.nodes {
-            let first = c.children.map_or(u32::MAX, |ch| ch[0]);
+        for (c, &nx) in self.nodes.iter().zip(&next) {
+            let first = c.children.map_or(GPU_NONE, |ch| ch[0]);
             out.extend([
                 c.uv[0] as f32,
                 c.uv[1] as f32,
                 c.spread as f32,
                 f32::from_bits(first),
+                f32::from_bits(nx),
             ]);
             for layer in &c.mass {
                 out.extend(layer.iter().map(|&m| m as f32));
@@ -355,5 +378,64 @@ impl Cells {
             }
         }
         xyz
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn node(children: Option<[u32; 2]>) -> Cell {
+        Cell {
+            uv: [0.0; 2],
+            spread: 0.0,
+            children,
+            mass: vec![[0.0; 9]; 2],
+        }
+    }
+
+    /// Walk `gpu_data` as the shader does: descend where `descend(id)`, else
+    /// take `next`.
+    fn walk(data: &[f32], stride: usize, descend: &dyn Fn(u32) -> bool) -> Vec<u32> {
+        let mut seen = Vec::new();
+        let mut id = 0u32;
+        while id != GPU_NONE {
+            let o = id as usize * stride;
+            let first = data[o + 3].to_bits();
+            if first != GPU_NONE && descend(id) {
+                id = first;
+                continue;
+            }
+            seen.push(id);
+            id = data[o + 4].to_bits();
+        }
+        seen
+    }
+
+    #[test]
+    fn the_threaded_walk_visits_what_the_stack_walk_visits() {
+        // tops 0, 1, 2; 0 -> (3, 4), 2 -> (5, 6), 4 -> (7, 8), 6 -> (9, 10)
+        let mut nodes: Vec<Cell> = (0..11).map(|_| node(None)).collect();
+        nodes[0].children = Some([3, 4]);
+        nodes[2].children = Some([5, 6]);
+        nodes[4].children = Some([7, 8]);
+        nodes[6].children = Some([9, 10]);
+        let cells = Cells {
+            grid: Grid {
+                n_theta: 4,
+                n_rho: 4,
+                n_s: 2,
+                r0: 0.1,
+            },
+            nodes,
+            n_top: 3,
+        };
+        let data = cells.gpu_data();
+        let stride = GPU_HEADER + 9 * 2;
+        assert_eq!(data.len(), 11 * stride);
+        assert_eq!(walk(&data, stride, &|_| false), vec![0, 1, 2]);
+        assert_eq!(walk(&data, stride, &|_| true), vec![3, 7, 8, 1, 5, 9, 10]);
+        assert_eq!(walk(&data, stride, &|id| id != 2), vec![3, 7, 8, 1, 2]);
+        assert_eq!(walk(&data, stride, &|id| id == 6), vec![0, 1, 2]);
     }
 }

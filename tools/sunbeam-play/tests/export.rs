@@ -58,7 +58,7 @@ fn glsl_passes_glslang() {
             "vec3 env_cells(",
             "usampler2D _group_0_binding_7_fs",
             "sampler2D _group_0_binding_3_fs",
-            "vec4 counts;",
+            "vec4 cells;",
         ] {
             assert!(text.contains(m), "{lang}: missing {m}");
         }
