@@ -173,6 +173,8 @@ else {
 // the environment's fields and files (exit 2 naming them).
 let env = null;
 let envDir = null;
+// The temporary folder goes however render.mjs exits (fail() exits at once).
+process.on('exit', () => { if (envDir) rmSync(envDir, { recursive: true, force: true }); });
 if (scene.environment) {
   const play = process.env.SUNBEAM_PLAY ?? resolve(here, '../../target/release/sunbeam-play');
   envDir = mkdtempSync(join(tmpdir(), 'sunbeam-env-'));
@@ -251,7 +253,6 @@ try {
 } finally {
   if (browser) await browser.close();
   server.close();
-  if (envDir) rmSync(envDir, { recursive: true, force: true });
 }
 if (pixels.error) fail(2, pixels.error);
 const errors = problems.filter((s) => !/GPU stall due to ReadPixels|Automatic fallback to software WebGL/.test(s));
