@@ -63,8 +63,7 @@ pub(super) fn maps(
 /// `env`: read from the pack's `NAME.env-response.ktx2` (`sunbeam-pack
 /// --response`) when it serves this pack and environment, else built (what
 /// the build took, and why, goes to `notes`). A file that cannot be read is
-/// an input error naming it. Also what `--export-environment` writes from
-/// (crate::env_export).
+/// an input error naming it. Also what `--export-environment` writes from.
 pub(crate) fn response(
     env: &Environment,
     pack: &Arc<Pack>,
