@@ -6,7 +6,7 @@
 #   ninja -C examples -f out/build.ninja [-j2] [fields|packs|pictures|frames|sheet|web|turntable|all]
 #
 # Takes the Makefile's variables (BIN, OUT, SHARED, MATERIALS, SIZE, BRDF_SIZE,
-# SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, SKY_SAMPLES, PLAY_SKY_FRAMES,
+# SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, SKY_SAMPLES, PLAY_SKY_FRAMES, PLAY_FIRST_CELLS,
 # TURNTABLE_MATERIAL, TURNTABLE_SIZE, TURNTABLE_FRAMES, TURNTABLE_ESTIMATOR, COLUMNS,
 # SCALE_TEXELS, SCALES_xeno, SCALES_elaphe, SHEET, Q)
 # with the same defaults, on the command line only. Paths are relative to
@@ -31,11 +31,12 @@ PACK_FLAGS=
 PLAY_FLAGS=
 SKY_SAMPLES=16
 PLAY_SKY_FRAMES=32
+PLAY_FIRST_CELLS=256
 TURNTABLE_MATERIAL=__default__
 TURNTABLE_SIZE=256x144
 TURNTABLE_FRAMES=24
 TURNTABLE_ESTIMATOR=monte-carlo
-COLUMNS=6
+COLUMNS=7
 SCALE_TEXELS=16
 # Scales per species (examples/Makefile SCALES_*; docs/BAKE.md "Scales").
 SCALES_xeno="--scale-rows 20 --scale-length 1.0 --scale-overlap 0.3 --scale-dome 0.06 --scale-tilt 6 --scale-tilt-jitter 4 --scale-ridge-jitter 6"
@@ -45,7 +46,7 @@ Q=-q
 for a in "$@"; do
   case "$a" in
     BIN=* | OUT=* | SHARED=* | MATERIALS=* | SIZE=* | BRDF_SIZE=* | SYNTH_SIZE=* | SYNTH_PIXEL=* | \
-      SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | SKY_SAMPLES=* | PLAY_SKY_FRAMES=* | COLUMNS=* | SHEET=* | Q=* | \
+      SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | SKY_SAMPLES=* | PLAY_SKY_FRAMES=* | PLAY_FIRST_CELLS=* | COLUMNS=* | SHEET=* | Q=* | \
       TURNTABLE_MATERIAL=* | TURNTABLE_SIZE=* | TURNTABLE_FRAMES=* | TURNTABLE_ESTIMATOR=* | \
       SCALE_TEXELS=* | SCALES_xeno=* | SCALES_elaphe=*)
       printf -v "${a%%=*}" '%s' "${a#*=}" ;;
@@ -105,7 +106,7 @@ rule export_shader
   command = rm -f \$tidy && $(esc "$BIN")/sunbeam-play --export-shader glsl-es -o \${target} \$q
   description = export \${target}
 rule scene
-  command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake.glb|' \$in > \${outdir}/.\${name}-scene.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-scene.json.tmp.\$\$\$\$ \${target}
+  command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake-\${name}.glb|' \$in > \${outdir}/.\${name}-scene.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-scene.json.tmp.\$\$\$\$ \${target}
   description = scene \${target}
 rule play
   command = rm -f \$tidy && $(esc "$BIN")/sunbeam-play \$in --headless --size $(esc "$SIZE") $(esc "$PLAY_FLAGS") -o \${target} --depfile \${target}.d \$q
@@ -113,7 +114,7 @@ rule play
   deps = gcc
   description = play \${target}
 rule sky_scene
-  command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake.glb|' \$in > \${outdir}/.\${name}-sky.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-sky.json.tmp.\$\$\$\$ \${target}
+  command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake-\${name}.glb|' \$in > \${outdir}/.\${name}-sky.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-sky.json.tmp.\$\$\$\$ \${target}
   description = sky_scene \${target}
 rule turntable_scene
   command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake-\${name}.glb|' \$in > \${outdir}/.\${name}-turntable.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-turntable.json.tmp.\$\$\$\$ \${target}
@@ -121,6 +122,11 @@ rule turntable_scene
 rule sky
   command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$SIZE") --samples $(esc "$SKY_SAMPLES") -o \${target} \$q
   description = sky \${target}
+rule play_first
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-play \$in --headless --size $(esc "$SIZE") --frames 1 --env-estimator cells --env-cells $(esc "$PLAY_FIRST_CELLS") -o \${target} --depfile \${target}.d \$q
+  depfile = \${target}.d
+  deps = gcc
+  description = play_first \${target}
 rule play_sky
   command = rm -f \$tidy && $(esc "$BIN")/sunbeam-play \$in --headless --size $(esc "$SIZE") --frames $(esc "$PLAY_SKY_FRAMES") -o \${target} --depfile \${target}.d \$q
   depfile = \${target}.d
@@ -185,17 +191,20 @@ EOF
     echo "  target = $o/$m-scene.json"
     echo "  name = $m"
     echo "  tidy = $(esc "$OUT/.$m-scene.json").tmp.*"
-    echo "build $o/$m-frame.png: play $o/$m-scene.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/snake.glb $(path "$BIN/sunbeam-play")"
+    echo "build $o/$m-frame.png: play $o/$m-scene.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
     echo "  target = $(esc "$OUT/$m-frame.png")"
     echo "  tidy = $(esc "$OUT/.$m-frame.png").tmp.*"
     echo "build $o/$m-sky.json: sky_scene sky-scene.json.in"
     echo "  target = $o/$m-sky.json"
     echo "  name = $m"
     echo "  tidy = $(esc "$OUT/.$m-sky.json").tmp.*"
-    echo "build $o/$m-sky.png: sky $o/$m-sky.json | $o/$m.ktx2 $o/snake.glb $(path "$EVAL")"
+    echo "build $o/$m-sky.png: sky $o/$m-sky.json | $o/$m.ktx2 $o/snake-$m.glb $(path "$EVAL")"
     echo "  target = $(esc "$OUT/$m-sky.png")"
     echo "  tidy = $(esc "$OUT/.$m-sky.png").tmp.*"
-    echo "build $o/$m-play-sky.png: play_sky $o/$m-sky.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/$m.env-response.ktx2 $o/snake.glb $(path "$BIN/sunbeam-play")"
+    echo "build $o/$m-play-first.png: play_first $o/$m-sky.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/$m.env-response.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
+    echo "  target = $(esc "$OUT/$m-play-first.png")"
+    echo "  tidy = $(esc "$OUT/.$m-play-first.png").tmp.*"
+    echo "build $o/$m-play-sky.png: play_sky $o/$m-sky.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/$m.env-response.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
     echo "  target = $(esc "$OUT/$m-play-sky.png")"
     echo "  tidy = $(esc "$OUT/.$m-play-sky.png").tmp.*"
     echo "build $o/snake-$m.glb: bake_pack $o/$m.ktx2 | $o/$m.response.ktx2 $(path "$BIN/sunbeam-bake")"
@@ -205,7 +214,7 @@ EOF
       elaphe) echo "  scales = $(esc "$SCALES_elaphe")" ;;
     esac
     echo "  tidy = $(esc "$OUT/.snake-$m.glb").tmp.*"
-    sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png $o/$m-play-sky.png $o/$m-sky.png"
+    sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png $o/$m-play-first.png $o/$m-play-sky.png $o/$m-sky.png"
   done
   tm=$TURNTABLE_MATERIAL
   echo "build $o/$tm-turntable.json: turntable_scene sky-scene.json.in"
@@ -232,12 +241,12 @@ EOF
   echo "build fields: phony$(list .exr)"
   echo "build packs: phony$(list .ktx2)"
   echo "build pictures: phony$(list -brdf.png -grating.png)"
-  echo "build frames: phony$(list -frame.png -play-sky.png -sky.png)"
+  echo "build frames: phony$(list -frame.png -play-first.png -play-sky.png -sky.png)"
   echo "build sheet: phony $o/contact-sheet.png"
   web_in=""; for m in $MATERIALS; do web_in="$web_in $o/snake-$m.glb"; done
   echo "build web: phony $o/sunbeam-es.frag$web_in"
   echo "build turntable: phony $o/$tm-turntable.png"
-  echo "build all: phony $o/contact-sheet.png web turntable"
+  echo "build all: phony $o/contact-sheet.png $o/snake.glb web turntable"
   echo "default all"
 } > "$tmp"
 mv "$tmp" "$OUT/build.ninja"

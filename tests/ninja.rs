@@ -143,6 +143,9 @@ fn ninja_builds_what_make_builds_and_rebuilds_only_dependents() {
         want.insert(format!("play {o}/elaphe-frame.png"));
         want.insert(format!("sky {o}/elaphe-sky.png"));
         want.insert(format!("play_sky {o}/elaphe-play-sky.png"));
+        want.insert(format!("play_first {o}/elaphe-play-first.png"));
+        // the frames show the snake with Elaphe's scales, baked with its pack
+        want.insert(format!("bake {o}/snake-elaphe.glb"));
     }
     if goals.iter().any(|g| g == "sheet") {
         want.insert(format!("sheet {o}/contact-sheet.png"));
@@ -157,6 +160,7 @@ fn ninja_builds_what_make_builds_and_rebuilds_only_dependents() {
     let after = mtimes(&by_ninja);
     for (k, t) in &after {
         let should = k.starts_with("elaphe") && k != "elaphe-scene.json" && k != "elaphe-sky.json"
+            || k.starts_with("snake-elaphe.glb")
             || k == "contact-sheet.png";
         assert_eq!(
             before.get(k) != Some(t),
