@@ -104,8 +104,6 @@ struct EnvProposal {
 // the maps' cells (sunbeam_response::cells::Cells::gpu_data)
 @group(2) @binding(12) var<storage, read> cells: array<f32>;
 
-const ENV_PI: f32 = 3.141592653589793;
-
 // ---------------------------------------------------------------- random numbers
 fn pcg(v: u32) -> u32 {
     let state = v * 747796405u + 2891336453u;
@@ -466,91 +464,51 @@ fn env_descend(wr: vec3<f32>, u: vec3<f32>, q: u32) -> EnvDraw {
 }
 
 // ---------------------------------------------------------------- the cells
-// The coefficients at d averaged over about omega steradians
-// (Prefiltered::lookup: the level whose texel's polar extent squared is omega).
-fn env_prefiltered(d: vec3<f32>, omega: f32) -> vec3<f32> {
-    let texel = ENV_PI / f32(envg.table_h);
-    let level = clamp(0.5 * log2(max(omega, 1e-30) / (texel * texel)), 0.0, f32(envg.chain_levels - 1u));
-    return textureSampleLevel(env_chain, env_smp, sb_env_equirect(d), level).xyz;
+// The cells' evaluation is shaders/env_cells.wgsl (shared with the engines'
+// export, shaders/export_env.wgsl); the player supplies its data access here:
+// the nodes from the storage buffer, the chain and irradiance tables from
+// group 2, the mesh's gain with its masking.
+fn env_cell_f32(i: u32) -> f32 {
+    return cells[i];
 }
 
-// Cells refine near the horizon while their spread times this reaches it
-// (sunbeam_response::cells::REFINE).
-const ENV_REFINE: f32 = 2.0;
-// Cells::gpu_data: floats per node before its masses, and "no node".
-const ENV_CELL_HEADER: u32 = 5u;
-const ENV_CELL_NONE: u32 = 0xffffffffu;
-
-
-// The diffraction part (XYZ) of the environment without the sun at local
-// view wr, frame (t, b, n): each cell's mass at its layer times G / cos and
-// the prefiltered coefficients at its centroid (Cells::estimate, the CPU
-// twin; docs/LIGHTING.md "The first frame").
-fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
-    var xyz = vec3<f32>(0.0);
-    let ns = envp.n_s;
-    let stride = ENV_CELL_HEADER + 9u * ns;
-    if (envp.n_cells == 0u) {
-        return xyz;
-    }
-    // A depth-first walk threaded by each node's `next` (Cells::gpu_data): one
-    // index and no stack, whose dynamic indexing would live in local memory.
-    // Each node is visited at most once, which bounds the loop.
-    let n_nodes = arrayLength(&cells) / stride;
-    var id = 0u;
-    for (var visit = 0u; visit < n_nodes && id != ENV_CELL_NONE; visit = visit + 1u) {
-        let o = id * stride;
-        let uv = vec2<f32>(cells[o], cells[o + 1u]);
-        let spread = cells[o + 2u];
-        let first = bitcast<u32>(cells[o + 3u]);
-        let wxy = -uv - wr.xy;
-        let l = length(wxy);
-        let dist = 1.0 - l;
-        if (first != ENV_CELL_NONE && dist < ENV_REFINE * spread) {
-            id = first;
-            continue;
-        }
-        id = bitcast<u32>(cells[o + 4u]);
-        var inside = select(0.0, 1.0, dist > 0.0);
-        if (spread > 0.0) {
-            inside = 0.5 * (1.0 + sb_erf(dist / (1.4142135623730951 * spread)));
-        }
-        if (inside <= 0.0 || dist <= -0.5) {
-            continue;
-        }
-        var w2 = wxy;
-        if (l > 0.999) {
-            w2 = wxy * (0.999 / l);
-        }
-        let wi = vec3<f32>(w2, sqrt(max(1.0 - dot(w2, w2), 0.0)));
-        let r = length(uv);
-        let s = clamp((wi.z + wr.z) / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
-        let sc = s * f32(ns - 1u);
-        let k0 = min(u32(floor(sc)), ns - 2u);
-        let f = sc - f32(k0);
-        let gw = gain(wi, wr) / wi.z * inside;
-        if (!(gw > 0.0)) {
-            continue;
-        }
-        let omega = max(SB_TAU * spread * spread / wi.z, 1e-9);
-        let c = env_prefiltered(wi.x * t + wi.y * b + wi.z * n, omega);
-        let m0 = o + ENV_CELL_HEADER + k0 * 9u;
-        let m1 = m0 + 9u;
-        var e = vec3<f32>(0.0);
-        for (var bb = 0u; bb < 3u; bb = bb + 1u) {
-            let a0 = vec3<f32>(cells[m0 + 3u * bb], cells[m0 + 3u * bb + 1u], cells[m0 + 3u * bb + 2u]);
-            let a1 = vec3<f32>(cells[m1 + 3u * bb], cells[m1 + 3u * bb + 1u], cells[m1 + 3u * bb + 2u]);
-            e = e + c[bb] * mix(a0, a1, f);
-        }
-        xyz = xyz + gw * e;
-    }
-    return xyz;
+fn env_cell_u32(i: u32) -> u32 {
+    return bitcast<u32>(cells[i]);
 }
 
-// Irradiance (linear sRGB, without the sun) at world normal n from a table
-// over normals (Irradiance::at: bilinear, azimuth wraps).
-fn env_irradiance(tex: texture_2d<f32>, n: vec3<f32>) -> vec3<f32> {
-    return textureSampleLevel(tex, env_smp, sb_env_equirect(n), 0.0).xyz;
+fn env_cells_top() -> u32 {
+    return envp.n_cells;
+}
+
+fn env_cells_nodes() -> u32 {
+    return arrayLength(&cells) / (ENV_CELL_HEADER + 9u * envp.n_s);
+}
+
+fn env_cells_layers() -> u32 {
+    return envp.n_s;
+}
+
+fn env_cells_gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    return gain(wi, wr);
+}
+
+fn env_chain_height() -> u32 {
+    return envg.table_h;
+}
+
+fn env_chain_levels() -> u32 {
+    return envg.chain_levels;
+}
+
+fn env_chain_read(uv: vec2<f32>, level: f32) -> vec3<f32> {
+    return textureSampleLevel(env_chain, env_smp, uv, level).xyz;
+}
+
+fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
+    if (skin) {
+        return textureSampleLevel(env_irr_skin, env_smp, uv, 0.0).xyz;
+    }
+    return textureSampleLevel(env_irr_plain, env_smp, uv, 0.0).xyz;
 }
 
 // ---------------------------------------------------------------- the estimator
@@ -568,9 +526,9 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     let tabled = envg.estimator == 0u && (!diffract || abs(mat.ior - envg.irr_ior) < 1e-6);
     if (dw > 0.0 && tabled) {
         // The first-frame estimator: the tabulated (transmitted) irradiance.
-        var irr = env_irradiance(env_irr_plain, n);
+        var irr = env_irradiance(false, n);
         if (diffract) {
-            irr = env_irradiance(env_irr_skin, n);
+            irr = env_irradiance(true, n);
         }
         var irr_over_pi = irr / ENV_PI;
         if (envg.has_sun == 1u) {

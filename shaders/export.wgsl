@@ -6,12 +6,15 @@
 // Bindings (group 0): 0 the material's numbers, 1 the response map (3D texture,
 // RGBA16F from NAME.response.ktx2), 2 its sampler (linear; repeat in x,
 // clamp-to-edge in y and z).
+// Bindings 3 to 9 are the environment's (shaders/export_env.wgsl).
 // Call sunbeam_shade(t, b, n, wi, wr) per light: linear sRGB for a light of
 // intensity 1 (multiply by the light's colour and intensity, sum over lights,
 // then expose and tone-map as the engine does); sb_frame(normal, orientation)
-// gives (t, b, n) from the interpolated attributes as the player does. The
-// entry point sunbeam_fragment shows both calls with the attributes and the
-// two directions as varyings.
+// gives (t, b, n) from the interpolated attributes as the player does;
+// sunbeam_shade_environment(t, b, n, wr) adds an environment without its
+// sun, sunbeam_shade_sun(t, b, n, wi, wr) the sky's sun (shaders/export_env.wgsl). The entry point
+// sunbeam_fragment shows the calls with the attributes and the two
+// directions as varyings.
 
 struct SunbeamMaterial {
     // xyz: the map's texels along angle, radius, s (grid.n_theta, n_rho, n_s); w: unused
@@ -72,6 +75,8 @@ struct SunbeamVaryings {
 @fragment
 fn sunbeam_fragment(v: SunbeamVaryings) -> @location(0) vec4<f32> {
     let f = sb_frame(v.normal, v.orientation);
-    let c = sunbeam_shade(f[0], f[1], f[2], normalize(v.wi), normalize(v.wr));
+    let wr = normalize(v.wr);
+    let c = sunbeam_shade(f[0], f[1], f[2], normalize(v.wi), wr) + sunbeam_shade_environment(f[0], f[1], f[2], wr)
+        + sunbeam_shade_sun(f[0], f[1], f[2], sunbeam_env.sun_dir.xyz, wr);
     return vec4<f32>(c, 1.0);
 }

@@ -11,6 +11,9 @@
 //! and the sphere lit from the side with another skin: Smith masking with the
 //! pack's slopes, an index of 1.4, relative reflectance.
 
+#[path = "gpu/mod.rs"]
+mod gpu;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use sunbeam::{run_ok, scratch, tool, workspace_root};
@@ -76,6 +79,20 @@ fn compare(render: &Path, d: &Path, scene: &str, name: &str) {
 }
 
 fn compare_with(render: &Path, d: &Path, scene: &str, ref_scene: &str, name: &str) {
+    let c = measure(render, d, scene, ref_scene, name);
+    assert!(c.p99 < 2.0, "{name}: three.js vs reference {c}");
+}
+
+/// render.mjs on `scene` and `sunbeam-eval render --samples 16` on
+/// `ref_scene` (written into `d` as NAME.json and NAME-ref.json): the
+/// difference over lit pixels.
+fn measure(
+    render: &Path,
+    d: &Path,
+    scene: &str,
+    ref_scene: &str,
+    name: &str,
+) -> sunbeam_frame::ColourDiff {
     let s = d.join(format!("{name}.json"));
     std::fs::write(&s, scene).unwrap();
     let rs = d.join(format!("{name}-ref.json"));
@@ -108,7 +125,7 @@ fn compare_with(render: &Path, d: &Path, scene: &str, ref_scene: &str, name: &st
     let c = compare_linear(&a, &r).unwrap();
     eprintln!("three.js {name}: {c}");
     assert!(c.pixels > 200, "{name}: only {} lit pixels", c.pixels);
-    assert!(c.p99 < 2.0, "{name}: three.js vs reference {c}");
+    c
 }
 
 #[test]
@@ -202,17 +219,24 @@ fn bad_scenes_exit_non_zero_with_the_field_named() {
     assert!(!d.join("x.png").exists());
     let o = Command::new("node").arg(&render).output().unwrap();
     assert_eq!(o.status.code(), Some(1));
-    // An environment is refused until it is shaded (docs/SCENE.md).
+    // An environment whose map is missing: exit 2 naming it (sunbeam-play
+    // --export-environment checks it), no frame.
     std::fs::write(&s, r#"{ "camera": { "eye": [0, 0, 2], "target": [0, 0, 0] }, "meshes": [ { "mesh": "builtin:sphere" } ], "environment": { "map": "sky.exr" } }"#).unwrap();
     let o = Command::new("node")
         .arg(&render)
         .arg(&s)
         .arg("-o")
         .arg(d.join("x.png"))
+        .env("SUNBEAM_PLAY", tool("sunbeam-play"))
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("environment"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("environment") && err.contains("sky.exr"),
+        "{err}"
+    );
+    assert!(!d.join("x.png").exists());
     // An output that cannot be written: exit 3.
     ridge_pack(&d, "ok", "64", "25nm");
     let s = d.join("ok.json");
@@ -294,3 +318,218 @@ fn the_viewer_page_loads_without_errors() {
     assert!(run["mapBytes"].as_u64().unwrap() > 1000, "{report}");
     assert_eq!(run["material"], "xeno");
 }
+
+/// An environment (issue 26, "Engines"): render.mjs lights a sky-lit sphere
+/// through the exported sunbeam_shade_environment (the player's first-frame
+/// cells, from the files of `sunbeam-play --export-environment`) and the
+/// sun through sunbeam_shade_sun, one frame, against `sunbeam-eval render
+/// --samples 16` of the same scene; the player's own cells frame (one frame,
+/// 4 x 4 supersampled like render.mjs) against the same reference for
+/// comparison. The environment must matter: the frame without it (the sun
+/// as the only light) is far from the reference.
+#[test]
+fn threejs_renders_a_sky_lit_sphere_like_the_reference() {
+    let d = scratch("threejs-env");
+    let Some(render) = example(&d) else { return };
+    ridge_pack(&d, "ridges", "256", "20nm");
+    let sky = r#"{ "camera": { "eye": [0, 0.25, 1.2], "target": [0, 0, 0], "fov_y_deg": 35 },
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1 } ],
+  "environment": { "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 60 } },
+  "exposure": 4.64, "size": [40, 40] }"#;
+    let c = measure(&render, &d, sky, sky, "sky");
+    assert!(c.p99 < SKY_P99, "three.js sky: {c}");
+    // The player's first frame (cells) against the same reference.
+    if gpu::gpu().is_some() {
+        let o = run_ok(
+            Command::new(tool("sunbeam-play"))
+                .arg(d.join("sky.json"))
+                .args([
+                    "--headless",
+                    "--env-estimator",
+                    "cells",
+                    "--supersample",
+                    "4",
+                    "--json",
+                    "-q",
+                    "-o",
+                ])
+                .arg(d.join("sky-player.exr"))
+                .arg("--compare")
+                .arg(d.join("sky-ref.exr")),
+        );
+        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        eprintln!("player cells, first frame: {}", r["ciede2000"]);
+        // Both shade with the same WGSL functions and data: they must agree.
+        let p = LinearImage::read_exr(&d.join("sky-player.exr")).unwrap();
+        let t = LinearImage::read_exr(&d.join("sky.exr")).unwrap();
+        let pt = compare_linear(&t, &p).unwrap();
+        eprintln!("three.js vs player: {pt}");
+        assert!(pt.p99 < SKY_P99, "three.js vs player cells: {pt}");
+    }
+    // Without the environment's own light (the sun alone, as a point light)
+    // the frame is far from the reference: the comparison can fail.
+    let sun_only = r#"{ "camera": { "eye": [0, 0.25, 1.2], "target": [0, 0, 0], "fov_y_deg": 35 },
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1 } ],
+  "lights": [ { "direction": [0.4096, 0.5736, 0.7094], "intensity": 1 } ],
+  "exposure": 4.64, "size": [40, 40] }"#;
+    let r = d.join("sky-ref.exr");
+    std::fs::write(d.join("sun-only.json"), sun_only).unwrap();
+    run_ok(
+        Command::new("node")
+            .arg(&render)
+            .arg(d.join("sun-only.json"))
+            .arg("-o")
+            .arg(d.join("sun-only.png"))
+            .arg("--exr")
+            .arg(d.join("sun-only.exr"))
+            .env("SUNBEAM_PLAY", tool("sunbeam-play")),
+    );
+    let c = compare_linear(
+        &LinearImage::read_exr(&d.join("sun-only.exr")).unwrap(),
+        &LinearImage::read_exr(&r).unwrap(),
+    )
+    .unwrap();
+    eprintln!("sun only vs the sky's reference: {c}");
+    assert!(c.p99 > 3.0 * SKY_P99, "{c}");
+}
+
+/// Bound of [`threejs_renders_a_sky_lit_sphere_like_the_reference`]
+/// (docs/ENGINES.md "Environment"): measured on SwiftShader and lavapipe
+/// (2026-11-26) three.js p99 2.35 (mean 0.84, max 2.9) against the
+/// reference, the player's cells first frame 2.44, three.js against the
+/// player 1.53; plus 25 %. The issue's goal is 2: the cells' own error.
+const SKY_P99: f64 = 2.9;
+
+/// A real HDR image (../shared/data/hdri/studio.exr): render.mjs against the
+/// reference and against the player's cells frame (the same functions and
+/// data: they must agree, whatever the cells' own error under this map), and
+/// `"background": "environment"`: a far, small sphere in front of the map,
+/// so that the background decides the p99.
+#[test]
+fn threejs_renders_an_hdr_image_and_its_background() {
+    let d = scratch("threejs-hdri");
+    let Some(render) = example(&d) else { return };
+    let Some(map) = testdata::shared_file("hdri/studio.exr") else {
+        return;
+    };
+    ridge_pack(&d, "ridges", "256", "20nm");
+    let scene = |eye: &str, background: &str| {
+        format!(
+            r#"{{ "camera": {{ "eye": {eye}, "target": [0, 0, 0], "fov_y_deg": 35 }},
+  "meshes": [ {{ "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1 }} ],
+  "environment": {{ "map": "{}", "rotation_deg": 30 }},{background}
+  "exposure": 4.64, "size": [40, 40] }}"#,
+            map.display()
+        )
+    };
+    let studio = scene("[0, 0.25, 1.2]", "");
+    let c = measure(&render, &d, &studio, &studio, "studio");
+    assert!(c.p99 < STUDIO_P99, "three.js under studio.exr: {c}");
+    let far = scene("[0, 0.25, 20]", "\n  \"background\": \"environment\",");
+    let c = measure(&render, &d, &far, &far, "background");
+    assert!(c.p99 < BACKGROUND_P99, "background: {c}");
+    // The player's cells frame of both scenes: the same functions and data
+    // (without the map's hot spots as lights, which the export does not carry
+    // yet: docs/LIGHTING.md "Hot spots as lights").
+    if gpu::gpu().is_some() {
+        for (name, bound) in [("studio", SKY_P99), ("background", BACKGROUND_PLAYER_P99)] {
+            let o = run_ok(
+                Command::new(tool("sunbeam-play"))
+                    .arg(d.join(format!("{name}.json")))
+                    .args([
+                        "--headless",
+                        "--env-estimator",
+                        "cells",
+                        "--env-hot-spots",
+                        "0",
+                        "--supersample",
+                        "4",
+                        "--json",
+                        "-q",
+                        "-o",
+                    ])
+                    .arg(d.join(format!("{name}-player.exr")))
+                    .arg("--compare")
+                    .arg(d.join(format!("{name}-ref.exr"))),
+            );
+            let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            eprintln!("player cells, {name}, first frame: {}", r["ciede2000"]);
+            let p = LinearImage::read_exr(&d.join(format!("{name}-player.exr"))).unwrap();
+            let t = LinearImage::read_exr(&d.join(format!("{name}.exr"))).unwrap();
+            let pt = compare_linear(&t, &p).unwrap();
+            eprintln!("three.js vs player, {name}: {pt}");
+            assert!(pt.p99 < bound, "three.js vs player cells, {name}: {pt}");
+        }
+        // With its hot spots as lights the player comes closer to the reference.
+        let hot = |n: &str| {
+            let o = run_ok(
+                Command::new(tool("sunbeam-play"))
+                    .arg(d.join("studio.json"))
+                    .args([
+                        "--headless",
+                        "--env-estimator",
+                        "cells",
+                        "--env-hot-spots",
+                        n,
+                    ])
+                    .args(["--supersample", "4", "--json", "-q", "-o"])
+                    .arg(d.join(format!("studio-hot-{n}.exr")))
+                    .arg("--compare")
+                    .arg(d.join("studio-ref.exr")),
+            );
+            let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            r["ciede2000"]["mean"].as_f64().unwrap()
+        };
+        let (without, with) = (hot("0"), hot("32"));
+        eprintln!(
+            "player cells under studio.exr: mean {without:.2} without hot spots, {with:.2} with"
+        );
+        assert!(
+            with < 0.7 * without,
+            "hot spots: mean {with} against {without}"
+        );
+    }
+}
+
+/// Bounds of [`threejs_renders_an_hdr_image_and_its_background`], measured
+/// plus 25 % (docs/ENGINES.md "Environment", 2026-11-26): under studio.exr
+/// the cells are far from the reference, p99 37.1 (the player's 37.4: their
+/// known limit, the map's softboxes); the background p99 15.5 (the
+/// player's own background pass 13.9: the map's sharp edges sampled by 16
+/// rays per pixel in each).
+const STUDIO_P99: f64 = 46.0;
+const BACKGROUND_P99: f64 = 19.5;
+/// three.js against the player's frame with the background: mean 0.29, p99
+/// 4.17, max 34: a few pixels on the map's sharp edges differ (not traced:
+/// the nearest texel of f16 level 0 of the chain against the player's f32
+/// table, or the sub-pixel positions), plus 25 %.
+const BACKGROUND_PLAYER_P99: f64 = 5.2;
+
+/// The baked snake under the sky (issue 26: three.js on the snake, sky),
+/// three.js against the reference (about 50 s on 2 cores: the snake is the
+/// issue's second scene, so CI runs it).
+#[test]
+fn threejs_renders_the_snake_under_the_sky() {
+    let d = scratch("threejs-snake-sky");
+    let Some(render) = example(&d) else { return };
+    ridge_pack(&d, "ridges", "256", "20nm");
+    run_ok(
+        Command::new(tool("sunbeam-bake"))
+            .arg("--generate-snake")
+            .arg("-o")
+            .arg(d.join("snake.glb"))
+            .arg("-q"),
+    );
+    let snake = r#"{ "camera": { "eye": [0, 0.3, 1.0], "target": [0, 0, 0], "fov_y_deg": 35 },
+  "meshes": [ { "mesh": "snake.glb", "pack": "ridges.ktx2", "base_color": [0.05, 0.05, 0.05], "diffuse_weight": 0.2 } ],
+  "environment": { "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 60 } },
+  "exposure": 4.64, "size": [96, 48] }"#;
+    let c = measure(&render, &d, snake, snake, "snake-sky");
+    assert!(c.p99 < SNAKE_SKY_P99, "three.js snake under the sky: {c}");
+}
+
+/// Bound of [`threejs_renders_the_snake_under_the_sky`] (docs/ENGINES.md
+/// "Environment"): measured p99 29.2 (mean 3.9) over 348 px, 2026-11-26;
+/// the player's cells first frame of the same scene (--supersample 4) p99
+/// 30.3 (mean 4.7): the cells' error on the snake, not the engine's. Plus 25 %.
+const SNAKE_SKY_P99: f64 = 36.5;

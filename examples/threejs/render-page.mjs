@@ -5,8 +5,8 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import {
-  adaptExportedGlsl, addOrientation, builtinGeometry, extensionSkin, maskingSlope, parseResponseMap,
-  sceneCamera, SunbeamDiffractionPlugin, sunbeamMaterial, updateSunbeamUniforms,
+  adaptExportedGlsl, addOrientation, builtinGeometry, environmentBackground, extensionSkin, maskingSlope,
+  parseEnvironment, parseResponseMap, sceneCamera, SunbeamDiffractionPlugin, sunbeamMaterial, updateSunbeamUniforms,
 } from './sunbeam-three.mjs';
 
 // Colours are linear values as given (no sRGB conversion of inputs or outputs).
@@ -14,7 +14,7 @@ THREE.ColorManagement.enabled = false;
 
 window.sunbeamRender = async (job) => {
   try {
-    const { scene: desc, meshes, size, supersample: k, glsl } = job;
+    const { scene: desc, meshes, size, supersample: k, glsl, env: envJob } = job;
     const [w, h] = size;
     const W = w * k, H = h * k;
     const canvas = document.createElement('canvas');
@@ -32,15 +32,31 @@ window.sunbeamRender = async (job) => {
       if (!maps.has(url)) maps.set(url, parseResponseMap(await (await fetch(url)).arrayBuffer()));
       return maps.get(url);
     };
+    // The environment's files (sunbeam-play --export-environment, served by render.mjs).
+    let environment = null;
+    if (envJob) {
+      const get = async (url) => (await fetch(url)).arrayBuffer();
+      const cells = {};
+      for (const [file, url] of Object.entries(envJob.cells)) cells[file] = await get(url);
+      const suns = {};
+      for (const [file, url] of Object.entries(envJob.suns)) suns[file] = await get(url);
+      environment = parseEnvironment({
+        json: envJob.json, chain: await get(envJob.chain), irradianceSkin: await get(envJob.irradianceSkin),
+        irradiance: await get(envJob.irradiance), cells, suns,
+      });
+    }
+    let meshIndex = 0;
     const make = (map, baseColor, diffuseWeight, skin) => sunbeamMaterial({
       exportedGlsl: exported, map, baseColor, diffuseWeight, ...skin, lights: desc.lights, exposure: desc.exposure,
+      environment, envCells: environment && map ? environment.forMesh(meshIndex) : null,
     });
     // The scene's skin for a mesh: its index, normalisation and masking (the
     // pack's rms slopes unless the scene gives them).
     const sceneSkin = (m, map) => ({
       ior: m.ior, reflectance: m.reflectance, rmsSlope: map ? maskingSlope(m.masking, m.rmsSlope, map, m.what) : [0, 0],
     });
-    for (const m of meshes) {
+    for (const [mi, m] of meshes.entries()) {
+      meshIndex = mi;
       // The scene's pack wins; else the GLB's own SUNBEAM_materials_diffraction.
       const sceneMap = m.map ? await loadMap(m.map) : null;
       if (m.builtin) {
@@ -72,11 +88,12 @@ window.sunbeamRender = async (job) => {
       root.add(gltf.scene);
     }
     const camera = sceneCamera(desc, w / h);
+    if (desc.background === 'environment') root.add(environmentBackground(exported, environment, camera, desc.exposure));
     root.updateMatrixWorld(true);
     updateSunbeamUniforms(root, camera);
     const rt = new THREE.WebGLRenderTarget(W, H, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true });
     renderer.setRenderTarget(rt);
-    const bg = desc.background;
+    const bg = Array.isArray(desc.background) ? desc.background : [0, 0, 0];
     renderer.setClearColor(new THREE.Color(bg[0] * scale, bg[1] * scale, bg[2] * scale), 1);
     renderer.render(root, camera);
     const buf = new Float32Array(W * H * 4);

@@ -8,6 +8,10 @@
 //   (SUNBEAM_PLAY or ../../target/release/sunbeam-play, or --glsl FILE);
 // - each mesh's pack is read through its response map, NAME.response.ktx2
 //   beside the pack (`sunbeam-pack --response`);
+// - an "environment" (sky or map) lights the meshes through the exported
+//   sunbeam_shade_environment (the player's first-frame cells) with the
+//   files `sunbeam-play SCENE --export-environment DIR` writes, and its sun
+//   through sunbeam_shade_sun; "background": "environment" draws it behind;
 // - the frame is rendered into a float target at K x K times the size (default
 //   K = 4) and box-filtered in linear light (a pixel is the average over its
 //   area), then written as PNG (exposure, clip at 1, sRGB curve: what
@@ -79,8 +83,15 @@ scene.meshes.forEach((m, i) => {
   if (m.ior !== undefined && !(typeof m.ior === 'number' && m.ior > 1 && m.ior <= 4)) fail(2, `${at}.ior: expected a refractive index in (1, 4]`);
   if (!['absolute', 'relative'].includes(m.reflectance ?? 'absolute')) fail(2, `${at}.reflectance "${m.reflectance}": expected "absolute" or "relative"`);
 });
-if (scene.environment) fail(2, `${opt.scene}: environment: sky and map lighting are not rendered yet; light the scene with lights[] (docs/SCENE.md)`);
-scene.lights = scene.lights ?? [{ direction: [0.3, 1.0, 0.6], intensity: 1 }];
+if (scene.environment !== undefined) {
+  const e = scene.environment;
+  if (!e || typeof e !== 'object' || (e.sky === undefined) === (e.map === undefined)) fail(2, `${opt.scene}: environment: expected exactly one of "sky" or "map" (docs/SCENE.md)`);
+}
+const bgOk = scene.background === undefined || (Array.isArray(scene.background) && scene.background.length === 3 && scene.background.every(Number.isFinite))
+  || (scene.background === 'environment' && scene.environment);
+if (!bgOk) fail(2, `${opt.scene}: background: expected [r, g, b] or "environment" (with an environment)`);
+// With an environment an omitted lights means none (the sky has its own sun).
+scene.lights = scene.lights ?? (scene.environment ? [] : [{ direction: [0.3, 1.0, 0.6], intensity: 1 }]);
 scene.exposure = scene.exposure ?? 0;
 scene.background = scene.background ?? [0, 0, 0];
 const size = opt.size ?? scene.size ?? [512, 512];
@@ -156,6 +167,37 @@ else {
   }
 }
 
+// ---- the environment's files (sunbeam-play SCENE --export-environment DIR) ----------
+// The maps, the pack's response and the cells are built (or read) by the tool
+// from the scene file itself, so they are the player's; sunbeam-play checks
+// the environment's fields and files (exit 2 naming them).
+let env = null;
+let envDir = null;
+// The temporary folder goes however render.mjs exits (fail() exits at once).
+process.on('exit', () => { if (envDir) rmSync(envDir, { recursive: true, force: true }); });
+if (scene.environment) {
+  const play = process.env.SUNBEAM_PLAY ?? resolve(here, '../../target/release/sunbeam-play');
+  envDir = mkdtempSync(join(tmpdir(), 'sunbeam-env-'));
+  try {
+    execFileSync(play, [resolve(opt.scene), '--export-environment', envDir, '-q'], { stdio: ['ignore', 'ignore', 'pipe'] });
+  } catch (e) {
+    rmSync(envDir, { recursive: true, force: true });
+    const why = e.stderr ? e.stderr.toString().trim() : e.message;
+    fail(e.status === 2 ? 2 : 4, `environment: ${play} --export-environment failed: ${why}`);
+  }
+  const json = JSON.parse(readFileSync(join(envDir, 'environment.json'), 'utf8'));
+  const cells = {};
+  const suns = {};
+  for (const m of json.meshes) {
+    cells[m.file] = serve(join(envDir, m.file));
+    if (m.sun) suns[m.sun] = serve(join(envDir, m.sun));
+  }
+  env = {
+    json, cells, suns, chain: serve(join(envDir, json.chain.file)),
+    irradianceSkin: serve(join(envDir, json.irradiance.skin)), irradiance: serve(join(envDir, json.irradiance.plain)),
+  };
+}
+
 // ---- a local server for the page, three and the scene's files ----------------------
 const page = `<!doctype html><html><head><meta charset="utf-8">
 <script type="importmap">{"imports":{"three":"/node_modules/three/build/three.module.js","three/addons/":"/node_modules/three/examples/jsm/"}}</script>
@@ -204,7 +246,7 @@ try {
   p.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
   await p.goto(`${base}/render.html`);
   await p.waitForFunction(() => window.sunbeamRender !== undefined, null, { timeout: 60000 });
-  const job = { scene, meshes, size, supersample: opt.supersample, glsl };
+  const job = { scene, meshes, size, supersample: opt.supersample, glsl, env };
   pixels = await p.evaluate((j) => window.sunbeamRender(j), job);
 } catch (e) {
   fail(4, `rendering in Chromium failed: ${e.message}${problems.length ? `\n${problems.join('\n')}` : ''}`);

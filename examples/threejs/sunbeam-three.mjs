@@ -4,10 +4,13 @@
 // The shading code is not a port: it is the GLSL ES 3.00 that
 // `sunbeam-play --export-shader glsl-es` writes from the player's own WGSL
 // (shaders/material.wgsl: the frame, exact Fresnel, G, Smith masking, the
-// diffuse base's share; shaders/response_map.wgsl: the map), adapted here only
-// in its declarations (a plain struct uniform instead of a uniform block, our
-// varyings and light loop instead of its demo entry point). docs/ENGINES.md
-// documents the interface.
+// diffuse base's share; shaders/response_map.wgsl: the map; and the
+// environment: shaders/env_cells.wgsl, the player's first-frame cells, with
+// shaders/export_env.wgsl), adapted here only in its declarations (plain
+// struct uniforms instead of uniform blocks, our varyings and light loop
+// instead of its demo entry point). docs/ENGINES.md documents the interface.
+// An environment comes as the files of `sunbeam-play SCENE
+// --export-environment DIR` (parseEnvironment).
 //
 // The response map (NAME.response.ktx2, docs/PACK_FORMAT.md "Response map") is
 // read with ktx-parse (shipped with three) into a Data3DTexture: RGBA half
@@ -41,6 +44,98 @@ export function parseResponseMap(arrayBuffer) {
   return { texture: tex, grid: g, info };
 }
 
+// ---- the environment (sunbeam-play --export-environment DIR, docs/ENGINES.md "Environment")
+
+function ktxLevels(arrayBuffer, what, vkFormat) {
+  const ktx = readKTX2(new Uint8Array(arrayBuffer));
+  if (ktx.vkFormat !== vkFormat) throw new Error(`${what}: vkFormat ${ktx.vkFormat}, expected ${vkFormat}`);
+  return ktx.levels.map((l, m) => ({
+    width: Math.max(1, ktx.pixelWidth >> m),
+    height: Math.max(1, ktx.pixelHeight >> m),
+    bytes: l.levelData.buffer.slice(l.levelData.byteOffset, l.levelData.byteOffset + l.levelData.byteLength),
+  }));
+}
+
+// An equirectangular RGBA16F texture (repeat in azimuth, clamp in the polar
+// angle, linear; with its levels when given, linear between them).
+function equirectTexture(levels) {
+  const tex = new THREE.DataTexture(new Uint16Array(levels[0].bytes), levels[0].width, levels[0].height, THREE.RGBAFormat, THREE.HalfFloatType);
+  if (levels.length > 1) {
+    tex.mipmaps = levels.map((l) => ({ data: new Uint16Array(l.bytes), width: l.width, height: l.height }));
+    tex.minFilter = THREE.LinearMipmapLinearFilter;
+  } else {
+    tex.minFilter = THREE.LinearFilter;
+  }
+  tex.magFilter = THREE.LinearFilter;
+  tex.wrapS = THREE.RepeatWrapping;
+  tex.wrapT = THREE.ClampToEdgeWrapping;
+  tex.generateMipmaps = false;
+  tex.unpackAlignment = 1;
+  tex.colorSpace = THREE.NoColorSpace;
+  tex.needsUpdate = true;
+  return tex;
+}
+
+/**
+ * The environment for sunbeamMaterial from the files of `sunbeam-play
+ * SCENE.json --export-environment DIR`: `json` (environment.json, parsed),
+ * `chain` (chain.ktx2), `irradianceSkin` (irradiance-skin.ktx2),
+ * `irradiance` (irradiance.ktx2), `cells` and `suns` (objects: file name
+ * -> ArrayBuffer, of every meshes[].file and meshes[].sun). Returns { json,
+ * chain, irrSkin, irrPlain, cells: {file -> texture}, basisToRgb, sun };
+ * `forMesh(i)` the cells (and sun map) of scene mesh i.
+ */
+export function parseEnvironment({ json, chain, irradianceSkin, irradiance, cells, suns = {} }) {
+  if (json.format !== 'sunbeam-environment' || json.version !== 1) throw new Error('environment.json: not a sunbeam-environment version 1');
+  const levels = ktxLevels(chain, 'chain.ktx2', 97);
+  if (levels.length !== json.chain.levels) throw new Error(`chain.ktx2: ${levels.length} levels, environment.json says ${json.chain.levels}`);
+  // WebGL samples a mipmapped texture only with every level down to 1 x 1:
+  // the chain stops at 2 x 1 (or 3 x 1), so add its mean (equal columns: the
+  // same solid angle). The shader never reads past chain.levels - 1.
+  const last = levels[levels.length - 1];
+  if (last.width > 1 || last.height > 1) {
+    const h = new Uint16Array(last.bytes);
+    const n = h.length / 4;
+    const mean = new Uint16Array(4);
+    for (let c = 0; c < 4; c++) {
+      let acc = 0;
+      for (let i = 0; i < n; i++) acc += THREE.DataUtils.fromHalfFloat(h[4 * i + c]);
+      mean[c] = THREE.DataUtils.toHalfFloat(acc / n);
+    }
+    levels.push({ width: 1, height: 1, bytes: mean.buffer });
+  }
+  const out = {
+    json,
+    chain: equirectTexture(levels),
+    irrSkin: equirectTexture(ktxLevels(irradianceSkin, 'irradiance-skin.ktx2', 97).slice(0, 1)),
+    irrPlain: equirectTexture(ktxLevels(irradiance, 'irradiance.ktx2', 97).slice(0, 1)),
+    cells: {},
+    basisToRgb: json.basis_to_rgb,
+    sun: json.sun,
+  };
+  for (const [file, buf] of Object.entries(cells)) {
+    const [l] = ktxLevels(buf, file, 98);
+    const tex = new THREE.DataTexture(new Uint32Array(l.bytes), l.width, l.height, THREE.RedIntegerFormat, THREE.UnsignedIntType);
+    tex.internalFormat = 'R32UI';
+    tex.minFilter = THREE.NearestFilter;
+    tex.magFilter = THREE.NearestFilter;
+    tex.generateMipmaps = false;
+    tex.unpackAlignment = 1;
+    tex.needsUpdate = true;
+    out.cells[file] = tex;
+  }
+  const sunMaps = {};
+  for (const [file, buf] of Object.entries(suns)) sunMaps[file] = parseResponseMap(buf);
+  out.forMesh = (i) => {
+    const m = json.meshes.find((e) => e.mesh === i);
+    if (!m) return null;
+    const sun = m.sun ? sunMaps[m.sun] : null;
+    if (m.sun && !sun) throw new Error(`environment: ${m.sun} not given`);
+    return { texture: out.cells[m.file], nTop: m.n_top, nS: m.n_s, nodes: m.nodes, sun, sunGrid: m.sun_grid };
+  };
+  return out;
+}
+
 /** The exported GLSL ES with its declarations adapted for a three.js RawShaderMaterial. */
 export function adaptExportedGlsl(src) {
   const lines = src.split('\n');
@@ -50,15 +145,18 @@ export function adaptExportedGlsl(src) {
     if (l.startsWith('void main()')) break; // the demo entry point: ours follows
     if (/^smooth in vec3 _vs2fs_location\d;/.test(l)) continue;
     if (l.startsWith('layout(location = 0) out vec4')) continue;
-    if (l.startsWith('layout(std140) uniform SunbeamMaterial_block')) {
-      out.push('uniform SunbeamMaterial _group_0_binding_0_fs;');
+    // naga's uniform blocks (the material's, the environment's) as plain struct uniforms
+    const block = /^layout\(std140\) uniform (\w+)_block_\d+Fragment \{ (\w+) (\w+); \};/.exec(l);
+    if (block) {
+      out.push(`uniform ${block[2]} ${block[3]};`);
       continue;
     }
     out.push(l);
   }
   const text = out.join('\n');
-  if (!text.includes('vec3 sunbeam_shade(') || !text.includes('mat3x3 sb_frame(') || !text.includes('_group_0_binding_1_fs')) {
-    throw new Error('exported GLSL: sunbeam_shade, sb_frame or the map binding not found (docs/ENGINES.md)');
+  for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun(', 'vec3 sunbeam_shade_environment(', 'mat3x3 sb_frame(',
+    'uniform SunbeamMaterial _group_0_binding_0_fs;', 'uniform SunbeamEnvironment _group_0_binding_8_fs;', '_group_0_binding_1_fs', '_group_0_binding_7_fs', '_group_0_binding_9_fs']) {
+    if (!text.includes(need)) throw new Error(`exported GLSL: ${need} not found (docs/ENGINES.md; export it with this sunbeam-play)`);
   }
   return text;
 }
@@ -129,6 +227,7 @@ uniform vec4 sbLights[${MAX_LIGHTS}]; // xyz towards the light (unit), w intensi
 uniform float sbExposure;              // 2^exposure
 uniform int sbHasMap;
 uniform int sbDisplay;                 // 1: clip at 1 and sRGB-encode (drawing to a canvas)
+uniform int sbEnvOn;                   // 1: lit by an environment (parseEnvironment)
 in vec3 vWorld;
 in vec3 vNormal;
 in vec3 vOrient;
@@ -152,6 +251,20 @@ void main() {
     }
     rgb += sbLights[i].w * c;
   }
+  if (sbEnvOn == 1) {
+    // The environment without its sun (the exported sunbeam_shade_environment:
+    // the player's first-frame cells), then the sky's sun from its centre
+    // (sunbeam_shade_sun: its own spectral map).
+    const float PI = 3.141592653589793;
+    vec3 base = _group_0_binding_0_fs.base.rgb;
+    vec4 sun = _group_0_binding_8_fs.sun_dir;
+    if (sbHasMap == 1) {
+      rgb += sunbeam_shade_environment(t, b, n, wr) + sunbeam_shade_sun(t, b, n, sun.xyz, wr);
+    } else {
+      rgb += base * env_irradiance(false, n) / PI;
+      if (sun.w > 0.0) rgb += base * _group_0_binding_8_fs.sun_rgb.rgb * max(dot(sun.xyz, n), 0.0) / PI;
+    }
+  }
   vec3 c = rgb * sbExposure;
   if (sbDisplay == 1) {
     // sunbeam_optics::colour: clip, then the sRGB curve (what sunbeam-play writes).
@@ -169,10 +282,15 @@ void main() {
  * default, or 'relative'), `rmsSlope` (Smith masking's [x, y] rms slopes;
  * [0, 0]: none; see maskingSlope), `lights` [{direction: [x, y, z] towards the
  * light, intensity}], `exposure` in stops, `display`: clip and sRGB-encode
- * (for a canvas; off for linear float targets). Uniforms can be changed later
+ * (for a canvas; off for linear float targets), `environment`: from
+ * parseEnvironment (or null), with `envCells` its cells for this mesh
+ * (environment.forMesh(i)): the environment lights the mesh through the
+ * exported sunbeam_shade_environment and its sun through sunbeam_shade_sun;
+ * the mesh's `ior` must be the one the transmitted irradiance was made for
+ * (environment.json irradiance.ior). Uniforms can be changed later
  * (material.uniforms; the skin through skinUniform).
  */
-export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, ior = 1.5, reflectance = 'absolute', rmsSlope = [0, 0], lights = [], exposure = 0, display = false }) {
+export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, ior = 1.5, reflectance = 'absolute', rmsSlope = [0, 0], lights = [], exposure = 0, display = false, environment = null, envCells = null }) {
   const g = map ? map.grid : { n_theta: 1, n_rho: 2, n_s: 2, r0: 1 };
   const lightVecs = [];
   for (let i = 0; i < MAX_LIGHTS; i++) {
@@ -184,6 +302,17 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
   const placeholder = new THREE.Data3DTexture(new Uint16Array(4 * 2 * 2), 1, 2, 2);
   placeholder.type = THREE.HalfFloatType;
   placeholder.needsUpdate = true;
+  // Stand-ins of the environment's textures (each sampler needs a texture of its type).
+  const flat = new THREE.DataTexture(new Uint16Array(4), 1, 1, THREE.RGBAFormat, THREE.HalfFloatType);
+  flat.needsUpdate = true;
+  const noCells = new THREE.DataTexture(new Uint32Array(1), 1, 1, THREE.RedIntegerFormat, THREE.UnsignedIntType);
+  noCells.internalFormat = 'R32UI';
+  noCells.needsUpdate = true;
+  const env = environment;
+  if (env && map && Math.abs(env.json.irradiance.ior - ior) > 1e-6) {
+    throw new Error(`environment: the transmitted irradiance is for index ${env.json.irradiance.ior}, the mesh's is ${ior}`);
+  }
+  const sun = env?.sun;
   const m = new THREE.RawShaderMaterial({
     glslVersion: THREE.GLSL3,
     vertexShader: VERTEX,
@@ -196,7 +325,23 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
       sbExposure: { value: Math.pow(2, exposure) },
       sbHasMap: { value: map ? 1 : 0 },
       sbDisplay: { value: display ? 1 : 0 },
+      sbEnvOn: { value: env ? 1 : 0 },
       _group_0_binding_1_fs: { value: map ? map.texture : placeholder },
+      _group_0_binding_3_fs: { value: env ? env.chain : flat },
+      _group_0_binding_4_fs: { value: env ? env.irrSkin : flat },
+      _group_0_binding_5_fs: { value: env ? env.irrPlain : flat },
+      _group_0_binding_7_fs: { value: envCells ? envCells.texture : noCells },
+      _group_0_binding_9_fs: { value: envCells?.sun ? envCells.sun.texture : placeholder },
+      _group_0_binding_8_fs: {
+        value: {
+          cells: new THREE.Vector4(envCells ? envCells.nTop : 0, envCells ? envCells.nS : 2, envCells ? envCells.nodes : 0, 0),
+          chain: new THREE.Vector4(env ? env.json.chain.height : 1, env ? env.json.chain.levels : 1, 0, 0),
+          sun_dir: sun ? new THREE.Vector4(...sun.direction, 1) : new THREE.Vector4(),
+          sun_rgb: sun ? new THREE.Vector4(...sun.rgb, 0) : new THREE.Vector4(),
+          // a mesh without its sun map: n_theta 0 (no diffraction from the sun)
+          sun_grid: envCells?.sun ? new THREE.Vector4(...envCells.sunGrid) : new THREE.Vector4(0, 2, 2, 1),
+        },
+      },
       _group_0_binding_0_fs: {
         value: {
           grid: new THREE.Vector4(g.n_theta, g.n_rho, g.n_s, 0),
@@ -337,4 +482,53 @@ export function sceneCamera(scene, aspect) {
   cam.lookAt(target);
   cam.updateMatrixWorld();
   return cam;
+}
+
+/**
+ * `"background": "environment"` (docs/SCENE.md): a full-screen triangle,
+ * drawn first, showing the environment along each pixel's view ray as the
+ * player's background pass does: the exported sb_env_texel (the texel of the
+ * coefficient table holding the direction; here level 0 of the chain) times
+ * basis_to_rgb, times 2^exposure. `camera` is the scene camera.
+ */
+export function environmentBackground(exportedGlsl, environment, camera, exposure = 0) {
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array([-1, -1, 0, 3, -1, 0, -1, 3, 0]), 3));
+  const m = environment.basisToRgb;
+  const material = new THREE.RawShaderMaterial({
+    glslVersion: THREE.GLSL3,
+    vertexShader: `precision highp float;
+in vec3 position;
+out vec2 vNdc;
+void main() { vNdc = position.xy; gl_Position = vec4(position.xy, 1.0, 1.0); }`,
+    fragmentShader: `${exportedGlsl}
+uniform mat4 sbInvViewProj;
+uniform vec3 sbEye;
+uniform mat3 sbBasisToRgb;
+uniform uvec2 sbTable;
+uniform float sbExposure;
+uniform highp sampler2D sbChain;
+in vec2 vNdc;
+layout(location = 0) out vec4 fragColor;
+void main() {
+  vec4 p = sbInvViewProj * vec4(vNdc, 1.0, 1.0);
+  vec3 d = normalize(p.xyz / p.w - sbEye);
+  fragColor = vec4(sbBasisToRgb * sb_env_texel(sbChain, sbTable.x, sbTable.y, d) * sbExposure, 1.0);
+}`,
+    uniforms: {
+      sbInvViewProj: { value: new THREE.Matrix4().multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse).invert() },
+      sbEye: { value: new THREE.Vector3().setFromMatrixPosition(camera.matrixWorld) },
+      // row-major rows of environment.json, as three's Matrix3.set takes them
+      sbBasisToRgb: { value: new THREE.Matrix3().set(...m[0], ...m[1], ...m[2]) },
+      sbTable: { value: new THREE.Vector2(environment.json.chain.width, environment.json.chain.height) },
+      sbExposure: { value: Math.pow(2, exposure) },
+      sbChain: { value: environment.chain },
+    },
+    depthTest: false,
+    depthWrite: false,
+  });
+  const mesh = new THREE.Mesh(geometry, material);
+  mesh.frustumCulled = false;
+  mesh.renderOrder = -1;
+  return mesh;
 }

@@ -87,7 +87,7 @@ pub(crate) struct EnvProposalU {
 
 /// XYZ (scene units, the response maps' normalisation: 1 nm sums over
 /// 380..780 nm divided by `sum D65 ybar`) of a spectrum.
-fn spectrum_xyz(f: impl Fn(f64) -> f64) -> [f64; 3] {
+pub(crate) fn spectrum_xyz(f: impl Fn(f64) -> f64) -> [f64; 3] {
     let range = cie::DEFAULT_RANGE_NM;
     let norm = cie::d65_y_norm(range);
     let mut xyz = [0.0; 3];

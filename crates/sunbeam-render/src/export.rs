@@ -3,7 +3,9 @@
 //! (shaders/material.wgsl: Fresnel, G, Smith masking, the diffuse base's share
 //! and the frame; shaders/response_map.wgsl; plus the engine interface in
 //! shaders/export.wgsl: one uniform block, the map, its sampler,
-//! `sunbeam_shade(t, b, n, wi, wr)`).
+//! `sunbeam_shade(t, b, n, wi, wr)`; the environment: shaders/env_cells.wgsl,
+//! the player's first-frame cells, with shaders/export_env.wgsl reading their
+//! data from textures, `sunbeam_shade_environment(t, b, n, wr)`).
 //! docs/ENGINES.md documents the interface and how each engine takes it.
 //! naga does the translation (it is already in the tree through wgpu) rather
 //! than hand-kept copies per language, so the languages cannot drift apart.
@@ -14,7 +16,10 @@ use sunbeam_common::{Error, Result};
 pub const SOURCE: &str = concat!(
     include_str!("../../../shaders/material.wgsl"),
     include_str!("../../../shaders/response_map.wgsl"),
-    include_str!("../../../shaders/export.wgsl")
+    include_str!("../../../shaders/export.wgsl"),
+    include_str!("../../../shaders/env_table.wgsl"),
+    include_str!("../../../shaders/export_env.wgsl"),
+    include_str!("../../../shaders/env_cells.wgsl")
 );
 
 /// The fragment entry point that shows the call (the function engines use is

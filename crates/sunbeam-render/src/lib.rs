@@ -15,6 +15,7 @@
 
 pub mod accum;
 pub mod env;
+pub mod env_export;
 pub mod export;
 pub mod gpu;
 pub mod renderer;

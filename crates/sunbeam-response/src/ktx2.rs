@@ -68,23 +68,113 @@ pub(crate) fn encode_texture(
     size: [usize; 3],
     data: &[u16],
 ) -> Vec<u8> {
-    let dfd = dfd();
+    let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+    encode_levels(
+        VK_R16G16B16A16_SFLOAT,
+        2,
+        dfd(),
+        key,
+        info_json,
+        size,
+        &[bytes],
+    )
+}
+
+/// VK_FORMAT_R32_UINT.
+pub const VK_R32_UINT: u32 = 98;
+
+/// The data format descriptor of R32_UINT: one 32-bit unsigned sample.
+fn dfd_r32_uint() -> Vec<u8> {
+    let block = 24 + 16;
+    let mut d = Vec::with_capacity(4 + block);
+    d.extend_from_slice(&((4 + block) as u32).to_le_bytes());
+    d.extend_from_slice(&0u32.to_le_bytes()); // Khronos, basic descriptor
+    d.extend_from_slice(&(2u32 | ((block as u32) << 16)).to_le_bytes());
+    d.extend_from_slice(&[1, 1, 1, 0]); // RGBSDA, BT.709 primaries, linear, flags 0
+    d.extend_from_slice(&[0, 0, 0, 0]); // 1x1x1x1 block
+    d.extend_from_slice(&[4, 0, 0, 0, 0, 0, 0, 0]);
+    d.extend_from_slice(&(31u32 << 16).to_le_bytes()); // R, 32 bits, unsigned integer
+    d.extend_from_slice(&0u32.to_le_bytes());
+    d.extend_from_slice(&0u32.to_le_bytes());
+    d.extend_from_slice(&u32::MAX.to_le_bytes());
+    d
+}
+
+/// A 2D texture for engines (`sunbeam-play --export-environment`), as KTX2
+/// bytes (deterministic), `info_json` under `key`.
+pub enum Texture2d<'a> {
+    /// RGBA16F (f16 bits, rows top first), with its mip levels: `(width,
+    /// height, texels)` level 0 first.
+    Rgba16f(&'a [(usize, usize, Vec<u16>)]),
+    /// R32_UINT, one level.
+    R32u(usize, usize, &'a [u32]),
+}
+
+/// Encode a [`Texture2d`].
+pub fn encode_2d(key: &str, info_json: &str, t: &Texture2d<'_>) -> Vec<u8> {
+    match t {
+        Texture2d::Rgba16f(levels) => {
+            let bytes: Vec<Vec<u8>> = levels
+                .iter()
+                .map(|(_, _, d)| d.iter().flat_map(|v| v.to_le_bytes()).collect())
+                .collect();
+            let (w, h, _) = &levels[0];
+            encode_levels(
+                VK_R16G16B16A16_SFLOAT,
+                2,
+                dfd(),
+                key,
+                info_json,
+                [*w, *h, 0],
+                &bytes,
+            )
+        }
+        Texture2d::R32u(w, h, data) => {
+            let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+            encode_levels(
+                VK_R32_UINT,
+                4,
+                dfd_r32_uint(),
+                key,
+                info_json,
+                [*w, *h, 0],
+                &[bytes],
+            )
+        }
+    }
+}
+
+/// The container around `levels` (level 0 first; stored smallest first, as
+/// KTX 2.0 section 3.9 asks, each at a multiple of 8 bytes).
+fn encode_levels(
+    vk_format: u32,
+    type_size: u32,
+    dfd: Vec<u8>,
+    key: &str,
+    info_json: &str,
+    size: [usize; 3],
+    levels: &[Vec<u8>],
+) -> Vec<u8> {
     let kvd = kvd(key, info_json);
-    let dfd_off = HEADER_LEN + LEVEL_INDEX_LEN;
+    let dfd_off = HEADER_LEN + LEVEL_INDEX_LEN * levels.len();
     let kvd_off = dfd_off + dfd.len();
-    let data_off = (kvd_off + kvd.len()).div_ceil(TEXEL) * TEXEL;
-    let data_len = data.len() * 2;
-    let mut out = Vec::with_capacity(data_off + data_len);
+    let mut offsets = vec![0usize; levels.len()];
+    let mut at = (kvd_off + kvd.len()).div_ceil(TEXEL) * TEXEL;
+    for (m, level) in levels.iter().enumerate().rev() {
+        offsets[m] = at;
+        at = (at + level.len()).div_ceil(TEXEL) * TEXEL;
+    }
+    let mut out = Vec::with_capacity(at);
     out.extend_from_slice(&IDENTIFIER);
     for v in [
-        VK_R16G16B16A16_SFLOAT,
-        2, // typeSize
+        vk_format,
+        type_size,
         size[0] as u32,
         size[1] as u32,
         size[2] as u32,
         0, // layerCount
         1, // faceCount
-        1, // levelCount
+        levels.len() as u32,
         0, // supercompression
         dfd_off as u32,
         dfd.len() as u32,
@@ -95,14 +185,17 @@ pub(crate) fn encode_texture(
     }
     out.extend_from_slice(&0u64.to_le_bytes()); // sgd offset
     out.extend_from_slice(&0u64.to_le_bytes()); // sgd length
-    for v in [data_off as u64, data_len as u64, data_len as u64] {
-        out.extend_from_slice(&v.to_le_bytes());
+    for (m, level) in levels.iter().enumerate() {
+        let len = level.len() as u64;
+        for v in [offsets[m] as u64, len, len] {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
     }
     out.extend_from_slice(&dfd);
     out.extend_from_slice(&kvd);
-    out.resize(data_off, 0);
-    for v in data {
-        out.extend_from_slice(&v.to_le_bytes());
+    for (m, level) in levels.iter().enumerate().rev() {
+        out.resize(offsets[m], 0);
+        out.extend_from_slice(level);
     }
     out
 }

@@ -116,6 +116,12 @@ pub(crate) struct Cli {
     /// glsl (4.50), glsl-es (3.00, WebGL2), hlsl, msl, spv (SPIR-V), wgsl (docs/ENGINES.md).
     #[arg(long, value_name = "LANG", value_parser = sunbeam_common::cli::one_of::<sunbeam_render::export::Lang>(&sunbeam_render::export::Lang::NAMES))]
     pub(crate) export_shader: Option<sunbeam_render::export::Lang>,
+    /// Write the scene's environment for engines into DIR and exit: its prefiltered
+    /// table, irradiance tables and each pack's cells, as KTX2, with
+    /// environment.json (what `sunbeam_shade_environment` of --export-shader binds;
+    /// docs/ENGINES.md "Environment"). Needs a scene with "environment".
+    #[arg(long, value_name = "DIR")]
+    pub(crate) export_environment: Option<PathBuf>,
     /// Less output.
     #[arg(short, long)]
     pub(crate) quiet: bool,

@@ -105,6 +105,7 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
         msaa,
         footprint: !cli.no_footprint,
         env_hot_spots: cli.env_hot_spots as usize,
+        env_cells: (cli.env_cells as usize, sunbeam_render::env::ENV_CELLS_DEPTH),
         ..Default::default()
     })
 }
@@ -135,6 +136,9 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     }
     let scene = load_scene(&cli)?;
     let st = settings(&cli, &scene)?;
+    if let Some(dir) = &cli.export_environment {
+        return export_environment(&scene, &st, dir, cli.quiet);
+    }
     let backend: Backend = cli.backend;
     // The default mode draws with the response maps: a pack with current maps
     // beside it is read as its manifest only (the CPU renderer needs the terms,
@@ -322,6 +326,36 @@ fn export_shader(lang: sunbeam_render::export::Lang, cli: &Cli) -> Result<()> {
             "sunbeam-play: wrote {} ({} bytes)",
             out.display(),
             bytes.len()
+        );
+    }
+    Ok(())
+}
+
+/// `SCENE.json --export-environment DIR`: the environment's files for engines
+/// (sunbeam_render::env_export, docs/ENGINES.md "Environment").
+fn export_environment(
+    scene: &Scene,
+    st: &Settings,
+    dir: &std::path::Path,
+    quiet: bool,
+) -> Result<()> {
+    let prepared =
+        sunbeam_frame::prepare_with(scene, &sunbeam_render::response::load_pack_for_environment)?;
+    if let Some((line, _)) = sunbeam_frame::environment_clamped_warning(&prepared) {
+        if !quiet {
+            eprintln!("sunbeam-play: warning: {line}");
+        }
+    }
+    let (files, notes) =
+        sunbeam_render::env_export::export(&prepared, &st.response, st.env_cells, dir)?;
+    if !quiet {
+        for n in &notes {
+            eprintln!("sunbeam-play: {n}");
+        }
+        eprintln!(
+            "sunbeam-play: wrote {} files into {}",
+            files.len(),
+            dir.display()
         );
     }
     Ok(())

@@ -49,6 +49,19 @@ fn glsl_passes_glslang() {
         for m in ["vec4 skin;", "sb_fresnel(", "sb_masking(", "sb_frame("] {
             assert!(text.contains(m), "{lang}: missing {m}");
         }
+        // The environment (docs/ENGINES.md "Environment"): the player's cells
+        // read from an unsigned integer texture, the prefiltered chain, the
+        // environment's numbers, the sun as a light.
+        for m in [
+            "vec3 sunbeam_shade_environment(",
+            "vec3 sunbeam_shade_sun(",
+            "vec3 env_cells(",
+            "usampler2D _group_0_binding_7_fs",
+            "sampler2D _group_0_binding_3_fs",
+            "vec4 cells;",
+        ] {
+            assert!(text.contains(m), "{lang}: missing {m}");
+        }
         if have_command("glslangValidator", &["--version"]) {
             let o = Command::new("glslangValidator").arg(&f).output().unwrap();
             assert!(
@@ -109,11 +122,20 @@ fn hlsl_msl_wgsl_are_written_with_the_interface() {
                 "cbuffer sunbeam",
                 "float4 skin",
                 "sb_masking(",
+                "sunbeam_shade_environment(",
+                "sunbeam_shade_sun(",
+                "Texture2D<uint4>",
             ][..],
         ),
         (
             "msl",
-            &["sunbeam_shade(", "texture3d<float", "sb_masking("][..],
+            &[
+                "sunbeam_shade(",
+                "texture3d<float",
+                "sb_masking(",
+                "sunbeam_shade_environment(",
+                "texture2d<uint",
+            ][..],
         ),
         (
             "wgsl",
@@ -125,6 +147,9 @@ fn hlsl_msl_wgsl_are_written_with_the_interface() {
                 "fn sb_masking(",
                 "fn sb_frame(",
                 "skin: vec4<f32>",
+                "fn sunbeam_shade_environment(",
+                "fn env_cells(",
+                "texture_2d<u32>",
             ][..],
         ),
     ] {

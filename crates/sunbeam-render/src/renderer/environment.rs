@@ -36,10 +36,7 @@ pub(super) fn of_scene(p: &Prepared, mode: Mode) -> Result<Option<Arc<Environmen
 pub(super) type BuiltMaps = Vec<(*const Pack, Arc<crate::env::EnvMaps>)>;
 
 /// The extended-light maps of `pack` (meshes[`mi`], read from `path`) under
-/// `env`, once per pack (`built`): read from the pack's
-/// `NAME.env-response.ktx2` (`sunbeam-pack --response`) when it serves this
-/// pack and environment, else built (what the build took, and why, goes to
-/// `notes`). A file that cannot be read is an input error naming it.
+/// `env` on the GPU, once per pack (`built`; [`response`] reads or builds them).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn maps(
     gpu: &crate::gpu::Gpu,
@@ -56,6 +53,25 @@ pub(super) fn maps(
     if let Some((_, m)) = built.iter().find(|(k, _)| *k == key) {
         return Ok(m.clone());
     }
+    let er = response(env, pack, path, mi, opts, notes)?;
+    let m = Arc::new(crate::env::EnvMaps::new(gpu, &er, cells)?);
+    built.push((key, m.clone()));
+    Ok(m)
+}
+
+/// The extended-light maps of `pack` (meshes[`mi`], read from `path`) under
+/// `env`: read from the pack's `NAME.env-response.ktx2` (`sunbeam-pack
+/// --response`) when it serves this pack and environment, else built (what
+/// the build took, and why, goes to `notes`). A file that cannot be read is
+/// an input error naming it. Also what `--export-environment` writes from.
+pub(crate) fn response(
+    env: &Environment,
+    pack: &Arc<Pack>,
+    path: Option<&Path>,
+    mi: usize,
+    opts: &sunbeam_response::Options,
+    notes: &mut Vec<String>,
+) -> Result<sunbeam_response::env::EnvResponse> {
     let t0 = std::time::Instant::now();
     let side = path.map(env_file::sidecar_path).filter(|p| p.is_file());
     let mut stale = None;
@@ -67,9 +83,7 @@ pub(super) fn maps(
                     side.display(),
                     t0.elapsed()
                 );
-                let m = Arc::new(crate::env::EnvMaps::new(gpu, &er, cells)?);
-                built.push((key, m.clone()));
-                return Ok(m);
+                return Ok(er);
             }
             Err(why) => stale = Some(format!("{} {why}; ", side.display())),
         }
@@ -111,7 +125,5 @@ pub(super) fn maps(
         er.proposal.offsets.len(),
         t0.elapsed().as_secs_f64()
     ));
-    let m = Arc::new(crate::env::EnvMaps::new(gpu, &er, cells)?);
-    built.push((key, m.clone()));
-    Ok(m)
+    Ok(er)
 }

@@ -43,8 +43,8 @@ use wgpu::util::DeviceExt;
 /// material (shaders/response_map.wgsl; both also what `--export-shader`
 /// translates), the scale maps' frame (shaders/scales.wgsl), the player's
 /// shading (shaders/diffraction.wgsl) and the environment's estimators
-/// (shaders/environment.wgsl, with the hot spots' lights in
-/// shaders/env_hotspots.wgsl).
+/// (shaders/environment.wgsl; shaders/env_cells.wgsl: the cells, shared with
+/// the export; shaders/env_hotspots.wgsl: a map's hot spots as lights).
 pub const SHADER: &str = concat!(
     include_str!("../../../../shaders/material.wgsl"),
     include_str!("../../../../shaders/scales.wgsl"),
@@ -53,6 +53,7 @@ pub const SHADER: &str = concat!(
     include_str!("../../../../shaders/response_map.wgsl"),
     include_str!("../../../../shaders/diffraction.wgsl"),
     include_str!("../../../../shaders/environment.wgsl"),
+    include_str!("../../../../shaders/env_cells.wgsl"),
     include_str!("../../../../shaders/env_hotspots.wgsl")
 );
 

@@ -1,0 +1,108 @@
+// The first-frame cells (docs/LIGHTING.md "The first frame"), one source
+// for the player (appended after shaders/environment.wgsl) and the engines'
+// export (after shaders/export_env.wgsl): the pack's extended-light response
+// clustered into cells (sunbeam_response::cells::Cells::gpu_data), each
+// evaluated per shading point against the prefiltered coefficient table
+// (sunbeam_light::prefilter), and the irradiance tables of the diffuse base.
+//
+// Needs shaders/material.wgsl (sb_erf), shaders/response_map.wgsl (SB_TAU)
+// and shaders/env_table.wgsl (sb_env_equirect) before it. The host supplies
+// the data, so that the player reads a storage buffer and the export a data
+// texture (WebGL2 has no storage buffers):
+//   env_cell_f32(i), env_cell_u32(i): float i of Cells::gpu_data, as a float
+//     or as its bits (the child pointers);
+//   env_cells_top(): cells of the top cut; env_cells_nodes(): every node;
+//   env_cells_layers(): the maps' s layers;
+//   env_cells_gain(wi, wr): the mesh's gain G with its masking;
+//   env_chain_height(), env_chain_levels(): the chain's level-0 height and levels;
+//   env_chain_read(uv, level): the chain at equirectangular uv, trilinear;
+//   env_irradiance_read(skin, uv): a table (skin: transmitted, else plain).
+
+const ENV_PI: f32 = 3.141592653589793;
+
+// The coefficients at d averaged over about omega steradians
+// (Prefiltered::lookup: the level whose texel's polar extent squared is omega).
+fn env_prefiltered(d: vec3<f32>, omega: f32) -> vec3<f32> {
+    let texel = ENV_PI / f32(env_chain_height());
+    let level = clamp(0.5 * log2(max(omega, 1e-30) / (texel * texel)), 0.0, f32(env_chain_levels() - 1u));
+    return env_chain_read(sb_env_equirect(d), level);
+}
+
+// Cells refine near the horizon while their spread times this reaches it
+// (sunbeam_response::cells::REFINE).
+const ENV_REFINE: f32 = 2.0;
+// Cells::gpu_data: floats per node before its masses, and "no node".
+const ENV_CELL_HEADER: u32 = 5u;
+const ENV_CELL_NONE: u32 = 0xffffffffu;
+
+// The diffraction part (XYZ) of the environment without the sun at local
+// view wr, frame (t, b, n): each cell's mass at its layer times G / cos and
+// the prefiltered coefficients at its centroid (Cells::estimate, the CPU
+// twin; docs/LIGHTING.md "The first frame").
+fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    var xyz = vec3<f32>(0.0);
+    let ns = env_cells_layers();
+    let stride = ENV_CELL_HEADER + 9u * ns;
+    if (env_cells_top() == 0u) {
+        return xyz;
+    }
+    // A depth-first walk threaded by each node's `next` (Cells::gpu_data): one
+    // index and no stack, whose dynamic indexing would live in local memory.
+    // Each node is visited at most once, which bounds the loop.
+    let n_nodes = env_cells_nodes();
+    var id = 0u;
+    for (var visit = 0u; visit < n_nodes && id != ENV_CELL_NONE; visit = visit + 1u) {
+        let o = id * stride;
+        let uv = vec2<f32>(env_cell_f32(o), env_cell_f32(o + 1u));
+        let spread = env_cell_f32(o + 2u);
+        let first = env_cell_u32(o + 3u);
+        let wxy = -uv - wr.xy;
+        let l = length(wxy);
+        let dist = 1.0 - l;
+        if (first != ENV_CELL_NONE && dist < ENV_REFINE * spread) {
+            id = first;
+            continue;
+        }
+        id = env_cell_u32(o + 4u);
+        var inside = select(0.0, 1.0, dist > 0.0);
+        if (spread > 0.0) {
+            inside = 0.5 * (1.0 + sb_erf(dist / (1.4142135623730951 * spread)));
+        }
+        if (inside <= 0.0 || dist <= -0.5) {
+            continue;
+        }
+        var w2 = wxy;
+        if (l > 0.999) {
+            w2 = wxy * (0.999 / l);
+        }
+        let wi = vec3<f32>(w2, sqrt(max(1.0 - dot(w2, w2), 0.0)));
+        let r = length(uv);
+        let s = clamp((wi.z + wr.z) / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
+        let sc = s * f32(ns - 1u);
+        let k0 = min(u32(floor(sc)), ns - 2u);
+        let f = sc - f32(k0);
+        let gw = env_cells_gain(wi, wr) / wi.z * inside;
+        if (!(gw > 0.0)) {
+            continue;
+        }
+        let omega = max(SB_TAU * spread * spread / wi.z, 1e-9);
+        let c = env_prefiltered(wi.x * t + wi.y * b + wi.z * n, omega);
+        let m0 = o + ENV_CELL_HEADER + k0 * 9u;
+        let m1 = m0 + 9u;
+        var e = vec3<f32>(0.0);
+        for (var bb = 0u; bb < 3u; bb = bb + 1u) {
+            let a0 = vec3<f32>(env_cell_f32(m0 + 3u * bb), env_cell_f32(m0 + 3u * bb + 1u), env_cell_f32(m0 + 3u * bb + 2u));
+            let a1 = vec3<f32>(env_cell_f32(m1 + 3u * bb), env_cell_f32(m1 + 3u * bb + 1u), env_cell_f32(m1 + 3u * bb + 2u));
+            e = e + c[bb] * mix(a0, a1, f);
+        }
+        xyz = xyz + gw * e;
+    }
+    return xyz;
+}
+
+// Irradiance (linear sRGB, without the sun) at world normal n from a table
+// over normals (Irradiance::at: bilinear, azimuth wraps): the transmitted
+// one under a skin, else the plain one.
+fn env_irradiance(skin: bool, n: vec3<f32>) -> vec3<f32> {
+    return env_irradiance_read(skin, sb_env_equirect(n));
+}

@@ -1,0 +1,135 @@
+// The environment in the engines' export (docs/ENGINES.md "Environment"):
+// the data access shaders/env_cells.wgsl asks of its host, from textures
+// (WebGL2 has no storage buffers), and sunbeam_shade_environment. The files
+// come from `sunbeam-play --export-environment DIR` (sunbeam_render::env_export).
+//
+// Bindings (group 0, after the material's 0 to 2):
+//   3 env_chain: the prefiltered coefficient table, 2D RGBA16F with its mip
+//     levels (equirectangular: u = phi / 2 pi with phi = atan2(z, x), v =
+//     theta / pi from +y; level m is w / 2^m x h / 2^m; chain.ktx2);
+//   4, 5 the irradiance tables without the sun, 2D RGBA16F, one level, the
+//     same coordinates: transmitted through the skin (irradiance-skin.ktx2)
+//     and plain (irradiance.ktx2);
+//   6 env_smp: linear, linear between mip levels, repeat in u, clamp in v;
+//   7 env_cells_tex: the cells, 2D R32UI, float i of Cells::gpu_data (its
+//     bits) at texel (i % width, i / width) (cells.ktx2);
+//   8 sunbeam_env: the numbers (environment.json);
+//   9 env_sun_map: the sky's sun, Omega_sun E_sun over directions: a
+//     response map of the sun's spectrum (sun-I.ktx2, read like the material's
+//     map, with its sampler 2), for sunbeam_shade_sun.
+
+struct SunbeamEnvironment {
+    // the mesh's cells: x the top cut (meshes[].n_top; 0: none), y the maps'
+    // s layers (n_s), z every node (nodes); w unused
+    cells: vec4<f32>,
+    // x: the chain's level-0 height (chain.height), y: its levels
+    // (chain.levels); zw unused
+    chain: vec4<f32>,
+    // xyz: towards the sun's centre (world, unit); w: 1 when the sky's sun
+    // is up (sun.direction), else 0
+    sun_dir: vec4<f32>,
+    // rgb: the sun's Omega L, linear sRGB (sun.rgb); a: unused
+    sun_rgb: vec4<f32>,
+    // the sun map's grid: n_theta, n_rho, n_s, r0 (meshes[].sun_grid)
+    sun_grid: vec4<f32>,
+};
+
+@group(0) @binding(3) var env_chain: texture_2d<f32>;
+@group(0) @binding(4) var env_irr_skin: texture_2d<f32>;
+@group(0) @binding(5) var env_irr_plain: texture_2d<f32>;
+@group(0) @binding(6) var env_smp: sampler;
+@group(0) @binding(7) var env_cells_tex: texture_2d<u32>;
+@group(0) @binding(8) var<uniform> sunbeam_env: SunbeamEnvironment;
+@group(0) @binding(9) var env_sun_map: texture_3d<f32>;
+
+fn env_cell_u32(i: u32) -> u32 {
+    let w = u32(textureDimensions(env_cells_tex, 0).x);
+    return textureLoad(env_cells_tex, vec2<i32>(i32(i % w), i32(i / w)), 0).x;
+}
+
+fn env_cell_f32(i: u32) -> f32 {
+    return bitcast<f32>(env_cell_u32(i));
+}
+
+fn env_cells_top() -> u32 {
+    return u32(sunbeam_env.cells.x);
+}
+
+fn env_cells_nodes() -> u32 {
+    return u32(sunbeam_env.cells.z);
+}
+
+fn env_cells_layers() -> u32 {
+    return u32(sunbeam_env.cells.y);
+}
+
+fn env_cells_gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    return sb_gain(wi, wr, SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw)) * sb_masking(wi, wr, sunbeam.skin.zw);
+}
+
+fn env_chain_height() -> u32 {
+    return u32(sunbeam_env.chain.x);
+}
+
+fn env_chain_levels() -> u32 {
+    return u32(sunbeam_env.chain.y);
+}
+
+fn env_chain_read(uv: vec2<f32>, level: f32) -> vec3<f32> {
+    return textureSampleLevel(env_chain, env_smp, uv, level).xyz;
+}
+
+fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
+    if (skin) {
+        return textureSampleLevel(env_irr_skin, env_smp, uv, 0.0).xyz;
+    }
+    return textureSampleLevel(env_irr_plain, env_smp, uv, 0.0).xyz;
+}
+
+// The environment without its sun, linear sRGB leaving the surface towards
+// wr (frame and directions as sunbeam_shade): the base lit by the
+// transmitted irradiance, dw * base * E(n) / pi, plus (1 - dw) times the
+// cells' diffraction (the player's `--env-estimator cells`, the same
+// functions). The transmitted table is made for one index
+// (environment.json `irradiance.ior`): the material's skin.x must be it.
+fn sunbeam_shade_environment(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
+    if (wr_l.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let dw = sunbeam.warp.z;
+    let base = dw * sunbeam.base.rgb * env_irradiance(true, n) / ENV_PI;
+    if (dw >= 1.0 || env_cells_top() == 0u) {
+        return base;
+    }
+    return base + (1.0 - dw) * sb_xyz_to_linear_srgb(env_cells(t, b, n, wr_l));
+}
+
+
+// The sky's sun from direction wi (towards a point of its disc, e.g. its
+// centre sun_dir; an engine's directional light, with its shadows), linear
+// sRGB towards wr: as the player's sun, (1 - dw) G G2 Omega E_sun read from
+// the sun's own map (the sun's spectrum: a white light tinted by its RGB
+// would not do, a diffraction colour is nearly monochromatic) plus the base
+// lit by the disc, dw * base * Omega L cos (1 - F) / pi. 0 without a sun.
+fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    if (sunbeam_env.sun_dir.w <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
+    let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
+    let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw);
+    let dw = sunbeam.warp.z;
+    var diff = vec3<f32>(0.0);
+    if (wi_l.z > 0.0 && wr_l.z > 0.0 && sunbeam_env.sun_grid.x > 0.0) {
+        let r0 = sunbeam_env.sun_grid.w;
+        let gr = SbGrid(sunbeam_env.sun_grid.xyz, r0, asinh(2.0 / r0));
+        let c = sb_resp_coords(-wi_l - wr_l, gr);
+        let cc = vec3<f32>(c.x, clamp(c.y, 0.0, gr.n.y - 1.0), clamp(c.z, 0.0, gr.n.z - 1.0));
+        let e = textureSampleLevel(env_sun_map, resp_smp, (cc + 0.5) / gr.n, 0.0).xyz;
+        diff = sb_xyz_to_linear_srgb(e * sb_gain(wi_l, wr_l, skin) * sb_masking(wi_l, wr_l, skin.slope));
+    }
+    let cos_i = max(wi_l.z, 0.0);
+    let lit = sunbeam_env.sun_rgb.rgb * cos_i * sb_base_transmission(cos_i, skin.ior, true) / ENV_PI;
+    return dw * sunbeam.base.rgb * lit + (1.0 - dw) * diff;
+}
