@@ -220,10 +220,15 @@ impl EnvScene {
                     split.lights.len(),
                     100.0 * split.share
                 );
+                // the taps once, here: they do not depend on the view
                 light_data = split
                     .lights
                     .iter()
-                    .flat_map(|l| [v4(l.dir, l.spread), v4(l.power, 0.0)])
+                    .flat_map(|l| {
+                        sunbeam_response::hotspots::taps(l)
+                            .into_iter()
+                            .flat_map(|(d, w)| [v4(d, 0.0), v4(l.power.map(|p| p * w), 0.0)])
+                    })
                     .collect();
             }
             sunbeam_light::prefilter::Prefiltered::new(tw, th, split.residual).levels
@@ -517,6 +522,7 @@ fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         },
         count: None,
     };
+    let storage = crate::gpu::fragment_storage_entry;
     let map = |binding| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
@@ -532,16 +538,7 @@ fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         entries: &[
             uniform(0),
             uniform(1),
-            wgpu::BindGroupLayoutEntry {
-                binding: 2,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
+            storage(2),
             map(3),
             map(4),
             map(5),
@@ -565,26 +562,8 @@ fn layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             plain_2d(9),
             plain_2d(10),
             plain_2d(11),
-            wgpu::BindGroupLayoutEntry {
-                binding: 12,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 13,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
+            storage(12),
+            storage(13),
         ],
     })
 }

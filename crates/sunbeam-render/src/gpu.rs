@@ -143,3 +143,18 @@ impl Gpu {
         Ok(())
     }
 }
+
+/// A read-only storage buffer at `binding`, seen by the fragment stage (the
+/// layouts of the material's and the environment's bind groups).
+pub(crate) fn fragment_storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}

@@ -5,46 +5,17 @@
 //! `Cells::gpu_data`), the same bytes on every run, and a scene without an
 //! environment is a usage error that writes nothing. No GPU needed.
 
-use std::path::{Path, PathBuf};
+#[allow(dead_code)] // this test uses the pack builder and the scratch folder only
+mod common;
+
+use common::{pack, scratch};
+use std::path::Path;
 use std::process::Command;
-use sunbeam_pack::{build::BuildOptions, FieldRef, Model};
 
 const BIN: &str = env!("CARGO_BIN_EXE_sunbeam-play");
 
-fn tmp(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("play-export-env-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// A small ridge pack (sinusoidal ridges of 1.3 um, as tests/environment.rs).
-fn ridge_pack(dir: &Path) {
-    let (n, dx, period, amp) = (32usize, 50e-9, 1.3e-6, 420e-9);
-    let data: Vec<f64> = (0..n * n)
-        .map(|k| {
-            let i = (k % n) as f64;
-            0.5 * amp * (1.0 + (2.0 * std::f64::consts::PI * (i * dx) / period).sin())
-        })
-        .collect();
-    let f = FieldRef {
-        width: n,
-        height: n,
-        dx,
-        dy: dx,
-        data: &data,
-    };
-    let opts = BuildOptions {
-        model: Model::Window,
-        ..BuildOptions::default()
-    };
-    let pack = sunbeam_pack::build(f, &opts, &mut |_, _| {}).unwrap();
-    sunbeam_pack::io::write_pack(
-        &pack,
-        &dir.join("ridge.ktx2"),
-        sunbeam_pack::io::OutputKind::Ktx2,
-    )
-    .unwrap();
+fn tmp(name: &str) -> std::path::PathBuf {
+    scratch(&format!("play-export-env-{name}"))
 }
 
 fn u32_at(b: &[u8], o: usize) -> u32 {
@@ -70,7 +41,7 @@ fn ktx2_head(b: &[u8]) -> (u32, u32, u32, Vec<(usize, usize)>) {
 #[test]
 fn writes_the_players_data_deterministically() {
     let d = tmp("sky");
-    ridge_pack(&d);
+    pack(&d, "ridge", "xenopeltis");
     let scene = d.join("sky.json");
     std::fs::write(
         &scene,

@@ -13,16 +13,7 @@ use wgpu::util::DeviceExt;
 /// terms, term table, response table, response map and its sampler, the
 /// scale maps).
 pub(super) fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 2] {
-    let storage_entry = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
+    let storage_entry = crate::gpu::fragment_storage_entry;
     let uniform_entry = |binding| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
