@@ -52,6 +52,32 @@ pub(crate) enum Cmd {
     Render(RenderArgs),
     /// Contact sheet: PNGs on a grid, row by row (the demo's overview picture).
     Sheet(SheetArgs),
+    /// CIEDE2000 of a linear frame (EXR) against a reference frame: all lit, interior and edge pixels; optional error map.
+    Diff(DiffArgs),
+}
+
+#[derive(clap::Args)]
+pub(crate) struct DiffArgs {
+    /// The frame to judge (linear EXR, e.g. `sunbeam-play --headless -o f.exr`).
+    pub(crate) image: PathBuf,
+    /// The reference frame (linear EXR, e.g. `sunbeam-eval render -o r.exr`).
+    pub(crate) reference: PathBuf,
+    /// Write a false-colour PNG of the per-pixel error (black 0, red, yellow at --scale; unlit dark blue).
+    #[arg(long)]
+    pub(crate) heatmap: Option<PathBuf>,
+    /// CIEDE2000 shown as yellow in the heat map.
+    #[arg(long, default_value_t = 10.0, value_parser = positive)]
+    pub(crate) scale: f64,
+    /// Machine-readable report on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+fn positive(s: &str) -> std::result::Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("`{s}` is not a positive number")),
+    }
 }
 
 #[derive(clap::Args)]

@@ -1,7 +1,7 @@
 //! What each subcommand of sunbeam-eval does with its parsed arguments.
 
 use crate::args::*;
-use crate::{bench, brdf, grating_plot, input, probe, render, sheet};
+use crate::{bench, brdf, diff, grating_plot, input, probe, render, sheet};
 use serde_json::json;
 
 use sunbeam_analysis::{compare, grating, sample, Source};
@@ -31,6 +31,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         }
         Cmd::Render(a) => render::run(&a, cli.quiet),
         Cmd::Sheet(a) => sheet::run(&a.output, &a.inputs, a.columns),
+        Cmd::Diff(a) => diff::run(&a.image, &a.reference, a.heatmap.as_deref(), a.scale, a.json),
     }
 }
 

@@ -5,6 +5,7 @@ mod args;
 mod bench;
 mod brdf;
 mod commands;
+mod diff;
 mod grating_plot;
 mod input;
 mod plot;

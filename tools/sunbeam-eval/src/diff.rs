@@ -1,0 +1,102 @@
+//! `sunbeam-eval diff`: CIEDE2000 between a rendered linear frame (EXR) and a
+//! reference frame, the way the tests compare renderers (PHYSICS.md 4: over
+//! the pixels lit in the reference, in linear light before the display
+//! transform), split into the interior of the lit area and its one-pixel
+//! edge (silhouettes, where sub-pixel coverage dominates), with an optional
+//! false-colour map of the per-pixel error to see *where* two renderers
+//! disagree.
+
+use serde_json::json;
+use std::path::Path;
+use sunbeam_common::Result;
+use sunbeam_optics::colour;
+use sunbeam_raster::diff::stats;
+use sunbeam_raster::linear::{interior_pixels, luminance, LIT_Y};
+use sunbeam_raster::{Image, LinearImage};
+
+/// Per-pixel CIEDE2000 of `a` against `reference` (`None` where the
+/// reference is unlit).
+fn per_pixel(a: &LinearImage, reference: &LinearImage) -> Vec<Option<f64>> {
+    a.rgb
+        .iter()
+        .zip(&reference.rgb)
+        .map(|(p, q)| {
+            (luminance(*q) >= LIT_Y).then(|| {
+                colour::ciede2000_xyz(
+                    colour::linear_srgb_to_xyz(p.map(|v| f64::from(v).max(0.0))),
+                    colour::linear_srgb_to_xyz(q.map(|v| f64::from(v).max(0.0))),
+                )
+            })
+        })
+        .collect()
+}
+
+/// Black (0) through red to yellow (at `scale` and above); unlit pixels dark blue.
+fn heat(d: Option<f64>, scale: f64) -> [f32; 3] {
+    match d {
+        None => [0.0, 0.0, 0.15],
+        Some(d) => {
+            let t = (d / scale).clamp(0.0, 1.0) as f32;
+            [(2.0 * t).min(1.0), (2.0 * t - 1.0).max(0.0), 0.0]
+        }
+    }
+}
+
+pub(crate) fn run(
+    image: &Path,
+    reference: &Path,
+    heatmap: Option<&Path>,
+    scale: f64,
+    json_out: bool,
+) -> Result<()> {
+    let a = LinearImage::read_exr(image)?;
+    let r = LinearImage::read_exr(reference)?;
+    if (a.width, a.height) != (r.width, r.height) {
+        return Err(sunbeam_common::Error::input_file(
+            image,
+            format!(
+                "size {}x{} differs from the reference's {}x{}",
+                a.width, a.height, r.width, r.height
+            ),
+        ));
+    }
+    let d = per_pixel(&a, &r);
+    let interior = interior_pixels(&[&r]);
+    let mut is_interior = vec![false; d.len()];
+    for &i in &interior {
+        is_interior[i] = true;
+    }
+    let mut all: Vec<f64> = d.iter().flatten().copied().collect();
+    let mut inner: Vec<f64> = interior.iter().filter_map(|&i| d[i]).collect();
+    let mut edge: Vec<f64> = d
+        .iter()
+        .zip(&is_interior)
+        .filter(|(_, &int)| !int)
+        .filter_map(|(v, _)| *v)
+        .collect();
+    let (all, inner, edge) = (stats(&mut all), stats(&mut inner), stats(&mut edge));
+    if let Some(path) = heatmap {
+        let mut im = Image::new(a.width, a.height);
+        for (px, v) in im.rgb.iter_mut().zip(&d) {
+            *px = heat(*v, scale);
+        }
+        sunbeam_common::output::write_atomic(path, &im.png_bytes()?)?;
+    }
+    if json_out {
+        let s = |c: &sunbeam_raster::ColourDiff| {
+            json!({"mean": c.mean, "p99": c.p99, "max": c.max, "pixels": c.pixels})
+        };
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json!({
+                "all": s(&all), "interior": s(&inner), "edge": s(&edge),
+            }))
+            .expect("a JSON value serializes")
+        );
+    } else {
+        println!("all lit:  {all}");
+        println!("interior: {inner}");
+        println!("edge:     {edge}");
+    }
+    Ok(())
+}
