@@ -31,7 +31,13 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         }
         Cmd::Render(a) => render::run(&a, cli.quiet),
         Cmd::Sheet(a) => sheet::run(&a.output, &a.inputs, a.columns),
-        Cmd::Diff(a) => diff::run(&a.image, &a.reference, a.heatmap.as_deref(), a.scale, a.json),
+        Cmd::Diff(a) => diff::run(
+            &a.image,
+            &a.reference,
+            a.heatmap.as_deref(),
+            a.scale,
+            a.json,
+        ),
     }
 }
 

@@ -83,9 +83,7 @@ pub(crate) fn run(
         sunbeam_common::output::write_atomic(path, &im.png_bytes()?)?;
     }
     if json_out {
-        let s = |c: &sunbeam_raster::ColourDiff| {
-            json!({"mean": c.mean, "p99": c.p99, "max": c.max, "pixels": c.pixels})
-        };
+        let s = |c: &sunbeam_raster::ColourDiff| json!({"mean": c.mean, "p99": c.p99, "max": c.max, "pixels": c.pixels});
         println!(
             "{}",
             serde_json::to_string_pretty(&json!({
