@@ -20,7 +20,8 @@
 //!
 //! Measured (2026-11-26, SwiftShader, 2 cores): with the maps mean 0.013,
 //! p99 0.17, max 0.45 over 2226 lit px; without them mean 2.8, p99 33.5,
-//! max 40.3. About 55 s, most of it the reference (about 40 s).
+//! max 40.3. The run: 88 s on 2 cores shared with other work (load 6; 54 s
+//! of CPU), the reference about 40 s of it, each render.mjs frame 4 s.
 
 mod common;
 
