@@ -6,11 +6,14 @@
 // Bindings (group 0): 0 the material's numbers, 1 the response map (3D texture,
 // RGBA16F from NAME.response.ktx2), 2 its sampler (linear; repeat in x,
 // clamp-to-edge in y and z).
-// Bindings 3 to 9 are the environment's (shaders/export_env.wgsl).
+// Bindings 3 to 9 are the environment's (shaders/export_env.wgsl), 10 and 11
+// the scale maps' (shaders/export_scales.wgsl).
 // Call sunbeam_shade(t, b, n, wi, wr) per light: linear sRGB for a light of
 // intensity 1 (multiply by the light's colour and intensity, sum over lights,
 // then expose and tone-map as the engine does); sb_frame(normal, orientation)
-// gives (t, b, n) from the interpolated attributes as the player does;
+// gives (t, b, n) from the interpolated attributes as the player does, and
+// sunbeam_scale_frame(normal, orientation, tangent, uv, scales) on a mesh
+// with scale maps (sunbeam-bake --scales);
 // sunbeam_shade_environment(t, b, n, wr) adds an environment without its
 // sun, sunbeam_shade_sun(t, b, n, wi, wr) the sky's sun (shaders/export_env.wgsl). The entry point
 // sunbeam_fragment shows the calls with the attributes and the two
@@ -70,11 +73,16 @@ struct SunbeamVaryings {
     @location(1) orientation: vec3<f32>,
     @location(2) wi: vec3<f32>,
     @location(3) wr: vec3<f32>,
+    // a mesh with scale maps (shaders/export_scales.wgsl): the glTF TANGENT,
+    // the maps' TEXCOORD, and `scales` (0: no maps; else 16 plus the wrap bits)
+    @location(4) tangent: vec4<f32>,
+    @location(5) uv: vec2<f32>,
+    @location(6) @interpolate(flat) scales: u32,
 };
 
 @fragment
 fn sunbeam_fragment(v: SunbeamVaryings) -> @location(0) vec4<f32> {
-    let f = sb_frame(v.normal, v.orientation);
+    let f = sunbeam_scale_frame(v.normal, v.orientation, v.tangent, v.uv, v.scales);
     let wr = normalize(v.wr);
     let c = sunbeam_shade(f[0], f[1], f[2], normalize(v.wi), wr) + sunbeam_shade_environment(f[0], f[1], f[2], wr)
         + sunbeam_shade_sun(f[0], f[1], f[2], sunbeam_env.sun_dir.xyz, wr);

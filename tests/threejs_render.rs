@@ -14,63 +14,14 @@
 #[path = "gpu/mod.rs"]
 mod gpu;
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::threejs::{example, measure, ridge_pack};
+use std::path::Path;
 use std::process::Command;
 use sunbeam::{run_ok, scratch, tool, workspace_root};
 use sunbeam_common::testdata;
 use sunbeam_frame::{compare_linear, LinearImage};
-
-/// The example next to a node_modules with three and playwright-core, as a user runs it.
-fn example(d: &Path) -> Option<PathBuf> {
-    if !testdata::have_command("node", &[]) || !testdata::have_command("chromium", &["--version"]) {
-        return None;
-    }
-    let modules = workspace_root().join("tests/node/node_modules");
-    if !modules.join("playwright-core/package.json").exists() {
-        if testdata::require_all() {
-            panic!("tests/node/node_modules/playwright-core missing and SUNBEAM_REQUIRE_ALL=1 (run scripts/ensure-deps.sh)");
-        }
-        eprintln!("SKIP: playwright-core not installed in tests/node/node_modules");
-        return None;
-    }
-    let js = d.join("js");
-    std::fs::create_dir_all(&js).unwrap();
-    for f in ["render.mjs", "render-page.mjs", "sunbeam-three.mjs"] {
-        std::fs::copy(
-            workspace_root().join("examples/threejs").join(f),
-            js.join(f),
-        )
-        .unwrap();
-    }
-    std::os::unix::fs::symlink(&modules, js.join("node_modules")).unwrap();
-    Some(js.join("render.mjs"))
-}
-
-fn ridge_pack(d: &Path, name: &str, size: &str, pixel: &str) -> PathBuf {
-    let h = d.join(format!("{name}.exr"));
-    let p = d.join(format!("{name}.ktx2"));
-    run_ok(
-        Command::new(tool("sunbeam-import"))
-            .args([
-                "synthetic:xenopeltis",
-                "--synthetic-size",
-                size,
-                "--synthetic-pixel",
-                pixel,
-                "-q",
-                "-o",
-            ])
-            .arg(&h),
-    );
-    run_ok(
-        Command::new(tool("sunbeam-pack"))
-            .arg(&h)
-            .arg("-o")
-            .arg(&p)
-            .args(["--response", "-q"]),
-    );
-    p
-}
 
 /// render.mjs on `scene` against the reference of `ref_scene` (the same
 /// scene unless the material comes from the GLB's extension instead of `pack`).
@@ -81,51 +32,6 @@ fn compare(render: &Path, d: &Path, scene: &str, name: &str) {
 fn compare_with(render: &Path, d: &Path, scene: &str, ref_scene: &str, name: &str) {
     let c = measure(render, d, scene, ref_scene, name);
     assert!(c.p99 < 2.0, "{name}: three.js vs reference {c}");
-}
-
-/// render.mjs on `scene` and `sunbeam-eval render --samples 16` on
-/// `ref_scene` (written into `d` as NAME.json and NAME-ref.json): the
-/// difference over lit pixels.
-fn measure(
-    render: &Path,
-    d: &Path,
-    scene: &str,
-    ref_scene: &str,
-    name: &str,
-) -> sunbeam_frame::ColourDiff {
-    let s = d.join(format!("{name}.json"));
-    std::fs::write(&s, scene).unwrap();
-    let rs = d.join(format!("{name}-ref.json"));
-    std::fs::write(&rs, ref_scene).unwrap();
-    let (png, exr, reference) = (
-        d.join(format!("{name}.png")),
-        d.join(format!("{name}.exr")),
-        d.join(format!("{name}-ref.exr")),
-    );
-    run_ok(
-        Command::new("node")
-            .arg(render)
-            .arg(&s)
-            .arg("-o")
-            .arg(&png)
-            .arg("--exr")
-            .arg(&exr)
-            .env("SUNBEAM_PLAY", tool("sunbeam-play")),
-    );
-    assert!(png.is_file());
-    run_ok(
-        Command::new(tool("sunbeam-eval"))
-            .arg("render")
-            .arg(&rs)
-            .args(["--samples", "16", "-q", "-o"])
-            .arg(&reference),
-    );
-    let a = LinearImage::read_exr(&exr).unwrap();
-    let r = LinearImage::read_exr(&reference).unwrap();
-    let c = compare_linear(&a, &r).unwrap();
-    eprintln!("three.js {name}: {c}");
-    assert!(c.pixels > 200, "{name}: only {} lit pixels", c.pixels);
-    c
 }
 
 #[test]
@@ -258,8 +164,9 @@ fn bad_scenes_exit_non_zero_with_the_field_named() {
 }
 
 /// examples/threejs/index.html (the viewer a user opens after `make demo`) loads
-/// the snake with its material from the GLB's extension and draws a frame with
-/// no WebGL, console or page error (page-check.mjs fails on any).
+/// the snake with its material from the GLB's extension and its scale maps
+/// (baked with `--scales`, as `make demo` does) and draws a frame with no
+/// WebGL, console or page error (page-check.mjs fails on any).
 #[test]
 fn the_viewer_page_loads_without_errors() {
     let d = scratch("threejs-page");
@@ -291,7 +198,7 @@ fn the_viewer_page_loads_without_errors() {
         Command::new(tool("sunbeam-bake"))
             .args(["--generate-snake", "--snake-detail", "0.5", "--pack"])
             .arg(&pack)
-            .arg("-o")
+            .args(["--scales", "--scale-texels", "8", "-o"])
             .arg(out.join("snake-xeno.glb"))
             .arg("-q"),
     );
@@ -317,6 +224,10 @@ fn the_viewer_page_loads_without_errors() {
     assert!(run["loadMs"].as_f64().unwrap() > 0.0, "{report}");
     assert!(run["mapBytes"].as_u64().unwrap() > 1000, "{report}");
     assert_eq!(run["material"], "xeno");
+    assert_eq!(
+        run["scaledMeshes"], 1,
+        "the scale maps were not applied: {report}"
+    );
 }
 
 /// An environment (issue 26, "Engines"): render.mjs lights a sky-lit sphere

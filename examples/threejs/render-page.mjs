@@ -5,7 +5,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import {
-  adaptExportedGlsl, addOrientation, builtinGeometry, environmentBackground, extensionSkin, maskingSlope,
+  adaptExportedGlsl, addOrientation, addScaleAttributes, builtinGeometry, environmentBackground, extensionSkin, maskingSlope,
   parseEnvironment, parseResponseMap, sceneCamera, SunbeamDiffractionPlugin, sunbeamMaterial, updateSunbeamUniforms,
 } from './sunbeam-three.mjs';
 
@@ -46,9 +46,9 @@ window.sunbeamRender = async (job) => {
       });
     }
     let meshIndex = 0;
-    const make = (map, baseColor, diffuseWeight, skin) => sunbeamMaterial({
+    const make = (map, baseColor, diffuseWeight, skin, scales = null) => sunbeamMaterial({
       exportedGlsl: exported, map, baseColor, diffuseWeight, ...skin, lights: desc.lights, exposure: desc.exposure,
-      environment, envCells: environment && map ? environment.forMesh(meshIndex) : null,
+      environment, envCells: environment && map ? environment.forMesh(meshIndex) : null, scales,
     });
     // The scene's skin for a mesh: its index, normalisation and masking (the
     // pack's rms slopes unless the scene gives them).
@@ -71,8 +71,11 @@ window.sunbeamRender = async (job) => {
       for (const o of meshObjs) {
         addOrientation(o.geometry);
         const ext = o.userData.sunbeam;
+        // The GLB's scale maps (sunbeam-bake --scales), whichever pack the mesh has.
+        const scales = o.userData.sunbeamScales ?? null;
+        if (scales) addScaleAttributes(o.geometry, scales.texCoord);
         if (sceneMap || !ext || m.packGiven) {
-          o.material = make(sceneMap, m.baseColor, m.diffuseWeight, sceneSkin(m, sceneMap));
+          o.material = make(sceneMap, m.baseColor, m.diffuseWeight, sceneSkin(m, sceneMap), scales);
         } else {
           const url = m.extMaps?.[ext.responseMap.uri];
           if (!url) return { error: `${m.url}: SUNBEAM_materials_diffraction map ${ext.responseMap.uri} not served` };
@@ -82,7 +85,7 @@ window.sunbeamRender = async (job) => {
           if (ext.masking === undefined) skin.rmsSlope = maskingSlope(m.masking, m.rmsSlope, map, m.what);
           if (ext.ior === undefined && ext.f0 === undefined) skin.ior = m.ior;
           if (ext.reflectance === undefined) skin.reflectance = m.reflectance;
-          o.material = make(map, ext.baseColor ?? m.baseColor, ext.diffuseWeight ?? m.diffuseWeight, skin);
+          o.material = make(map, ext.baseColor ?? m.baseColor, ext.diffuseWeight ?? m.diffuseWeight, skin, scales);
         }
       }
       root.add(gltf.scene);

@@ -6,7 +6,8 @@
 // (shaders/material.wgsl: the frame, exact Fresnel, G, Smith masking, the
 // diffuse base's share; shaders/response_map.wgsl: the map; and the
 // environment: shaders/env_cells.wgsl, the player's first-frame cells, with
-// shaders/export_env.wgsl), adapted here only in its declarations (plain
+// shaders/export_env.wgsl; the scale maps: shaders/scales.wgsl, the player's
+// frame function, with shaders/export_scales.wgsl), adapted here only in its declarations (plain
 // struct uniforms instead of uniform blocks, our varyings and light loop
 // instead of its demo entry point). docs/ENGINES.md documents the interface.
 // An environment comes as the files of `sunbeam-play SCENE
@@ -143,7 +144,7 @@ export function adaptExportedGlsl(src) {
   for (const l of lines) {
     if (l.startsWith('#version')) continue;
     if (l.startsWith('void main()')) break; // the demo entry point: ours follows
-    if (/^smooth in vec3 _vs2fs_location\d;/.test(l)) continue;
+    if (/^(smooth|flat) in \w+ _vs2fs_location\d+;/.test(l)) continue;
     if (l.startsWith('layout(location = 0) out vec4')) continue;
     // naga's uniform blocks (the material's, the environment's) as plain struct uniforms
     const block = /^layout\(std140\) uniform (\w+)_block_\d+Fragment \{ (\w+) (\w+); \};/.exec(l);
@@ -155,7 +156,8 @@ export function adaptExportedGlsl(src) {
   }
   const text = out.join('\n');
   for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun(', 'vec3 sunbeam_shade_environment(', 'mat3x3 sb_frame(',
-    'uniform SunbeamMaterial _group_0_binding_0_fs;', 'uniform SunbeamEnvironment _group_0_binding_8_fs;', '_group_0_binding_1_fs', '_group_0_binding_7_fs', '_group_0_binding_9_fs']) {
+    'uniform SunbeamMaterial _group_0_binding_0_fs;', 'uniform SunbeamEnvironment _group_0_binding_8_fs;', '_group_0_binding_1_fs', '_group_0_binding_7_fs', '_group_0_binding_9_fs',
+    'mat3x3 sunbeam_scale_frame(', '_group_0_binding_10_fs', '_group_0_binding_11_fs']) {
     if (!text.includes(need)) throw new Error(`exported GLSL: ${need} not found (docs/ENGINES.md; export it with this sunbeam-play)`);
   }
   return text;
@@ -208,14 +210,20 @@ uniform mat3 sbNormalMatrix; // world-space normal matrix
 in vec3 position;
 in vec3 normal;
 in vec3 sbOrient;
+in vec4 sbTangent; // a mesh with scale maps (addScaleAttributes): the glTF TANGENT
+in vec2 sbUv;      // and the maps' TEXCOORD; (0, 0, 0, 1) and (0, 0) otherwise
 out vec3 vWorld;
 out vec3 vNormal;
 out vec3 vOrient;
+out vec4 vTangent;
+out vec2 vUv;
 void main() {
   vec4 w = modelMatrix * vec4(position, 1.0);
   vWorld = w.xyz;
   vNormal = sbNormalMatrix * normal;
   vOrient = mat3(modelMatrix) * sbOrient;
+  vTangent = vec4(mat3(modelMatrix) * sbTangent.xyz, sbTangent.w);
+  vUv = sbUv;
   gl_Position = projectionMatrix * viewMatrix * w;
 }`;
 
@@ -228,13 +236,18 @@ uniform float sbExposure;              // 2^exposure
 uniform int sbHasMap;
 uniform int sbDisplay;                 // 1: clip at 1 and sRGB-encode (drawing to a canvas)
 uniform int sbEnvOn;                   // 1: lit by an environment (parseEnvironment)
+uniform uint sbScales;                 // 0: no scale maps; else 16 + the wrap bits (shaders/export_scales.wgsl)
 in vec3 vWorld;
 in vec3 vNormal;
 in vec3 vOrient;
+in vec4 vTangent;
+in vec2 vUv;
 layout(location = 0) out vec4 fragColor;
 void main() {
-  // The player's frame (shaders/material.wgsl sb_frame): t orthogonalised against n.
-  mat3 f = sb_frame(vNormal, vOrient);
+  // The player's frame (shaders/material.wgsl sb_frame: t orthogonalised
+  // against n), or on a mesh with scale maps the frame the maps give
+  // (shaders/scales.wgsl sb_scale_frame, as the player's frame_at).
+  mat3 f = sunbeam_scale_frame(vNormal, vOrient, vTangent, vUv, sbScales);
   vec3 t = f[0];
   vec3 b = f[1];
   vec3 n = f[2];
@@ -287,10 +300,13 @@ void main() {
  * (environment.forMesh(i)): the environment lights the mesh through the
  * exported sunbeam_shade_environment and its sun through sunbeam_shade_sun;
  * the mesh's `ior` must be the one the transmitted irradiance was made for
- * (environment.json irradiance.ior). Uniforms can be changed later
- * (material.uniforms; the skin through skinUniform).
+ * (environment.json irradiance.ior). `scales`: the mesh's scale maps
+ * (`sunbeam-bake --scales`; SunbeamDiffractionPlugin puts them on
+ * `mesh.userData.sunbeamScales`, and the geometry needs addScaleAttributes)
+ * or null. Uniforms can be changed later (material.uniforms; the skin
+ * through skinUniform).
  */
-export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, ior = 1.5, reflectance = 'absolute', rmsSlope = [0, 0], lights = [], exposure = 0, display = false, environment = null, envCells = null }) {
+export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, ior = 1.5, reflectance = 'absolute', rmsSlope = [0, 0], lights = [], exposure = 0, display = false, environment = null, envCells = null, scales = null }) {
   const g = map ? map.grid : { n_theta: 1, n_rho: 2, n_s: 2, r0: 1 };
   const lightVecs = [];
   for (let i = 0; i < MAX_LIGHTS; i++) {
@@ -308,6 +324,8 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
   const noCells = new THREE.DataTexture(new Uint32Array(1), 1, 1, THREE.RedIntegerFormat, THREE.UnsignedIntType);
   noCells.internalFormat = 'R32UI';
   noCells.needsUpdate = true;
+  const noScale = new THREE.DataTexture(new Uint8Array([128, 128, 255, 255]), 1, 1, THREE.RGBAFormat, THREE.UnsignedByteType);
+  noScale.needsUpdate = true;
   const env = environment;
   if (env && map && Math.abs(env.json.irradiance.ior - ior) > 1e-6) {
     throw new Error(`environment: the transmitted irradiance is for index ${env.json.irradiance.ior}, the mesh's is ${ior}`);
@@ -326,6 +344,9 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
       sbHasMap: { value: map ? 1 : 0 },
       sbDisplay: { value: display ? 1 : 0 },
       sbEnvOn: { value: env ? 1 : 0 },
+      sbScales: { value: scales ? 16 | scales.wraps : 0 },
+      _group_0_binding_10_fs: { value: scales ? scales.normal : noScale },
+      _group_0_binding_11_fs: { value: scales ? scales.orient : noScale },
       _group_0_binding_1_fs: { value: map ? map.texture : placeholder },
       _group_0_binding_3_fs: { value: env ? env.chain : flat },
       _group_0_binding_4_fs: { value: env ? env.irrSkin : flat },
@@ -384,12 +405,45 @@ export function addOrientation(geometry) {
 }
 
 /**
+ * The attributes the scale maps need (`sbTangent`, `sbUv`): the glTF TANGENT
+ * (three's `tangent`) and TEXCOORD_`texCoord` (three's `uv`, `uv1`, ...).
+ */
+export function addScaleAttributes(geometry, texCoord = 0) {
+  const t = geometry.getAttribute('tangent');
+  const uvName = texCoord === 0 ? 'uv' : `uv${texCoord}`;
+  const uv = geometry.getAttribute(uvName);
+  if (!t || !uv) throw new Error(`a mesh with scale maps needs TANGENT and TEXCOORD_${texCoord} (bake it with sunbeam-bake --scales)`);
+  geometry.setAttribute('sbTangent', t);
+  geometry.setAttribute('sbUv', uv);
+  return geometry;
+}
+
+// A scale map as the exported shader reads it (textureLoad: texel for texel):
+// the bytes as stored (GLTFLoader's image bitmaps: no premultiplied alpha, no
+// colour-space conversion; flipY false), no mipmaps.
+function scaleTexture(tex) {
+  tex.colorSpace = THREE.NoColorSpace;
+  tex.flipY = false;
+  tex.premultiplyAlpha = false;
+  tex.minFilter = THREE.NearestFilter;
+  tex.magFilter = THREE.NearestFilter;
+  tex.generateMipmaps = false;
+  tex.needsUpdate = true;
+  return tex;
+}
+
+/**
  * GLTFLoader plugin for the vendor extension SUNBEAM_materials_diffraction
  * (written by `sunbeam-bake --pack`, docs/ENGINES.md): every mesh whose glTF
  * material carries it gets `userData.sunbeam` = the extension's object
  * (`responseMap.uri` relative to the GLB, `grid`, `diffuseWeight`,
  * `baseColor`, and the skin where given: `ior`, `reflectance`, `masking`,
- * `rmsSlope`; see extensionSkin). Register with
+ * `rmsSlope`; see extensionSkin). With `orientationTexture` (`sunbeam-bake
+ * --scales`) the mesh also gets `userData.sunbeamScales` = { normal (the
+ * material's normalTexture), orient, wraps (bit 0 the normal map repeats
+ * along s, 1 along t, 2 and 3 the orientation map's; a glTF wrap other than
+ * CLAMP_TO_EDGE repeats, as the reference reads it), texCoord }: the
+ * `scales` of sunbeamMaterial. Register with
  * `loader.register((p) => new SunbeamDiffractionPlugin(p))`.
  */
 export class SunbeamDiffractionPlugin {
@@ -398,15 +452,43 @@ export class SunbeamDiffractionPlugin {
     this.name = 'SUNBEAM_materials_diffraction';
   }
 
-  afterRoot(gltf) {
-    const mats = this.parser.json.materials ?? [];
+  async afterRoot(gltf) {
+    const json = this.parser.json;
+    const mats = json.materials ?? [];
+    const found = [];
     gltf.scene.traverse((o) => {
       if (!o.isMesh) return;
       const a = this.parser.associations.get(o.material);
-      const ext = a && a.materials !== undefined ? mats[a.materials]?.extensions?.[this.name] : undefined;
-      if (ext) o.userData.sunbeam = ext;
+      const mi = a && a.materials !== undefined ? a.materials : undefined;
+      const ext = mi !== undefined ? mats[mi]?.extensions?.[this.name] : undefined;
+      if (ext) {
+        o.userData.sunbeam = ext;
+        if (ext.orientationTexture) found.push([o, mi, ext]);
+      }
     });
-    return null;
+    const repeats = (ti) => {
+      const s = json.samplers?.[json.textures?.[ti]?.sampler] ?? {};
+      return [s.wrapS, s.wrapT].map((w) => (w ?? 10497) !== 33071);
+    };
+    for (const [o, mi, ext] of found) {
+      const what = `materials[${mi}]`;
+      const nt = mats[mi].normalTexture;
+      const ot = ext.orientationTexture;
+      if (!nt) throw new Error(`${what}: orientationTexture without normalTexture`);
+      const texCoord = ot.texCoord ?? 0;
+      if ((nt.texCoord ?? 0) !== texCoord) throw new Error(`${what}: the normal and orientation maps use different TEXCOORDs`);
+      const [ns, nt2] = repeats(nt.index);
+      const [os, ot2] = repeats(ot.index);
+      const normal = await this.parser.getDependency('texture', nt.index);
+      const orient = await this.parser.getDependency('texture', ot.index);
+      if (!normal || !orient) throw new Error(`${what}: the scale maps could not be loaded`);
+      o.userData.sunbeamScales = {
+        normal: scaleTexture(normal),
+        orient: scaleTexture(orient),
+        wraps: (ns ? 1 : 0) | (nt2 ? 2 : 0) | (os ? 4 : 0) | (ot2 ? 8 : 0),
+        texCoord,
+      };
+    }
   }
 }
 

@@ -1,6 +1,9 @@
 //! Helpers shared by the pipeline tests (tests/pipeline.rs, tests/ninja.rs):
-//! small make variables, what this machine can build, folder contents.
+//! small make variables, what this machine can build, folder contents; the
+//! three.js tests' in [`threejs`].
 #![allow(dead_code)]
+
+pub mod threejs;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -5,7 +5,10 @@
 //! shaders/export.wgsl: one uniform block, the map, its sampler,
 //! `sunbeam_shade(t, b, n, wi, wr)`; the environment: shaders/env_cells.wgsl,
 //! the player's first-frame cells, with shaders/export_env.wgsl reading their
-//! data from textures, `sunbeam_shade_environment(t, b, n, wr)`).
+//! data from textures, `sunbeam_shade_environment(t, b, n, wr)`; the scale
+//! maps: shaders/scales.wgsl, the player's frame function, with
+//! shaders/export_scales.wgsl binding the two textures,
+//! `sunbeam_scale_frame`).
 //! docs/ENGINES.md documents the interface and how each engine takes it.
 //! naga does the translation (it is already in the tree through wgpu) rather
 //! than hand-kept copies per language, so the languages cannot drift apart.
@@ -17,6 +20,8 @@ pub const SOURCE: &str = concat!(
     include_str!("../../../shaders/material.wgsl"),
     include_str!("../../../shaders/response_map.wgsl"),
     include_str!("../../../shaders/export.wgsl"),
+    include_str!("../../../shaders/scales.wgsl"),
+    include_str!("../../../shaders/export_scales.wgsl"),
     include_str!("../../../shaders/env_table.wgsl"),
     include_str!("../../../shaders/export_env.wgsl"),
     include_str!("../../../shaders/env_cells.wgsl")

@@ -62,6 +62,17 @@ fn glsl_passes_glslang() {
         ] {
             assert!(text.contains(m), "{lang}: missing {m}");
         }
+        // The scale maps (docs/ENGINES.md "Scale maps"): the player's frame
+        // function on the two textures, by texel (texelFetch).
+        for m in [
+            "mat3x3 sunbeam_scale_frame(",
+            "mat3x3 sb_scale_frame(",
+            "sampler2D _group_0_binding_10_fs",
+            "sampler2D _group_0_binding_11_fs",
+            "texelFetch(",
+        ] {
+            assert!(text.contains(m), "{lang}: missing {m}");
+        }
         if have_command("glslangValidator", &["--version"]) {
             let o = Command::new("glslangValidator").arg(&f).output().unwrap();
             assert!(
