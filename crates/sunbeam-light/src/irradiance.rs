@@ -4,7 +4,7 @@
 //!
 //! `E(n) = int L(d) max(n . d, 0) dw` of the radiance without the sun by a
 //! midpoint rule over 512 x 256 directions equal in solid angle (rows uniform
-//! in `d_y`), at the normals of a 96 x 48 equirectangular table read
+//! in `d_y`), at the normals of a 128 x 64 equirectangular table read
 //! bilinearly (`E` is the radiance convolved with a clamped cosine, smooth at
 //! that spacing); the sun's disc adds `Omega L_sun max(n . s, 0)` exactly (a
 //! disc of 0.5 degrees as a point: within 1e-5 away from its terminator).
@@ -17,7 +17,7 @@ use sunbeam_optics::colour;
 /// Directions of the quadrature (width; height is half).
 const DIRS_W: usize = 512;
 /// Normals of the table (width; height is half).
-const NORMALS_W: usize = 96;
+const NORMALS_W: usize = 128;
 
 /// Intervals of a weight other than the clamped cosine, tabulated over `c`
 /// in [0, 1] and read linearly ([`Irradiance::transmitted`]: error below 1e-7).
@@ -46,13 +46,17 @@ impl Irradiance {
     /// reflectance, `sunbeam_optics::gain::fresnel`), the same tabulation with
     /// the weight `c (1 - F(c))` in place of `c`.
     pub fn transmitted(env: &Environment, ior: f64) -> Irradiance {
-        let w = (0..=WEIGHT_TABLE + 1)
+        Self::build(env, Some(Self::transmitted_weight(ior)))
+    }
+
+    /// `c (1 - F(c))` tabulated over `c` in [0, 1].
+    fn transmitted_weight(ior: f64) -> Vec<f64> {
+        (0..=WEIGHT_TABLE + 1)
             .map(|i| {
                 let c = (i as f64 / WEIGHT_TABLE as f64).min(1.0);
                 c * (1.0 - sunbeam_optics::gain::fresnel(c, ior))
             })
-            .collect();
-        Self::build(env, Some(w))
+            .collect()
     }
 
     /// The weight at `c` in (0, 1].
@@ -69,55 +73,164 @@ impl Irradiance {
     }
 
     fn build(env: &Environment, weight: Option<Vec<f64>>) -> Irradiance {
+        Self::build_all(env, vec![weight]).remove(0)
+    }
+
+    /// The irradiance and the transmitted irradiance under a skin of index
+    /// `ior` ([`Irradiance::new`], [`Irradiance::transmitted`]) from one pass
+    /// over the environment (they share its transforms).
+    pub fn pair(env: &Environment, ior: f64) -> (Irradiance, Irradiance) {
+        let t = Self::transmitted_weight(ior);
+        let mut v = Self::build_all(env, vec![None, Some(t)]).into_iter();
+        let plain = v.next().expect("two tables");
+        (plain, v.next().expect("two tables"))
+    }
+
+    /// The tables of one environment for several weights.
+    ///
+    /// The midpoint sum over the directions, evaluated as a circular
+    /// correlation in `phi`: the normals' columns fall every
+    /// `DIRS_W / NORMALS_W` directions' columns (at a fixed half-texel
+    /// offset), so for a row of normals and a row of directions the weight
+    /// `w(n . d)` depends only on the difference of their columns, and the
+    /// row's contribution to every normal of the row is one correlation of
+    /// the radiance row with that kernel: an FFT product (`realfft`), summed
+    /// over the direction rows before one inverse transform per row of
+    /// normals. The same sum as the direct double loop (a test checks it to
+    /// 1e-9); measured on 2 busy cores, both tables of the sky in 0.6 s
+    /// against 2.7 s for the direct loop (0.7 s plain, 2.0 s transmitted,
+    /// whose weight lookup sat in the inner loop): part of the start-up of
+    /// every environment scene in the player and the reference.
+    fn build_all(env: &Environment, weights: Vec<Option<Vec<f64>>>) -> Vec<Irradiance> {
+        use realfft::num_complex::Complex;
         let sun = env.sun();
         // The radiance without the sun, on directions of equal solid angle.
         let (dw, dh) = (DIRS_W, DIRS_W / 2);
-        let dirs: Vec<([f64; 3], [f64; 3])> = (0..dw * dh)
-            .map(|k| {
-                let (i, j) = (k % dw, k / dw);
+        let rows: Vec<Vec<[f64; 3]>> = (0..dh)
+            .into_par_iter()
+            .map(|j| {
                 let y = 1.0 - 2.0 * (j as f64 + 0.5) / dh as f64;
-                let phi = 2.0 * PI * (i as f64 + 0.5) / dw as f64;
-                let d = crate::direction(y, phi);
-                let rgb = match sun {
-                    Some(s) if s.in_sun(d) => {
-                        let c = s.coefficients(d);
-                        let b = crate::daylight::basis_xyz();
-                        colour::xyz_to_linear_srgb(std::array::from_fn(|a| {
-                            (0..3).map(|k| c[k] * b[k][a]).sum()
-                        }))
-                    }
-                    _ => env.rgb(d),
-                };
-                (d, rgb)
+                (0..dw)
+                    .map(|i| {
+                        let phi = 2.0 * PI * (i as f64 + 0.5) / dw as f64;
+                        let d = crate::direction(y, phi);
+                        match sun {
+                            Some(s) if s.in_sun(d) => {
+                                let c = s.coefficients(d);
+                                let b = crate::daylight::basis_xyz();
+                                colour::xyz_to_linear_srgb(std::array::from_fn(|a| {
+                                    (0..3).map(|k| c[k] * b[k][a]).sum()
+                                }))
+                            }
+                            _ => env.rgb(d),
+                        }
+                    })
+                    .collect()
             })
             .collect();
         let d_omega = 4.0 * PI / (dw * dh) as f64;
         let (nw, nh) = (NORMALS_W, NORMALS_W / 2);
-        let table = (0..nw * nh)
+        let step = dw / nw;
+        let mut planner = realfft::RealFftPlanner::<f64>::new();
+        let fwd = planner.plan_fft_forward(dw);
+        let inv = planner.plan_fft_inverse(dw);
+        let nf = dw / 2 + 1;
+        // The spectrum of each radiance row, per channel.
+        let spectra: Vec<[Vec<Complex<f64>>; 3]> = rows
+            .par_iter()
+            .map(|row| {
+                std::array::from_fn(|a| {
+                    let mut x: Vec<f64> = row.iter().map(|p| p[a]).collect();
+                    let mut out = fwd.make_output_vec();
+                    fwd.process(&mut x, &mut out)
+                        .expect("FFT of a radiance row");
+                    out
+                })
+            })
+            .collect();
+        // Column offset of normal column 0 against direction column 0, in
+        // direction columns: phi_n - phi_d = 2 pi (m - shift) / dw for
+        // m = i_d - step i_n.
+        let shift = (step as f64 - 1.0) / 2.0;
+        let tables: Vec<Vec<Vec<[f64; 3]>>> = (0..nh)
             .into_par_iter()
-            .map(|k| {
-                let (i, j) = (k % nw, k / nw);
-                let theta = PI * (j as f64 + 0.5) / nh as f64;
-                let phi = 2.0 * PI * (i as f64 + 0.5) / nw as f64;
-                let n = crate::direction(theta.cos(), phi);
-                let mut e = [0.0; 3];
-                for (d, rgb) in &dirs {
-                    let c = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
-                    if c > 0.0 {
-                        let wc = Self::weight_at(&weight, c);
+            .map(|jn| {
+                let theta = PI * (jn as f64 + 0.5) / nh as f64;
+                let (yn, sn) = (theta.cos(), theta.sin());
+                let mut acc = vec![
+                    [
+                        vec![Complex::new(0.0, 0.0); nf],
+                        vec![Complex::new(0.0, 0.0); nf],
+                        vec![Complex::new(0.0, 0.0); nf]
+                    ];
+                    weights.len()
+                ];
+                let mut kernel = vec![0.0; dw];
+                let mut kspec = fwd.make_output_vec();
+                for (j, spec) in spectra.iter().enumerate() {
+                    let y = 1.0 - 2.0 * (j as f64 + 0.5) / dh as f64;
+                    let sd = (1.0 - y * y).max(0.0).sqrt();
+                    for (wi, weight) in weights.iter().enumerate() {
+                        let mut any = false;
+                        for (m, k) in kernel.iter_mut().enumerate() {
+                            let dphi = 2.0 * PI * (m as f64 - shift) / dw as f64;
+                            let c = sn * sd * dphi.cos() + yn * y;
+                            *k = if c > 0.0 {
+                                any = true;
+                                Self::weight_at(weight, c)
+                            } else {
+                                0.0
+                            };
+                        }
+                        if !any {
+                            continue;
+                        }
+                        fwd.process(&mut kernel, &mut kspec)
+                            .expect("FFT of a kernel row");
                         for a in 0..3 {
-                            e[a] += rgb[a] * wc;
+                            for (o, (l, k)) in acc[wi][a].iter_mut().zip(spec[a].iter().zip(&kspec))
+                            {
+                                *o += l * k.conj();
+                            }
                         }
                     }
                 }
-                e.map(|v| v * d_omega)
+                acc.into_iter()
+                    .map(|mut ch| {
+                        let cols: [Vec<f64>; 3] = std::array::from_fn(|a| {
+                            let mut x = inv.make_output_vec();
+                            // The imaginary parts of the DC and Nyquist bins
+                            // of a real signal's spectrum are 0 up to rounding.
+                            ch[a][0].im = 0.0;
+                            ch[a][nf - 1].im = 0.0;
+                            inv.process(&mut ch[a], &mut x).expect("inverse FFT");
+                            x
+                        });
+                        (0..nw)
+                            .map(|i_n| {
+                                std::array::from_fn(|a| cols[a][i_n * step] / dw as f64 * d_omega)
+                            })
+                            .collect()
+                    })
+                    .collect()
             })
             .collect();
         let sun = sun.map(|s| {
             let rgb = colour::xyz_to_linear_srgb(s.sun_xyz());
             (s.sun_direction(), rgb.map(|v| v * s.sun_solid_angle()))
         });
-        Irradiance { weight, table, sun }
+        weights
+            .into_iter()
+            .enumerate()
+            .map(|(wi, weight)| Irradiance {
+                weight,
+                table: tables
+                    .iter()
+                    .flat_map(|row| row[wi].iter().copied())
+                    .collect(),
+                sun,
+            })
+            .collect()
     }
 
     /// The table without the sun (the player's texture, read bilinearly as
@@ -221,6 +334,93 @@ mod tests {
                 let e = t.at(n.map(|v| v / l));
                 for v in e {
                     assert!((v / want - 1.0).abs() < 1e-3, "{ior}: {e:?} vs {want}");
+                }
+            }
+        }
+    }
+
+    /// The FFT evaluation is the midpoint sum itself: against a direct sum
+    /// over the same directions (written here, sharing only the radiance
+    /// lookups) at table normals, for a map with a bright spot and for the
+    /// sky, plain and transmitted, within 1e-9 of the largest value.
+    #[test]
+    fn correlation_equals_the_direct_sum() {
+        let (w, h) = (64, 32);
+        let rgb: Vec<[f32; 3]> = (0..w * h)
+            .map(|k| {
+                let (i, j) = (k % w, k / w);
+                let spot = if (20..23).contains(&i) && (8..10).contains(&j) {
+                    50.0
+                } else {
+                    0.0
+                };
+                [
+                    0.2 + spot + 0.01 * i as f32,
+                    0.3 + 0.02 * j as f32,
+                    0.1 + spot * 0.5,
+                ]
+            })
+            .collect();
+        let map = Environment::Map(EnvMap::new(w, h, rgb, 30.0, 1.0).unwrap());
+        let sky = Environment::Sky(Box::new(Sky::new(35.0, 70.0, 3.0, 1.0)));
+        for env in [map, sky] {
+            let (plain, trans) = Irradiance::pair(&env, 1.5);
+            let sun = env.sun();
+            let (dw, dh) = (DIRS_W, DIRS_W / 2);
+            let (nw, nh) = (NORMALS_W, NORMALS_W / 2);
+            let big = plain
+                .table
+                .iter()
+                .flatten()
+                .fold(0.0f64, |a, &b| a.max(b.abs()));
+            for &(i_n, j_n) in &[
+                (0usize, 0usize),
+                (5, 7),
+                (37, 31),
+                (100, 50),
+                (127, 63),
+                (64, 32),
+            ] {
+                let theta = PI * (j_n as f64 + 0.5) / nh as f64;
+                let phi_n = 2.0 * PI * (i_n as f64 + 0.5) / nw as f64;
+                let n = crate::direction(theta.cos(), phi_n);
+                let mut e = [[0.0f64; 3]; 2];
+                for j in 0..dh {
+                    let y = 1.0 - 2.0 * (j as f64 + 0.5) / dh as f64;
+                    for i in 0..dw {
+                        let d = crate::direction(y, 2.0 * PI * (i as f64 + 0.5) / dw as f64);
+                        let c = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+                        if c <= 0.0 {
+                            continue;
+                        }
+                        let l = match sun {
+                            Some(s) if s.in_sun(d) => {
+                                let k = s.coefficients(d);
+                                let b = crate::daylight::basis_xyz();
+                                colour::xyz_to_linear_srgb(std::array::from_fn(|a| {
+                                    (0..3).map(|q| k[q] * b[q][a]).sum()
+                                }))
+                            }
+                            _ => env.rgb(d),
+                        };
+                        let wt = [c, Irradiance::weight_at(&trans.weight, c)];
+                        for t in 0..2 {
+                            for a in 0..3 {
+                                e[t][a] += l[a] * wt[t] * 4.0 * PI / (dw * dh) as f64;
+                            }
+                        }
+                    }
+                }
+                for (t, table) in [&plain, &trans].iter().enumerate() {
+                    let got = table.table[j_n * nw + i_n];
+                    for a in 0..3 {
+                        assert!(
+                            (got[a] - e[t][a]).abs() <= 1e-9 * big,
+                            "table {t} normal ({i_n}, {j_n}) channel {a}: {} vs direct {}",
+                            got[a],
+                            e[t][a]
+                        );
+                    }
                 }
             }
         }

@@ -182,6 +182,7 @@ impl EnvShader {
     ) -> EnvShader {
         let mut quads: Vec<Option<Arc<EnvQuadrature>>> = Vec::with_capacity(packs.len());
         let mut irradiance = None;
+        let mut transmitted = Vec::new();
         if estimator == EnvEstimator::Quadrature {
             for (i, p) in packs.iter().enumerate() {
                 let q = p.as_ref().filter(|p| p.has_terms()).map(|p| {
@@ -200,14 +201,11 @@ impl EnvShader {
                 });
                 quads.push(q);
             }
-            irradiance = Some(Irradiance::new(&env));
-        }
-        let transmitted = if irradiance.is_some() {
             let ior = gain::Material::default().ior;
-            vec![(ior, Arc::new(Irradiance::transmitted(&env, ior)))]
-        } else {
-            Vec::new()
-        };
+            let (plain, skin) = Irradiance::pair(&env, ior);
+            irradiance = Some(plain);
+            transmitted = vec![(ior, Arc::new(skin))];
+        }
         EnvShader {
             quads,
             irradiance,

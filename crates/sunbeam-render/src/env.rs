@@ -244,8 +244,8 @@ impl EnvScene {
         let chain = texture_2d_f16(gpu, "prefiltered environment", &chain_levels);
         let irradiance = match (&env, cells) {
             (Some(e), true) => {
-                let tr = sunbeam_light::irradiance::Irradiance::transmitted(e, ior).table_rgba();
-                let plain = sunbeam_light::irradiance::Irradiance::new(e).table_rgba();
+                let (plain, tr) = sunbeam_light::irradiance::Irradiance::pair(e, ior);
+                let (plain, tr) = (plain.table_rgba(), tr.table_rgba());
                 [
                     texture_2d_f16(gpu, "transmitted irradiance", &[tr]),
                     texture_2d_f16(gpu, "irradiance", &[plain]),

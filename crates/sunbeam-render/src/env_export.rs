@@ -85,8 +85,8 @@ pub fn export(
         .map_or(sunbeam_optics::gain::Material::default().ior, |(_, m)| {
             m.skin.ior
         });
-    let skin = sunbeam_light::irradiance::Irradiance::transmitted(&env, ior).table_rgba();
-    let plain = sunbeam_light::irradiance::Irradiance::new(&env).table_rgba();
+    let (plain, skin) = sunbeam_light::irradiance::Irradiance::pair(&env, ior);
+    let (plain, skin) = (plain.table_rgba(), skin.table_rgba());
     let irr_json = serde_json::json!({"width": skin.0, "height": skin.1, "ior": ior});
     let skin_file = put(
         "irradiance-skin.ktx2",
