@@ -224,6 +224,7 @@ function fragment(exported) {
 uniform vec3 sbEye;
 uniform int sbLightCount;
 uniform vec4 sbLights[${MAX_LIGHTS}]; // xyz towards the light (unit), w intensity
+uniform vec3 sbLightColors[${MAX_LIGHTS}]; // linear sRGB colour (scene lights[].color): tints the light's RGB
 uniform float sbExposure;              // 2^exposure
 uniform int sbHasMap;
 uniform int sbDisplay;                 // 1: clip at 1 and sRGB-encode (drawing to a canvas)
@@ -249,7 +250,7 @@ void main() {
     } else {
       c = _group_0_binding_0_fs.base.rgb * max(dot(wi, n), 0.0);
     }
-    rgb += sbLights[i].w * c;
+    rgb += sbLights[i].w * sbLightColors[i] * c;
   }
   if (sbEnvOn == 1) {
     // The environment without its sun (the exported sunbeam_shade_environment:
@@ -281,7 +282,7 @@ void main() {
  * `diffuseWeight`, the skin: `ior` (1.5), `reflectance` ('absolute', the
  * default, or 'relative'), `rmsSlope` (Smith masking's [x, y] rms slopes;
  * [0, 0]: none; see maskingSlope), `lights` [{direction: [x, y, z] towards the
- * light, intensity}], `exposure` in stops, `display`: clip and sRGB-encode
+ * light, intensity, color: linear [r, g, b] (default white) tinting its RGB}], `exposure` in stops, `display`: clip and sRGB-encode
  * (for a canvas; off for linear float targets), `environment`: from
  * parseEnvironment (or null), with `envCells` its cells for this mesh
  * (environment.forMesh(i)): the environment lights the mesh through the
@@ -293,11 +294,13 @@ void main() {
 export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, ior = 1.5, reflectance = 'absolute', rmsSlope = [0, 0], lights = [], exposure = 0, display = false, environment = null, envCells = null }) {
   const g = map ? map.grid : { n_theta: 1, n_rho: 2, n_s: 2, r0: 1 };
   const lightVecs = [];
+  const lightColors = [];
   for (let i = 0; i < MAX_LIGHTS; i++) {
     const l = lights[i];
-    if (!l) { lightVecs.push(new THREE.Vector4()); continue; }
+    if (!l) { lightVecs.push(new THREE.Vector4()); lightColors.push(new THREE.Vector3()); continue; }
     const d = new THREE.Vector3(...l.direction).normalize();
     lightVecs.push(new THREE.Vector4(d.x, d.y, d.z, l.intensity ?? 1));
+    lightColors.push(new THREE.Vector3(...(l.color ?? [1, 1, 1])));
   }
   const placeholder = new THREE.Data3DTexture(new Uint16Array(4 * 2 * 2), 1, 2, 2);
   placeholder.type = THREE.HalfFloatType;
@@ -322,6 +325,7 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
       sbEye: { value: new THREE.Vector3() },
       sbLightCount: { value: Math.min(lights.length, MAX_LIGHTS) },
       sbLights: { value: lightVecs },
+      sbLightColors: { value: lightColors },
       sbExposure: { value: Math.pow(2, exposure) },
       sbHasMap: { value: map ? 1 : 0 },
       sbDisplay: { value: display ? 1 : 0 },
@@ -470,7 +474,8 @@ export function builtinGeometry(name) {
 
 /**
  * The camera of a scene file (sunbeam_scene::camera): perspective, vertical
- * field of view, near 0.01 d and far 100 d with d the eye-target distance.
+ * field of view, near 0.01 d and far 100 d with d the eye-target distance,
+ * `shift` (lens shift) in the projection matrix.
  */
 export function sceneCamera(scene, aspect) {
   const c = scene.camera;
@@ -481,6 +486,15 @@ export function sceneCamera(scene, aspect) {
   cam.up.set(...(c.up ?? [0, 1, 0]));
   cam.lookAt(target);
   cam.updateMatrixWorld();
+  // camera.shift (Blender's lens shift): the window moves by shift x the
+  // larger side, NDC by (2 sx m / w, 2 sy m / h) (sunbeam_scene::camera::shift_ndc)
+  const [sx, sy] = c.shift ?? [0, 0];
+  if (sx !== 0 || sy !== 0) {
+    const e = cam.projectionMatrix.elements; // column-major: [8], [9] = x, y rows of the z column
+    e[8] += 2 * sx * Math.max(1, 1 / aspect);
+    e[9] += 2 * sy * Math.max(aspect, 1);
+    cam.projectionMatrixInverse.copy(cam.projectionMatrix).invert();
+  }
   return cam;
 }
 
