@@ -475,7 +475,7 @@ export function builtinGeometry(name) {
 /**
  * The camera of a scene file (sunbeam_scene::camera): perspective, vertical
  * field of view, near 0.01 d and far 100 d with d the eye-target distance,
- * `shift` (lens shift) in the projection matrix.
+ * `shift` (lens shift) as a view offset (`setViewOffset`).
  */
 export function sceneCamera(scene, aspect) {
   const c = scene.camera;
@@ -486,14 +486,13 @@ export function sceneCamera(scene, aspect) {
   cam.up.set(...(c.up ?? [0, 1, 0]));
   cam.lookAt(target);
   cam.updateMatrixWorld();
-  // camera.shift (Blender's lens shift): the window moves by shift x the
-  // larger side, NDC by (2 sx m / w, 2 sy m / h) (sunbeam_scene::camera::shift_ndc)
+  // camera.shift (Blender's lens shift): the window moves right and up by
+  // shift x the larger side (sunbeam_scene::camera::shift_ndc), as a view
+  // offset in a frame of height 1 (kept by updateProjectionMatrix)
   const [sx, sy] = c.shift ?? [0, 0];
   if (sx !== 0 || sy !== 0) {
-    const e = cam.projectionMatrix.elements; // column-major: [8], [9] = x, y rows of the z column
-    e[8] += 2 * sx * Math.max(1, 1 / aspect);
-    e[9] += 2 * sy * Math.max(aspect, 1);
-    cam.projectionMatrixInverse.copy(cam.projectionMatrix).invert();
+    const m = Math.max(aspect, 1);
+    cam.setViewOffset(aspect, 1, sx * m, -sy * m, aspect, 1);
   }
   return cam;
 }
