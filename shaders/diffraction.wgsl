@@ -34,6 +34,9 @@ struct Globals {
     eye: vec4<f32>,
     // xyz: direction towards the light (unit), w: intensity
     lights: array<vec4<f32>, 4>,
+    // rgb: the light's linear sRGB colour (scene lights[].color; it tints the
+    // light's RGB contribution), w unused
+    light_colors: array<vec4<f32>, 4>,
     // rows of the XYZ -> linear sRGB matrix
     xyz_to_rgb: array<vec4<f32>, 3>,
     background: vec4<f32>,
@@ -577,7 +580,7 @@ fn shade_light(i: u32, fr: mat3x3<f32>, wr: vec3<f32>, diffract: bool, dw: f32, 
         }
         diff = xyz_to_rgb(xyz);
     }
-    return g.lights[i].w * (dw * mat.base.xyz * base_in + (1.0 - dw) * diff);
+    return g.lights[i].w * g.light_colors[i].rgb * (dw * mat.base.xyz * base_in + (1.0 - dw) * diff);
 }
 
 // The shading frame (columns t, b, n) of interpolated attributes: sb_frame of

@@ -6,7 +6,8 @@
 //! The expectations come from the documented camera model (computed here, not
 //! with the renderers' ray code) and `EnvMap::lookup`: a pixel whose four
 //! corners and centre see the same map texel shows that texel whatever its
-//! sub-pixel sample positions are.
+//! sub-pixel sample positions are. Both are checked without and with a lens
+//! shift (`camera.shift`).
 
 mod gpu;
 
@@ -40,10 +41,20 @@ fn map() -> EnvMap {
     EnvMap::new(mw, mh, rgb, ROTATION_DEG, INTENSITY).unwrap()
 }
 
+/// The lens shifts the background tests look through (none, and one that
+/// moves the window right and down: `camera.shift`).
+const SHIFTS: [[f64; 2]; 2] = [[0.0, 0.0], [0.1, -0.07]];
+
 /// A scene whose one mesh (the quad) faces away from the camera (back face
 /// culled): every pixel is background.
 fn scene() -> Prepared {
+    shifted_scene([0.0; 2])
+}
+
+/// [`scene`] through a lens shifted by `shift`.
+fn shifted_scene(shift: [f64; 2]) -> Prepared {
     let (mut scene, mesh) = fixtures::quad_scene([W, H]);
+    scene.camera.shift = shift;
     scene.camera.eye = [0.3, 0.4, -5.0];
     scene.camera.target = [0.0, 0.2, 0.0];
     scene.camera.fov_y_deg = 40.0;
@@ -78,13 +89,16 @@ fn unit(a: [f64; 3]) -> [f64; 3] {
 
 /// The camera model of docs/SCENE.md: a pinhole at `eye` looking at
 /// `target`, `fov_y_deg` vertically, square pixels, (x, y) in pixels from the
-/// top left corner.
+/// top left corner, the image window shifted by `shift` times the larger
+/// side (right, up).
 fn camera_ray(p: &Prepared, x: f64, y: f64) -> [f64; 3] {
     let c = &p.scene.camera;
     let f = unit(sub(c.target, c.eye));
     let s = unit(cross(f, c.up));
     let u = cross(s, f);
     let t = (c.fov_y_deg.to_radians() / 2.0).tan();
+    let m = W.max(H) as f64;
+    let (x, y) = (x + c.shift[0] * m, y - c.shift[1] * m);
     let a = (2.0 * x / W as f64 - 1.0) * t * W as f64 / H as f64;
     let b = (1.0 - 2.0 * y / H as f64) * t;
     unit(std::array::from_fn(|k| f[k] + a * s[k] + b * u[k]))
@@ -104,9 +118,9 @@ fn expected(p: &Prepared, m: &EnvMap, i: u32, j: u32) -> Option<[f64; 3]> {
 
 #[test]
 fn reference_background_is_the_environment_along_each_ray() {
-    let p = scene();
     let m = map();
-    for samples in [1, 4] {
+    for (shift, samples) in SHIFTS.into_iter().flat_map(|s| [(s, 1), (s, 4)]) {
+        let p = shifted_scene(shift);
         let opts = Options {
             samples,
             ..Default::default()
@@ -124,7 +138,7 @@ fn reference_background_is_the_environment_along_each_ray() {
                 for k in 0..3 {
                     assert!(
                         (got[k] as f64 - e[k]).abs() <= 1e-6 * e[k].abs().max(1.0),
-                        "samples {samples}, pixel ({i}, {j}): {got:?}, expected {e:?}"
+                        "shift {shift:?}, samples {samples}, pixel ({i}, {j}): {got:?}, expected {e:?}"
                     );
                 }
             }
@@ -146,7 +160,13 @@ fn environment_background_needs_an_environment() {
 #[test]
 fn player_background_matches_reference() {
     let Some(gpu) = gpu::gpu() else { return };
-    let p = scene();
+    for shift in SHIFTS {
+        player_background_matches_reference_with(&gpu, shift);
+    }
+}
+
+fn player_background_matches_reference_with(gpu: &sunbeam_render::Gpu, shift: [f64; 2]) {
+    let p = shifted_scene(shift);
     let m = map();
     let reference = sunbeam_raster::render_prepared(
         &p,
@@ -165,7 +185,7 @@ fn player_background_matches_reference() {
         ),
         (4, Settings::default()),
     ] {
-        let frame = sunbeam_render::render_headless(&gpu, &p, &st, None, frames).unwrap();
+        let frame = sunbeam_render::render_headless(gpu, &p, &st, None, frames).unwrap();
         let mut d = Vec::new();
         for j in 0..H {
             for i in 0..W {
@@ -182,7 +202,7 @@ fn player_background_matches_reference() {
         let s = sunbeam_frame::diff::stats(&mut d);
         let all = sunbeam_frame::compare(&frame, &reference).unwrap();
         eprintln!(
-            "player background ({frames} frames, msaa {}): {s}; whole frame {all}",
+            "player background (shift {shift:?}, {frames} frames, msaa {}): {s}; whole frame {all}",
             st.msaa
         );
         assert!(s.pixels > (W * H / 2) as usize);

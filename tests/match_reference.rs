@@ -279,3 +279,39 @@ fn background_matches_reference() {
     let d = sunbeam_frame::compare(&frame, &reference).unwrap();
     assert!(d.max < 0.5, "background: {d}");
 }
+
+/// A coloured light (scene `lights[].color`, tinting its RGB contribution)
+/// seen through a shifted lens (`camera.shift`) on a non-square frame: the
+/// reference under a red light differs from the white one (and is red), and
+/// the player's frame matches the reference, so both renderers carry the
+/// colour and the off-axis projection alike.
+#[test]
+fn coloured_light_and_lens_shift_match_reference() {
+    let Some(mut p) = with_pack(&fixtures::ELAPHE, fixtures::sphere_scene([96, 64])) else {
+        return;
+    };
+    p.scene.camera.shift = [0.12, -0.08];
+    let white = sunbeam_raster::render_prepared(&p, &Options::default());
+    p.scene.lights[0].color = [1.0, 0.35, 0.15];
+    let red = sunbeam_raster::render_prepared(&p, &Options::default());
+    let d = sunbeam_frame::compare(&red, &white).unwrap();
+    eprintln!("red vs white light (reference): {d}");
+    assert!(d.p99 > 10.0, "the light's colour changed little: {d}");
+    let sum = |img: &Image, k: usize| -> f64 {
+        (0..img.height)
+            .flat_map(|j| (0..img.width).map(move |i| (i, j)))
+            .map(|(i, j)| img.pixel(i, j)[k] as f64)
+            .sum()
+    };
+    // the red channel keeps more than green and blue lose
+    let ratio = |k: usize| sum(&red, k) / sum(&white, k);
+    eprintln!(
+        "channel sums red / white: {:.3} {:.3} {:.3}",
+        ratio(0),
+        ratio(1),
+        ratio(2)
+    );
+    assert!(ratio(0) > ratio(1) && ratio(1) > ratio(2), "not red");
+    let Some(gpu) = gpu() else { return };
+    check("sphere-elaphe-red-shifted", &gpu, &p, 0.5, 2.0);
+}

@@ -106,25 +106,70 @@ fn threejs_renders_the_sphere_and_the_snake_like_the_reference() {
     compare_with(&render, &d, &alone, snake, "snake-ext");
 }
 
+/// A coloured light (`lights[].color`) through a shifted lens
+/// (`camera.shift`) on a non-square frame: three.js against the reference
+/// (the colour tints the light's RGB in both, the shift moves the projection).
+#[test]
+fn threejs_renders_a_coloured_light_through_a_shifted_lens() {
+    let d = scratch("threejs-render-colour-shift");
+    let Some(render) = example(&d) else { return };
+    ridge_pack(&d, "ridges", "256", "20nm");
+    let scene = r#"{ "camera": { "eye": [0, 0, 1.6], "target": [0, 0, 0], "fov_y_deg": 35, "shift": [0.12, -0.08] },
+  "lights": [ { "direction": [0.15, 0.1, 1], "intensity": 1, "color": [1, 0.35, 0.15] }, { "direction": [-0.6, 0.3, 0.8], "intensity": 0.7, "color": [0.2, 0.5, 1] } ],
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1 } ],
+  "exposure": 4.64, "size": [64, 40] }"#;
+    compare(&render, &d, scene, "sphere-colour-shift");
+}
+
 #[test]
 fn bad_scenes_exit_non_zero_with_the_field_named() {
     let d = scratch("threejs-render-bad");
     let Some(render) = example(&d) else { return };
     let s = d.join("bad.json");
-    std::fs::write(&s, r#"{ "camera": { "eye": [0, 0, 2], "target": [0, 0, 0] }, "meshes": [ { "mesh": "builtin:sphere", "pack": "missing.ktx2" } ] }"#).unwrap();
-    let o = Command::new("node")
-        .arg(&render)
-        .arg(&s)
-        .arg("-o")
-        .arg(d.join("x.png"))
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("meshes[0].pack"), "{err}");
-    assert!(!d.join("x.png").exists());
+    // render.mjs on `text`: exit 2 naming `field`, no frame.
+    let refused = |text: &str, field: &str| {
+        std::fs::write(&s, text).unwrap();
+        let o = Command::new("node")
+            .arg(&render)
+            .arg(&s)
+            .arg("-o")
+            .arg(d.join("x.png"))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{text}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(field), "{text}: {err}");
+        assert!(!d.join("x.png").exists());
+    };
+    refused(
+        r#"{ "camera": { "eye": [0, 0, 2], "target": [0, 0, 0] }, "meshes": [ { "mesh": "builtin:sphere", "pack": "missing.ktx2" } ] }"#,
+        "meshes[0].pack",
+    );
     let o = Command::new("node").arg(&render).output().unwrap();
     assert_eq!(o.status.code(), Some(1));
+    // A light's colour and the lens shift are checked, naming the field.
+    for (bad, field) in [
+        (
+            r#""lights": [ { "direction": [0, 0, 1], "color": [1, -1, 0] } ]"#,
+            "lights[0].color",
+        ),
+        (
+            r#""lights": [ { "direction": [0, 0, 1], "color": [1, 1] } ]"#,
+            "lights[0].color",
+        ),
+        (
+            r#""camera": { "eye": [0, 0, 2], "target": [0, 0, 0], "shift": [0.1] }"#,
+            "camera.shift",
+        ),
+    ] {
+        let mut text = format!(
+            r#"{{ "camera": {{ "eye": [0, 0, 2], "target": [0, 0, 0] }}, "meshes": [ {{ "mesh": "builtin:sphere" }} ], {bad} }}"#
+        );
+        if bad.starts_with(r#""camera""#) {
+            text = format!(r#"{{ "meshes": [ {{ "mesh": "builtin:sphere" }} ], {bad} }}"#);
+        }
+        refused(&text, field);
+    }
     // An environment whose map is missing: exit 2 naming it (sunbeam-play
     // --export-environment checks it), no frame.
     std::fs::write(&s, r#"{ "camera": { "eye": [0, 0, 2], "target": [0, 0, 0] }, "meshes": [ { "mesh": "builtin:sphere" } ], "environment": { "map": "sky.exr" } }"#).unwrap();

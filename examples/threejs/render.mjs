@@ -92,6 +92,12 @@ const bgOk = scene.background === undefined || (Array.isArray(scene.background) 
 if (!bgOk) fail(2, `${opt.scene}: background: expected [r, g, b] or "environment" (with an environment)`);
 // With an environment an omitted lights means none (the sky has its own sun).
 scene.lights = scene.lights ?? (scene.environment ? [] : [{ direction: [0.3, 1.0, 0.6], intensity: 1 }]);
+scene.lights.forEach((l, i) => {
+  const c = l.color;
+  if (c !== undefined && !(Array.isArray(c) && c.length === 3 && c.every((v) => typeof v === 'number' && Number.isFinite(v) && v >= 0))) fail(2, `${opt.scene}: lights[${i}].color: expected [r, g, b], finite and >= 0 (linear sRGB)`);
+});
+const shift = scene.camera.shift;
+if (shift !== undefined && !(Array.isArray(shift) && shift.length === 2 && shift.every((v) => typeof v === 'number' && Math.abs(v) <= 10))) fail(2, `${opt.scene}: camera.shift: expected [x, y], each in [-10, 10]`);
 scene.exposure = scene.exposure ?? 0;
 scene.background = scene.background ?? [0, 0, 0];
 const size = opt.size ?? scene.size ?? [512, 512];

@@ -232,6 +232,7 @@ function fragment(exported) {
 uniform vec3 sbEye;
 uniform int sbLightCount;
 uniform vec4 sbLights[${MAX_LIGHTS}]; // xyz towards the light (unit), w intensity
+uniform vec3 sbLightColors[${MAX_LIGHTS}]; // linear sRGB colour (scene lights[].color): tints the light's RGB
 uniform float sbExposure;              // 2^exposure
 uniform int sbHasMap;
 uniform int sbDisplay;                 // 1: clip at 1 and sRGB-encode (drawing to a canvas)
@@ -262,7 +263,7 @@ void main() {
     } else {
       c = _group_0_binding_0_fs.base.rgb * max(dot(wi, n), 0.0);
     }
-    rgb += sbLights[i].w * c;
+    rgb += sbLights[i].w * sbLightColors[i] * c;
   }
   if (sbEnvOn == 1) {
     // The environment without its sun (the exported sunbeam_shade_environment:
@@ -294,7 +295,7 @@ void main() {
  * `diffuseWeight`, the skin: `ior` (1.5), `reflectance` ('absolute', the
  * default, or 'relative'), `rmsSlope` (Smith masking's [x, y] rms slopes;
  * [0, 0]: none; see maskingSlope), `lights` [{direction: [x, y, z] towards the
- * light, intensity}], `exposure` in stops, `display`: clip and sRGB-encode
+ * light, intensity, color: linear [r, g, b] (default white) tinting its RGB}], `exposure` in stops, `display`: clip and sRGB-encode
  * (for a canvas; off for linear float targets), `environment`: from
  * parseEnvironment (or null), with `envCells` its cells for this mesh
  * (environment.forMesh(i)): the environment lights the mesh through the
@@ -309,11 +310,13 @@ void main() {
 export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.05], diffuseWeight = 0.2, ior = 1.5, reflectance = 'absolute', rmsSlope = [0, 0], lights = [], exposure = 0, display = false, environment = null, envCells = null, scales = null }) {
   const g = map ? map.grid : { n_theta: 1, n_rho: 2, n_s: 2, r0: 1 };
   const lightVecs = [];
+  const lightColors = [];
   for (let i = 0; i < MAX_LIGHTS; i++) {
     const l = lights[i];
-    if (!l) { lightVecs.push(new THREE.Vector4()); continue; }
+    if (!l) { lightVecs.push(new THREE.Vector4()); lightColors.push(new THREE.Vector3()); continue; }
     const d = new THREE.Vector3(...l.direction).normalize();
     lightVecs.push(new THREE.Vector4(d.x, d.y, d.z, l.intensity ?? 1));
+    lightColors.push(new THREE.Vector3(...(l.color ?? [1, 1, 1])));
   }
   const placeholder = new THREE.Data3DTexture(new Uint16Array(4 * 2 * 2), 1, 2, 2);
   placeholder.type = THREE.HalfFloatType;
@@ -340,6 +343,7 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
       sbEye: { value: new THREE.Vector3() },
       sbLightCount: { value: Math.min(lights.length, MAX_LIGHTS) },
       sbLights: { value: lightVecs },
+      sbLightColors: { value: lightColors },
       sbExposure: { value: Math.pow(2, exposure) },
       sbHasMap: { value: map ? 1 : 0 },
       sbDisplay: { value: display ? 1 : 0 },
@@ -552,7 +556,8 @@ export function builtinGeometry(name) {
 
 /**
  * The camera of a scene file (sunbeam_scene::camera): perspective, vertical
- * field of view, near 0.01 d and far 100 d with d the eye-target distance.
+ * field of view, near 0.01 d and far 100 d with d the eye-target distance,
+ * `shift` (lens shift) as a view offset (`setViewOffset`).
  */
 export function sceneCamera(scene, aspect) {
   const c = scene.camera;
@@ -563,6 +568,14 @@ export function sceneCamera(scene, aspect) {
   cam.up.set(...(c.up ?? [0, 1, 0]));
   cam.lookAt(target);
   cam.updateMatrixWorld();
+  // camera.shift (Blender's lens shift): the window moves right and up by
+  // shift x the larger side (sunbeam_scene::camera::shift_ndc), as a view
+  // offset in a frame of height 1 (kept by updateProjectionMatrix)
+  const [sx, sy] = c.shift ?? [0, 0];
+  if (sx !== 0 || sy !== 0) {
+    const m = Math.max(aspect, 1);
+    cam.setViewOffset(aspect, 1, sx * m, -sy * m, aspect, 1);
+  }
   return cam;
 }
 

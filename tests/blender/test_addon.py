@@ -97,13 +97,15 @@ def empty_scene(width, height, percentage=100):
     scene.render.resolution_x, scene.render.resolution_y = width, height
     scene.render.resolution_percentage = percentage
     scene.sunbeam.samples = 4
+    scene.render.film_transparent = False
     bpy.context.preferences.addons[ADDON].preferences.binaries_folder = str(BIN)
     return scene
 
 
-def add_camera(scene, location, target, lens=50.0, fit="AUTO", roll_deg=0.0):
+def add_camera(scene, location, target, lens=50.0, fit="AUTO", roll_deg=0.0, shift=(0.0, 0.0)):
     cam_data = bpy.data.cameras.new("Camera")
     cam_data.lens, cam_data.sensor_fit = lens, fit
+    cam_data.shift_x, cam_data.shift_y = shift
     cam = bpy.data.objects.new("Camera", cam_data)
     scene.collection.objects.link(cam)
     cam.location = location
@@ -250,12 +252,13 @@ class RenderTest(unittest.TestCase):
         sphere = add_sphere()
         skin = sunbeam_skin(sphere)
         eye = (0.4, -2.6, 0.9)
-        add_camera(scene, eye, (0.0, 0.0, 0.0), lens=50.0)
+        add_camera(scene, eye, (0.0, 0.0, 0.0), lens=50.0, shift=(0.1, -0.06))
         sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
         scene.collection.objects.link(sun)
         a, b = 0.6, 0.8
         sun.rotation_euler = (a, 0.0, b)
         sun.data.energy = 2.0
+        sun.data.color = (1.0, 0.6, 0.3)
         environment_texture(scene, 40.0, 0.7)
 
         addon_frame = WORK / "addon.exr"
@@ -276,14 +279,16 @@ class RenderTest(unittest.TestCase):
         clean.save_render(str(WORK / "studio-clean.exr"), scene=scene)
         half_h = 36.0 / (2 * 50.0) * 48 / 64  # AUTO fit, landscape: the sensor's 36 mm across
         ref = {
+            # AUTO fit, landscape: Blender's shift is in widths, Sunbeam's in the larger side's
             "camera": {"eye": blender_to_sunbeam(eye), "target": [0, 0, 0], "up": [0, 1, 0],
-                       "fov_y_deg": math.degrees(2 * math.atan(half_h))},
+                       "fov_y_deg": math.degrees(2 * math.atan(half_h)), "shift": [0.1, -0.06]},
             "lights": [{"direction": [math.sin(a) * math.sin(b), math.cos(a), math.sin(a) * math.cos(b)],
-                        "intensity": 2.0 / math.pi}],
+                        "intensity": 2.0 / math.pi, "color": [1.0, 0.6, 0.3]}],
             "meshes": [{"mesh": "sphere-baked.glb", "pack": "skin.ktx2", "base_color": [0.1, 0.05, 0.02],
                         "diffuse_weight": 0.3, "masking": "smith", "ior": 1.6, "reflectance": "absolute"}],
             "environment": {"map": "studio-clean.exr", "rotation_deg": 40.0 + 180.0, "intensity": 0.7},
-            "exposure": 0, "background": [0, 0, 0], "size": [64 * SCALE, 48 * SCALE],
+            # a map World with Film > Transparent off: the map behind the sphere
+            "exposure": 0, "background": "environment", "size": [64 * SCALE, 48 * SCALE],
         }
         self.assertAlmostEqual(skin.ior, 1.6, places=5)
         (WORK / "ref.json").write_text(json.dumps(ref))
@@ -295,9 +300,32 @@ class RenderTest(unittest.TestCase):
         print(f"\nadd-on vs hand-written scene: {m.group(0)}", file=sys.stderr)
         self.assertGreater(lit, 500 * SCALE * SCALE, "the sphere covers most of the frame")
         self.assertLess(p99, 1.0)
+        # Each mapping counts: the hand-written scene without it is far from the add-on's frame.
+        for name, change in (("no shift", lambda r: r["camera"].pop("shift")),
+                             ("white sun", lambda r: r["lights"][0].pop("color")),
+                             ("black background", lambda r: r.update(background=[0, 0, 0]))):
+            other = json.loads(json.dumps(ref))
+            change(other)
+            (WORK / "other.json").write_text(json.dumps(other))
+            report = tool("sunbeam-eval", "render", WORK / "other.json", "-o", WORK / "other.exr",
+                          "--samples", "4", "--compare", addon_frame)
+            m = re.search(r"CIEDE2000 mean (\S+) p99 (\S+)", report)
+            print(f"add-on vs hand-written scene with {name}: {m.group(0)}", file=sys.stderr)
+            self.assertGreater(float(m.group(2)), 3.0, name)
         save_png(addon_frame, "blender-render.png")
         save_png(WORK / "ref.exr", "blender-reference.png")
         self.assertEqual(os.listdir(tempfile.tempdir), [])
+
+
+def looking_through(cam, width, height):
+    """A stand-in for a 3D viewport's context looking through `cam` (its view and projection
+    matrices, `calc_matrix_camera`) in a `width x height` region."""
+    window = cam.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=width, y=height)
+    return SimpleNamespace(
+        region=SimpleNamespace(width=width, height=height),
+        region_data=SimpleNamespace(is_perspective=True, view_matrix=cam.matrix_world.inverted(),
+                                    window_matrix=window),
+        space_data=SimpleNamespace(clip_start=cam.data.clip_start))
 
 
 def sunbeam_projection(camera, size, p):
@@ -313,16 +341,20 @@ def sunbeam_projection(camera, size, p):
     w, h = size
     x_ndc = d.dot(r) / (d.dot(f) * t * w / h)
     y_ndc = d.dot(u) / (d.dot(f) * t)
-    return (x_ndc + 1) / 2 * w, (1 - y_ndc) / 2 * h
+    # the lens shift moves the image window by shift x the larger side (right, up)
+    sx, sy = camera.get("shift", (0.0, 0.0))
+    m = max(w, h)
+    return (x_ndc + 1) / 2 * w - sx * m, (1 - y_ndc) / 2 * h + sy * m
 
 
 class CameraTest(unittest.TestCase):
     MARKERS = [(0.3, 0.2, -0.1), (-0.5, 0.4, 0.35), (0.1, -0.3, 0.6)]
 
-    def check(self, res, percentage, fit, roll, lens, sensor_height=None):
+    def check(self, res, percentage, fit, roll, lens, sensor_height=None, shift=(0.0, 0.0)):
         from sunbeam_blender import export
         scene = empty_scene(*res, percentage)
-        cam = add_camera(scene, (1.2, -3.0, 1.5), (0.1, 0.2, 0.0), lens=lens, fit=fit, roll_deg=roll)
+        cam = add_camera(scene, (1.2, -3.0, 1.5), (0.1, 0.2, 0.0), lens=lens, fit=fit, roll_deg=roll,
+                         shift=shift)
         if sensor_height:
             cam.data.sensor_height = sensor_height
         bpy.context.view_layer.update()
@@ -334,7 +366,8 @@ class CameraTest(unittest.TestCase):
             blender = (ndc.x * size[0], (1 - ndc.y) * size[1])
             ours = sunbeam_projection(camera, size, p)
             for a, b in zip(blender, ours):
-                self.assertLess(abs(a - b), 0.5, f"{fit} {res} {percentage}% roll {roll}: {blender} vs {ours}")
+                self.assertLess(abs(a - b), 0.5,
+                                f"{fit} {res} {percentage}% roll {roll} shift {shift}: {blender} vs {ours}")
 
     def test_auto_fit_landscape(self):
         self.check((1920, 1080), 50, "AUTO", 0.0, 35.0)
@@ -348,24 +381,30 @@ class CameraTest(unittest.TestCase):
     def test_horizontal_fit_portrait(self):
         self.check((500, 1000), 100, "HORIZONTAL", 5.0, 85.0)
 
+    def test_shift(self):
+        """Lens shift under each fit: Blender's is in units of the side the sensor spans, Sunbeam's
+        of the larger side (they differ for a portrait frame with Horizontal fit and a landscape
+        one with Vertical fit)."""
+        self.check((1920, 1080), 50, "AUTO", 0.0, 35.0, shift=(0.2, -0.1))
+        self.check((600, 900), 100, "AUTO", 15.0, 50.0, shift=(-0.15, 0.25))
+        self.check((500, 1000), 100, "HORIZONTAL", 5.0, 85.0, shift=(0.1, 0.3))
+        self.check((1600, 900), 75, "VERTICAL", -30.0, 28.0, sensor_height=20.0, shift=(0.3, -0.2))
+
 
     def test_viewport_camera(self):
         """The viewport's camera from its matrices, here those of a camera looking through it."""
         from sunbeam_blender import engine
         scene = empty_scene(64, 48)
-        cam = add_camera(scene, (1.2, -3.0, 1.5), (0.1, 0.2, 0.0), lens=35.0, roll_deg=10.0)
-        window = cam.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=64, y=48)
-        context = SimpleNamespace(
-            region=SimpleNamespace(width=64, height=48),
-            region_data=SimpleNamespace(is_perspective=True, view_matrix=cam.matrix_world.inverted(),
-                                        window_matrix=window),
-            space_data=SimpleNamespace(clip_start=cam.data.clip_start))
-        camera, size = engine.viewport_camera(context)
-        for p in self.MARKERS:
-            ndc = world_to_camera_view(scene, cam, Vector(p))
-            blender = (ndc.x * size[0], (1 - ndc.y) * size[1])
-            for a, b in zip(blender, sunbeam_projection(camera, size, p)):
-                self.assertLess(abs(a - b), 0.5)
+        for shift in ((0.0, 0.0), (0.2, -0.15)):
+            cam = add_camera(scene, (1.2, -3.0, 1.5), (0.1, 0.2, 0.0), lens=35.0, roll_deg=10.0,
+                             shift=shift)
+            camera, size = engine.viewport_camera(looking_through(cam, 64, 48))
+            self.assertEqual("shift" in camera, shift != (0.0, 0.0))
+            for p in self.MARKERS:
+                ndc = world_to_camera_view(scene, cam, Vector(p))
+                blender = (ndc.x * size[0], (1 - ndc.y) * size[1])
+                for a, b in zip(blender, sunbeam_projection(camera, size, p)):
+                    self.assertLess(abs(a - b), 0.5, f"shift {shift}")
 
 
 class BadInputTest(unittest.TestCase):
@@ -672,13 +711,7 @@ class ViewportTest(unittest.TestCase):
             setattr(stand_in, name, MethodType(getattr(engine.SunbeamRenderEngine, name), stand_in))
         stand_in._export_viewport()
         self.assertEqual(stand_in.reports, [])
-        window = cam.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=48, y=48)
-        context = SimpleNamespace(
-            region=SimpleNamespace(width=48, height=48),
-            region_data=SimpleNamespace(is_perspective=True, view_matrix=cam.matrix_world.inverted(),
-                                        window_matrix=window),
-            space_data=SimpleNamespace(clip_start=cam.data.clip_start))
-        stand_in._start_preview(*engine.viewport_camera(context), 2)
+        stand_in._start_preview(*engine.viewport_camera(looking_through(cam, 48, 48)), 2)
         thread, holder = stand_in._preview
         thread.join()
         self.assertIsNone(holder["error"])

@@ -162,6 +162,7 @@ pub fn quad_scene(size: [u32; 2]) -> (Scene, Mesh) {
         direction: [-0.5, 0.0, 0.866],
         intensity: 1.0,
         spectrum: "D65".into(),
+        color: [1.0; 3],
     }];
     (s, mesh)
 }
@@ -195,6 +196,7 @@ pub fn snake_scene(size: [u32; 2]) -> Result<(Scene, Mesh)> {
         direction: [-0.4, 0.5, 0.77],
         intensity: 1.0,
         spectrum: "D65".into(),
+        color: [1.0; 3],
     }];
     Ok((s, mesh))
 }

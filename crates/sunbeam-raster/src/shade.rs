@@ -148,9 +148,11 @@ impl<'a> Shader<'a> {
             } else {
                 [0.0; 3]
             };
+            // A coloured light tints its RGB contribution (docs/SCENE.md).
             for k in 0..3 {
-                rgb[k] +=
-                    light.intensity * (dw * mat.base_color[k] * base_in + (1.0 - dw) * diff[k]);
+                rgb[k] += light.intensity
+                    * light.color[k]
+                    * (dw * mat.base_color[k] * base_in + (1.0 - dw) * diff[k]);
             }
         }
         rgb

@@ -218,3 +218,73 @@ fn images_round_trip_png_and_compare() {
     let _ = Mesh::quad();
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `camera.shift` (docs/SCENE.md, Blender's lens shift): the reference's
+/// fragments, of the quad and of the background, project back to their pixel
+/// centres under a pinhole model with the shift written here independently
+/// (the image window moves by `shift x max(w, h)` pixels, right and up), and
+/// the quad's centre lands where that model puts it.
+#[test]
+fn lens_shift_matches_a_pinhole_model() {
+    let (w, h) = (48u32, 32u32);
+    let (mut scene, mesh) = fixtures::quad_scene([w, h]);
+    scene.meshes[0].pack = None;
+    // the view axis along -z: view coordinates are world ones minus the eye
+    scene.camera.eye = [0.3, -0.2, 4.0];
+    scene.camera.target = [0.3, -0.2, 0.0];
+    scene.camera.fov_y_deg = 30.0;
+    scene.camera.shift = [0.2, 0.15];
+    let p = fixtures::prepared(scene.clone(), mesh, None);
+    let g = raster::rasterise(&p, w, h);
+    let t = (30f64.to_radians() / 2.0).tan();
+    let m = w.max(h) as f64;
+    let eye = scene.camera.eye;
+    let project = |q: [f64; 3]| {
+        let (x, y, z) = (q[0] - eye[0], q[1] - eye[1], eye[2] - q[2]);
+        let f = h as f64 / 2.0 / t; // pixels per unit of tangent
+        [
+            w as f64 / 2.0 + x / z * f - 0.2 * m,
+            h as f64 / 2.0 - y / z * f + 0.15 * m,
+        ]
+    };
+    let mut covered = 0;
+    let mut worst: f64 = 0.0;
+    for j in 0..h as usize {
+        for i in 0..w as usize {
+            let f = &g[j * w as usize + i];
+            covered += usize::from(f.mesh.is_some());
+            let q = project(f.pos);
+            worst = worst
+                .max((q[0] - (i as f64 + 0.5)).abs())
+                .max((q[1] - (j as f64 + 0.5)).abs());
+        }
+    }
+    // (the rasteriser snaps vertices to 1/256 pixel: measured 0.001 px)
+    eprintln!("worst fragment {worst:.2e} px off its pixel centre");
+    assert!(worst < 0.01, "a fragment projects {worst} px off its pixel");
+    // the quad (side 1): its centre at the model's pixel, its pixels around it
+    let c = project([0.0; 3]);
+    assert!(
+        c[0] > 8.0 && c[0] < 12.0 && c[1] > 18.0 && c[1] < 24.0,
+        "{c:?}"
+    );
+    let (mut sx, mut sy) = (0.0, 0.0);
+    for (k, f) in g.iter().enumerate() {
+        if f.mesh.is_some() {
+            sx += (k % w as usize) as f64 + 0.5;
+            sy += (k / w as usize) as f64 + 0.5;
+        }
+    }
+    let side = 1.0 / 4.0 * h as f64 / 2.0 / t;
+    assert!(
+        (covered as f64 - side * side).abs() < 2.0 * side + 2.0,
+        "{covered} vs {}",
+        side * side
+    );
+    let centroid = [sx / covered as f64, sy / covered as f64];
+    eprintln!("quad centre {c:?}, its pixels' centroid {centroid:?}, {covered} px");
+    assert!(
+        (centroid[0] - c[0]).abs() < 0.5 && (centroid[1] - c[1]).abs() < 0.5,
+        "{centroid:?} vs {c:?}"
+    );
+}

@@ -2,6 +2,11 @@
 //! space looking down -z, clip depth in [0, 1], NDC y up, pixel (i, j) with j
 //! counted from the top row and its centre at (i + 0.5, j + 0.5).
 //!
+//! The lens shift (`camera.shift`, Blender's convention) moves the image window
+//! in the image plane by `shift` times the image's larger side: NDC
+//! `(x, y)` of the unshifted projection become `(x - 2 sx m / w, y - 2 sy m / h)`,
+//! `m = max(w, h)` (see [`Camera::shift_ndc`]).
+//!
 //! Near and far planes are not in the scene file: they are `0.01 d` and `100 d`
 //! with `d` the eye-target distance, so both renderers clip identically.
 
@@ -84,14 +89,29 @@ impl Camera {
         ]
     }
 
-    /// View -> clip, perspective, depth 0 at near and 1 at far.
+    /// The lens shift in NDC for an image of aspect `w / h`: `(2 sx m / w,
+    /// 2 sy m / h)` with `m = max(w, h)`, what the shift subtracts from the
+    /// unshifted NDC of a point.
+    pub fn shift_ndc(&self, aspect: f64) -> [f64; 2] {
+        let [sx, sy] = self.shift;
+        // m / w = max(1, 1 / aspect), m / h = max(aspect, 1)
+        [
+            2.0 * sx * (1.0 / aspect).max(1.0),
+            2.0 * sy * aspect.max(1.0),
+        ]
+    }
+
+    /// View -> clip, perspective, depth 0 at near and 1 at far, with the lens
+    /// shift (an off-axis frustum).
     pub fn projection(&self, aspect: f64) -> Mat4 {
         let (n, fa) = self.near_far();
         let t = 1.0 / (self.fov_y_deg.to_radians() / 2.0).tan();
+        // clip.xy -= shift_ndc * clip.w, clip.w = -z_view
+        let [dx, dy] = self.shift_ndc(aspect);
         [
             [t / aspect, 0.0, 0.0, 0.0],
             [0.0, t, 0.0, 0.0],
-            [0.0, 0.0, fa / (n - fa), -1.0],
+            [dx, dy, fa / (n - fa), -1.0],
             [0.0, 0.0, n * fa / (n - fa), 0.0],
         ]
     }
@@ -108,7 +128,14 @@ impl Camera {
         let s = [v[0][0], v[1][0], v[2][0]];
         let u = [v[0][1], v[1][1], v[2][1]];
         let f = [-v[0][2], -v[1][2], -v[2][2]];
-        (f, s.map(|c| c * aspect / t), u.map(|c| c / t))
+        let (rx, ry) = (s.map(|c| c * aspect / t), u.map(|c| c / t));
+        // NDC (x, y) of the shifted image is (x + dx, y + dy) of the unshifted one
+        let [dx, dy] = self.shift_ndc(aspect);
+        (
+            std::array::from_fn(|k| f[k] + dx * rx[k] + dy * ry[k]),
+            rx,
+            ry,
+        )
     }
 
     /// Unit world direction of the view ray through pixel position `(x, y)`
@@ -143,6 +170,7 @@ mod tests {
             target: [0.5, -0.3, 0.2],
             up: [0.0, 1.0, 0.0],
             fov_y_deg: 40.0,
+            shift: [0.0; 2],
         };
         let m = cam.view_proj(200, 100);
         let c = transform(&m, [0.5, -0.3, 0.2, 1.0]);
@@ -155,5 +183,39 @@ mod tests {
         let v = cam.view();
         let e = transform(&v, [1.0, 2.0, 5.0, 1.0]);
         assert!(e[0].abs() < 1e-12 && e[1].abs() < 1e-12 && e[2].abs() < 1e-12);
+    }
+
+    /// The lens shift moves the image by `shift x max(w, h)` pixels (right,
+    /// up), whatever the aspect; the view ray through a pixel goes back to
+    /// the point that projects there.
+    #[test]
+    fn shift_moves_the_image_by_fractions_of_the_larger_side() {
+        for (w, h) in [(200u32, 100u32), (90, 160)] {
+            let mut cam = Camera {
+                eye: [0.3, 0.2, 4.0],
+                target: [0.0, 0.0, 0.0],
+                up: [0.1, 1.0, 0.0],
+                fov_y_deg: 35.0,
+                shift: [0.0; 2],
+            };
+            let p = [0.4, -0.25, 0.3, 1.0];
+            let px = |cam: &Camera| {
+                let c = transform(&cam.view_proj(w, h), p);
+                [
+                    (c[0] / c[3] * 0.5 + 0.5) * w as f64,
+                    (0.5 - c[1] / c[3] * 0.5) * h as f64,
+                ]
+            };
+            let a = px(&cam);
+            cam.shift = [0.125, -0.0625];
+            let b = px(&cam);
+            let m = w.max(h) as f64;
+            // the window moves right and down: the point moves left and up
+            assert!((a[0] - b[0] - 0.125 * m).abs() < 1e-9, "{a:?} {b:?}");
+            assert!((a[1] - b[1] - 0.0625 * m).abs() < 1e-9, "{a:?} {b:?}");
+            let d = cam.ray(w, h, b[0], b[1]);
+            let e = normalize(sub([p[0], p[1], p[2]], cam.eye));
+            assert!(dot(d, e) > 1.0 - 1e-12, "{d:?} {e:?}");
+        }
     }
 }

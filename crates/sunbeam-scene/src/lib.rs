@@ -188,6 +188,15 @@ pub struct Camera {
     /// Vertical field of view, degrees.
     #[serde(default = "default_fov")]
     pub fov_y_deg: f64,
+    /// Lens shift `[x, y]` (Blender's): the image window moves right by `x`
+    /// and up by `y` times the image's larger side, the view direction and
+    /// field of view unchanged (an off-axis projection).
+    #[serde(
+        default,
+        skip_serializing_if = "is_zero2",
+        deserialize_with = "camera_shift"
+    )]
+    pub shift: [f64; 2],
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -201,6 +210,16 @@ pub struct Light {
     /// Spectral power distribution: "D65" (the default; the only one for now).
     #[serde(default = "default_spectrum")]
     pub spectrum: String,
+    /// Linear sRGB colour `[r, g, b]` multiplying the light's contribution
+    /// channel by channel (finite, >= 0; default white). The diffraction is
+    /// computed under the spectrum and its RGB result tinted: an
+    /// approximation for a coloured light (docs/SCENE.md).
+    #[serde(
+        default = "white",
+        skip_serializing_if = "is_white",
+        deserialize_with = "light_color"
+    )]
+    pub color: [f64; 3],
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -349,6 +368,40 @@ impl MeshInstance {
 fn one() -> f64 {
     1.0
 }
+fn white() -> [f64; 3] {
+    [1.0; 3]
+}
+fn is_white(c: &[f64; 3]) -> bool {
+    *c == [1.0; 3]
+}
+fn is_zero2(v: &[f64; 2]) -> bool {
+    *v == [0.0; 2]
+}
+
+/// An array of `N` numbers, or an error naming `field` and what it wants.
+fn numbers<'de, D: serde::Deserializer<'de>, const N: usize>(
+    d: D,
+    field: &str,
+    want: &str,
+) -> std::result::Result<[f64; N], D::Error> {
+    let bad = || serde::de::Error::custom(format!("{field}: expected {want}"));
+    match serde_json::Value::deserialize(d)? {
+        serde_json::Value::Array(a) if a.len() == N => {
+            let mut out = [0.0; N];
+            for (o, v) in out.iter_mut().zip(&a) {
+                *o = v.as_f64().ok_or_else(bad)?;
+            }
+            Ok(out)
+        }
+        _ => Err(bad()),
+    }
+}
+fn light_color<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<[f64; 3], D::Error> {
+    numbers(d, "lights[].color", "[r, g, b], 3 numbers (linear sRGB)")
+}
+fn camera_shift<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<[f64; 2], D::Error> {
+    numbers(d, "camera.shift", "[x, y], 2 numbers")
+}
 fn default_up() -> [f64; 3] {
     [0.0, 1.0, 0.0]
 }
@@ -378,6 +431,7 @@ impl Light {
             direction: [0.3, 1.0, 0.6],
             intensity: 1.0,
             spectrum: default_spectrum(),
+            color: white(),
         }
     }
 }
@@ -459,6 +513,7 @@ impl Scene {
                 target: c,
                 up: default_up(),
                 fov_y_deg: fov,
+                shift: [0.0; 2],
             },
             lights: default_lights(),
             meshes: vec![MeshInstance {
@@ -531,6 +586,17 @@ impl Scene {
         if !(self.camera.fov_y_deg > 0.1 && self.camera.fov_y_deg < 179.0) {
             return Err(Error::input("camera.fov_y_deg must be in (0.1, 179)"));
         }
+        if !self
+            .camera
+            .shift
+            .iter()
+            .all(|v| v.is_finite() && v.abs() <= 10.0)
+        {
+            return Err(Error::input(format!(
+                "camera.shift {:?} must be finite, each in [-10, 10]",
+                self.camera.shift
+            )));
+        }
         for (i, l) in self.lights.iter_mut().enumerate() {
             let n = (l.direction.iter().map(|v| v * v).sum::<f64>()).sqrt();
             if !(n.is_finite() && n > 0.0) {
@@ -543,6 +609,18 @@ impl Scene {
                 return Err(Error::input(format!(
                     "lights[{i}].spectrum '{}': only D65 is supported",
                     l.spectrum
+                )));
+            }
+            if !(l.intensity.is_finite() && l.intensity >= 0.0) {
+                return Err(Error::input(format!(
+                    "lights[{i}].intensity {} must be finite and >= 0",
+                    l.intensity
+                )));
+            }
+            if !l.color.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return Err(Error::input(format!(
+                    "lights[{i}].color {:?} must be finite and >= 0 (linear sRGB [r, g, b])",
+                    l.color
                 )));
             }
         }
@@ -762,5 +840,72 @@ mod tests {
             DefaultLighting::Point,
         );
         assert_eq!(p.meshes[0].masking, MaskingMode::Off);
+    }
+
+    #[test]
+    fn light_color_and_camera_shift() {
+        let scene = |light: &str, cam: &str| -> Result<Scene> {
+            let text = format!(
+                r#"{{"camera":{{"eye":[0,0,3],"target":[0,0,0]{cam}}},"meshes":[{{"mesh":"a.glb"}}],"lights":[{light}]}}"#
+            );
+            let mut s: Scene =
+                serde_json::from_str(&text).map_err(|e| Error::input(e.to_string()))?;
+            s.validate()?;
+            Ok(s)
+        };
+        let s = scene(r#"{"direction":[0,0,1]}"#, "").unwrap();
+        assert_eq!(s.lights[0].color, [1.0; 3]);
+        assert_eq!(s.camera.shift, [0.0; 2]);
+        // defaults are not written back
+        let text = serde_json::to_string(&s).unwrap();
+        assert!(
+            !text.contains("\"color\"") && !text.contains("shift"),
+            "{text}"
+        );
+        let s = scene(
+            r#"{"direction":[0,0,1],"color":[1,0.2,0]}"#,
+            r#","shift":[0.1,-0.2]"#,
+        )
+        .unwrap();
+        assert_eq!(s.lights[0].color, [1.0, 0.2, 0.0]);
+        assert_eq!(s.camera.shift, [0.1, -0.2]);
+        let again: Scene = serde_json::from_str(&serde_json::to_string(&s).unwrap()).unwrap();
+        assert_eq!(again, s);
+        for (light, cam, field) in [
+            (
+                r#"{"direction":[0,0,1],"color":[1,-0.1,0]}"#,
+                "",
+                "lights[0].color",
+            ),
+            (r#"{"direction":[0,0,1],"color":[1,1]}"#, "", "color"),
+            (
+                r#"{"direction":[0,0,1],"intensity":-1}"#,
+                "",
+                "lights[0].intensity",
+            ),
+            (r#"{"direction":[0,0,1]}"#, r#","shift":[0.1]"#, "shift"),
+            (
+                r#"{"direction":[0,0,1]}"#,
+                r#","shift":[1e3,0]"#,
+                "camera.shift",
+            ),
+        ] {
+            let msg = scene(light, cam).unwrap_err().to_string();
+            assert!(msg.contains(field), "{light} {cam}: {msg}");
+        }
+        let mut s = scene(r#"{"direction":[0,0,1]}"#, "").unwrap();
+        s.lights[0].color[2] = f64::NAN;
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("lights[0].color"));
+        s.lights[0].color[2] = 1.0;
+        s.camera.shift[1] = f64::INFINITY;
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("camera.shift"));
     }
 }

@@ -215,10 +215,16 @@ def viewport_camera(context):
     if not rv3d.is_perspective:
         raise SunbeamError("Viewport: Sunbeam renders perspective views only")
     inv = rv3d.view_matrix.inverted()
-    fov = 2.0 * math.degrees(math.atan(1.0 / rv3d.window_matrix[1][1]))
+    wm = rv3d.window_matrix
+    fov = 2.0 * math.degrees(math.atan(1.0 / wm[1][1]))
+    # An off-axis projection (a camera view with Shift): wm[0][2], wm[1][2] are the NDC
+    # offsets, Sunbeam's shift times 2 m / w and 2 m / h (m the larger side).
+    w, h = region.width, region.height
+    m = max(w, h, 1)
+    shift = (wm[0][2] * w / (2.0 * m), wm[1][2] * h / (2.0 * m))
     camera = export.view_camera(inv.translation, inv.to_3x3() @ Vector((0, 0, -1)),
                                 inv.to_3x3() @ Vector((0, 1, 0)), fov,
-                                context.space_data.clip_start, "Viewport")
+                                context.space_data.clip_start, "Viewport", shift=shift)
     return camera, (region.width, region.height)
 
 

@@ -69,8 +69,6 @@ def camera_from_object(scene, cam_obj, warnings):
     width, height = render_size(scene)
     if r.pixel_aspect_x != r.pixel_aspect_y:
         raise SunbeamError(f"Scene '{scene.name}': Pixel Aspect: Sunbeam renders square pixels")
-    if cam.shift_x or cam.shift_y:
-        warnings.append(f"Camera '{cam_obj.name}': Shift is not supported (rendered without it)")
     fit = cam.sensor_fit
     if fit == "AUTO":
         fit, sensor = ("HORIZONTAL" if width >= height else "VERTICAL"), cam.sensor_width
@@ -79,20 +77,31 @@ def camera_from_object(scene, cam_obj, warnings):
     half = sensor / (2.0 * cam.lens)
     if fit == "HORIZONTAL":
         half *= height / width
+    # Blender's shift is in units of the side the sensor spans (the fit's: width for
+    # horizontal, height for vertical), Sunbeam's of the larger side.
+    side = width if fit == "HORIZONTAL" else height
+    scale = side / max(width, height, 1)
     m = cam_obj.matrix_world
     return view_camera(m.translation, m.to_3x3() @ Vector((0, 0, -1)), m.to_3x3() @ Vector((0, 1, 0)),
-                       2.0 * math.degrees(math.atan(half)), cam.clip_start, f"Camera '{cam_obj.name}'")
+                       2.0 * math.degrees(math.atan(half)), cam.clip_start, f"Camera '{cam_obj.name}'",
+                       shift=(cam.shift_x * scale, cam.shift_y * scale))
 
 
-def view_camera(eye, forward, up, fov_y_deg, clip_start, what):
+def view_camera(eye, forward, up, fov_y_deg, clip_start, what, shift=(0.0, 0.0)):
     """A scene camera looking along `forward`; the target is placed at 100 x clip_start so that
-    Sunbeam's near plane (0.01 of the eye-target distance) is Blender's Clip Start."""
+    Sunbeam's near plane (0.01 of the eye-target distance) is Blender's Clip Start. `shift`:
+    the lens shift in fractions of the frame's larger side (`camera.shift`, written when not 0)."""
     if not 0.1 < fov_y_deg < 179.0:
         raise SunbeamError(f"{what}: Focal Length: vertical field of view {fov_y_deg:.3f} deg "
                            "is outside Sunbeam's (0.1, 179)")
+    if not all(math.isfinite(v) and abs(v) <= 10.0 for v in shift):
+        raise SunbeamError(f"{what}: Shift: {shift[0]:.3f}, {shift[1]:.3f} is outside Sunbeam's [-10, 10]")
     target = eye + forward.normalized() * (100.0 * clip_start)
-    return {"eye": to_sunbeam(eye), "target": to_sunbeam(target), "up": to_sunbeam(up.normalized()),
-            "fov_y_deg": fov_y_deg}
+    out = {"eye": to_sunbeam(eye), "target": to_sunbeam(target), "up": to_sunbeam(up.normalized()),
+           "fov_y_deg": fov_y_deg}
+    if shift[0] or shift[1]:
+        out["shift"] = [float(shift[0]), float(shift[1])]
+    return out
 
 
 # ---------------------------------------------------------------- lights
@@ -105,7 +114,7 @@ def lights(depsgraph, centre, warnings):
     and area lamps have no counterpart (the scene format has directional lights only): each
     becomes a directional light from the direction of the lamp seen from `centre` (the centre
     of the rendered meshes) with the irradiance it gives there (point and spot: P / (4 pi d^2);
-    area: P cos / (pi d^2)), and a warning says so.
+    area: P cos / (pi d^2)), and a warning says so. The lamp's Color is the light's `color`.
     """
     out = []
     for obj in depsgraph.objects:
@@ -113,8 +122,6 @@ def lights(depsgraph, centre, warnings):
             continue
         light = obj.data
         m = obj.matrix_world
-        if tuple(light.color) != (1.0, 1.0, 1.0):
-            warnings.append(f"Light '{obj.name}': Color is not supported (Sunbeam lights are D65 white)")
         if light.type == "SUN":
             direction = m.to_3x3() @ Vector((0, 0, 1))
             irradiance = light.energy
@@ -130,7 +137,12 @@ def lights(depsgraph, centre, warnings):
             warnings.append(f"Light '{obj.name}': {light.type.lower()} lamp rendered as a directional "
                             "light (Sunbeam has directional lights only)")
         if irradiance > 0.0 and direction.length > 0.0:
-            out.append({"direction": to_sunbeam(direction.normalized()), "intensity": irradiance / math.pi})
+            entry = {"direction": to_sunbeam(direction.normalized()), "intensity": irradiance / math.pi}
+            # Blender's lamp colour (scene linear): Sunbeam's `color`, which tints the light's RGB
+            color = [float(c) for c in light.color]
+            if color != [1.0, 1.0, 1.0]:
+                entry["color"] = color
+            out.append(entry)
     return out
 
 
@@ -193,8 +205,16 @@ def _mapping_rotation_deg(node, what):
     return -angle if node.vector_type == "TEXTURE" else angle
 
 
+def _environment_background(scene):
+    """The background under a map or sky: the environment itself (`"environment"`, drawn
+    along each view ray) unless Film > Transparent is on, where Blender draws none: black
+    (Sunbeam's frame has no alpha)."""
+    return [0.0, 0.0, 0.0] if scene.render.film_transparent else "environment"
+
+
 def world(scene, tmp, warnings):
-    """Sunbeam's `environment` (or None) and `background` for Blender's World.
+    """Sunbeam's `environment` (or None) and `background` for Blender's World (a map or sky:
+    `"environment"`, or black with Film > Transparent; a plain colour: that colour).
 
     Blender's equirectangular lookup puts the map's centre column at +x, Sunbeam's (docs/SCENE.md)
     its first column: the same image lights the same way when Sunbeam's map is rotated by
@@ -239,9 +259,8 @@ def world(scene, tmp, warnings):
         path = os.path.join(tmp, "world.exr")
         _write_image_map(src.image, path, what)
         rotation = (rotation + 180.0) % 360.0 - 180.0
-        warnings.append(f"{what}: the map lights the scene but is not drawn behind it "
-                        "(Sunbeam's background is one colour: black)")
-        return {"map": path, "rotation_deg": rotation, "intensity": strength}, [0.0, 0.0, 0.0]
+        return ({"map": path, "rotation_deg": rotation, "intensity": strength},
+                _environment_background(scene))
     if src.type == "TEX_SKY":
         what = f"{what}: Sky Texture '{src.name}'"
         if src.sky_type == "NISHITA":
@@ -259,7 +278,7 @@ def world(scene, tmp, warnings):
                "turbidity": min(10.0, max(1.7, turbidity))}
         warnings.append(f"{what}: Strength scales Sunbeam's sky, which is normalised so that a "
                         "white horizontal surface has radiance 1")
-        return {"sky": sky, "intensity": strength}, [0.0, 0.0, 0.0]
+        return {"sky": sky, "intensity": strength}, _environment_background(scene)
     raise SunbeamError(f"{what}: Background Color: only an Environment Texture, a Sky Texture "
                        f"or a colour is supported (not {src.name})")
 

@@ -571,6 +571,7 @@ impl Renderer {
         }
         let vp = camera::to_f32(&vpm);
         let mut lights = [[0.0f32; 4]; MAX_LIGHTS];
+        let mut light_colors = [[0.0f32; 4]; MAX_LIGHTS];
         let mut n = 0;
         for l in state.lights.iter().take(MAX_LIGHTS) {
             let d = l.direction;
@@ -584,6 +585,8 @@ impl Renderer {
                 (d[2] / len) as f32,
                 l.intensity as f32,
             ];
+            let c = l.color;
+            light_colors[n] = [c[0] as f32, c[1] as f32, c[2] as f32, 0.0];
             n += 1;
         }
         let m = colour::XYZ_TO_SRGB;
@@ -597,6 +600,7 @@ impl Renderer {
                 1.0,
             ],
             lights,
+            light_colors,
             xyz_to_rgb: [row(0), row(1), row(2)],
             background: {
                 let b = state.background.colour().unwrap_or([0.0; 3]);

@@ -28,6 +28,8 @@ pub(super) struct Globals {
     pub(super) view_proj: [[f32; 4]; 4],
     pub(super) eye: [f32; 4],
     pub(super) lights: [[f32; 4]; MAX_LIGHTS],
+    /// rgb: each light's linear sRGB colour (scene `lights[].color`).
+    pub(super) light_colors: [[f32; 4]; MAX_LIGHTS],
     pub(super) xyz_to_rgb: [[f32; 4]; 3],
     pub(super) background: [f32; 4],
     pub(super) n_lights: u32,
@@ -268,6 +270,7 @@ mod layout_tests {
                 view_proj,
                 eye,
                 lights,
+                light_colors,
                 xyz_to_rgb,
                 background,
                 n_lights,
