@@ -8,7 +8,7 @@
 # Takes the Makefile's variables (BIN, OUT, SHARED, MATERIALS, SIZE, BRDF_SIZE,
 # SYNTH_SIZE, SYNTH_PIXEL, SNAKE_DETAIL, PACK_FLAGS, PLAY_FLAGS, SKY_SAMPLES, PLAY_SKY_FRAMES, PLAY_FIRST_CELLS,
 # TURNTABLE_MATERIAL, TURNTABLE_SIZE, TURNTABLE_FRAMES, TURNTABLE_ESTIMATOR, COLUMNS,
-# SCALE_TEXELS, SCALES_xeno, SCALES_elaphe, SHEET, Q)
+# SCALE_TEXELS, SCALES_xeno, SCALES_elaphe, HDRI, SHEET, Q)
 # with the same defaults, on the command line only. Paths are relative to
 # examples/ exactly as make sees them, so Ninja runs in examples/ (-C examples)
 # and the tools' depfiles are the same bytes as under make. Ninja reads each
@@ -41,6 +41,7 @@ SCALE_TEXELS=16
 # Scales per species (examples/Makefile SCALES_*; docs/BAKE.md "Scales").
 SCALES_xeno="--scale-rows 20 --scale-length 1.0 --scale-overlap 0.3 --scale-dome 0.06 --scale-tilt 6 --scale-tilt-jitter 4 --scale-ridge-jitter 6"
 SCALES_elaphe="--scale-rows 36 --scale-length 1.5 --scale-overlap 0.3 --scale-dome 0.1 --scale-tilt 6 --scale-tilt-jitter 4 --scale-ridge-jitter 4"
+HDRI=__default__
 SHEET=__default__
 Q=-q
 for a in "$@"; do
@@ -48,7 +49,7 @@ for a in "$@"; do
     BIN=* | OUT=* | SHARED=* | MATERIALS=* | SIZE=* | BRDF_SIZE=* | SYNTH_SIZE=* | SYNTH_PIXEL=* | \
       SNAKE_DETAIL=* | PACK_FLAGS=* | PLAY_FLAGS=* | SKY_SAMPLES=* | PLAY_SKY_FRAMES=* | PLAY_FIRST_CELLS=* | COLUMNS=* | SHEET=* | Q=* | \
       TURNTABLE_MATERIAL=* | TURNTABLE_SIZE=* | TURNTABLE_FRAMES=* | TURNTABLE_ESTIMATOR=* | \
-      SCALE_TEXELS=* | SCALES_xeno=* | SCALES_elaphe=*)
+      SCALE_TEXELS=* | SCALES_xeno=* | SCALES_elaphe=* | HDRI=*)
       printf -v "${a%%=*}" '%s' "${a#*=}" ;;
     *) echo "ninja.sh: unknown argument '$a' (expected VAR=value, see the header)" >&2; exit 1 ;;
   esac
@@ -64,6 +65,18 @@ if [ "$MATERIALS" = __default__ ]; then
   if [ -n "$SHARED" ]; then MATERIALS="veeco elaphe xeno"; else MATERIALS="elaphe xeno"; fi
 fi
 [ "$TURNTABLE_MATERIAL" = __default__ ] && TURNTABLE_MATERIAL=${MATERIALS##* }
+# The viewer's environments (examples/Makefile ENVS): the sky, and the studio map when present.
+if [ "$HDRI" = __default__ ]; then
+  HDRI=""
+  if [ -n "$SHARED" ] && [ -e "$SHARED/hdri/studio.exr" ]; then HDRI=$SHARED/hdri/studio.exr; fi
+fi
+ENVS=sky
+HDRI_ABS=""
+if [ -n "$HDRI" ]; then
+  ENVS="sky studio"
+  # make's $(abspath): from the physical working directory, `..` removed textually
+  case $HDRI in /*) HDRI_ABS=$(realpath -s -m "$HDRI") ;; *) HDRI_ABS=$(realpath -s -m "$(pwd -P)/$HDRI") ;; esac
+fi
 EVAL=$BIN/sunbeam-eval
 [ "$SHEET" = __default__ ] && SHEET="$EVAL sheet"
 
@@ -135,6 +148,15 @@ rule play_sky
 rule turntable
   command = rm -f \$tidy && $(esc "$EVAL") render \$in --size $(esc "$TURNTABLE_SIZE") --samples $(esc "$SKY_SAMPLES") --env-estimator $(esc "$TURNTABLE_ESTIMATOR") --turntable $(esc "$TURNTABLE_FRAMES") --axis 0,0,1 -o \${target} \$q
   description = turntable \${target}
+rule studio_scene
+  command = rm -f \$tidy && sed -e 's|@PACK@|\${name}.ktx2|' -e 's|@MESH@|snake-\${name}.glb|' -e 's|@MAP@|$(esc "$HDRI_ABS")|' \$in > \${outdir}/.\${name}-studio.json.tmp.\$\$\$\$ && mv \${outdir}/.\${name}-studio.json.tmp.\$\$\$\$ \${target}
+  description = studio_scene \${target}
+rule export_environment
+  command = rm -f \${dir}/.*.tmp.* && $(esc "$BIN")/sunbeam-play \$in --export-environment \${dir} \$q
+  description = export_environment \${dir}
+rule environments
+  command = rm -f \$tidy && echo '{ "environments": [\$list] }' > \${outdir}/.environments.json.tmp.\$\$\$\$ && mv \${outdir}/.environments.json.tmp.\$\$\$\$ \${target}
+  description = environments \${target}
 rule brdf
   command = rm -f \$tidy && $(esc "$EVAL") brdf \$in --light 60deg,0deg --size $(esc "$BRDF_SIZE") -o \${target} \$q
   description = brdf \${target}
@@ -214,6 +236,18 @@ EOF
       elaphe) echo "  scales = $(esc "$SCALES_elaphe")" ;;
     esac
     echo "  tidy = $(esc "$OUT/.snake-$m.glb").tmp.*"
+    for e in $ENVS; do
+      if [ "$e" = studio ]; then
+        echo "build $o/$m-studio.json: studio_scene studio-scene.json.in"
+        echo "  target = $o/$m-studio.json"
+        echo "  name = $m"
+        echo "  tidy = $(esc "$OUT/.$m-studio.json").tmp.*"
+        echo "build $o/env-studio-$m/environment.json: export_environment $o/$m-studio.json | $(path "$HDRI") $o/$m.ktx2 $o/$m.env-response.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
+      else
+        echo "build $o/env-sky-$m/environment.json: export_environment $o/$m-sky.json | $o/$m.ktx2 $o/$m.env-response.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
+      fi
+      echo "  dir = $(esc "$OUT/env-$e-$m")"
+    done
     sheet_in="$sheet_in $o/$m-height.png $o/$m-brdf.png $o/$m-grating.png $o/$m-frame.png $o/$m-play-first.png $o/$m-play-sky.png $o/$m-sky.png"
   done
   tm=$TURNTABLE_MATERIAL
@@ -227,6 +261,11 @@ EOF
   echo "build $o/sunbeam-es.frag: export_shader | $(path "$BIN/sunbeam-play")"
   echo "  target = $(esc "$OUT/sunbeam-es.frag")"
   echo "  tidy = $(esc "$OUT/.sunbeam-es.frag").tmp.*"
+  env_list=""; for e in $ENVS; do env_list="$env_list${env_list:+, }\"$e\""; done
+  echo "build $o/environments.json: environments"
+  echo "  target = $o/environments.json"
+  echo "  list = $(esc "$env_list")"
+  echo "  tidy = $(esc "$OUT/.environments.json").tmp.*"
   echo "build $o/snake.glb: bake | $(path "$BIN/sunbeam-bake")"
   echo "  target = $(esc "$OUT/snake.glb")"
   echo "  tidy = $(esc "$OUT/.snake.glb").tmp.*"
@@ -244,6 +283,8 @@ EOF
   echo "build frames: phony$(list -frame.png -play-first.png -play-sky.png -sky.png)"
   echo "build sheet: phony $o/contact-sheet.png"
   web_in=""; for m in $MATERIALS; do web_in="$web_in $o/snake-$m.glb"; done
+  web_in="$web_in $o/environments.json"
+  for e in $ENVS; do for m in $MATERIALS; do web_in="$web_in $o/env-$e-$m/environment.json"; done; done
   echo "build web: phony $o/sunbeam-es.frag$web_in"
   echo "build turntable: phony $o/$tm-turntable.png"
   echo "build all: phony $o/contact-sheet.png $o/snake.glb web turntable"

@@ -171,3 +171,60 @@ fn ninja_builds_what_make_builds_and_rebuilds_only_dependents() {
     }
     assert!(planned(&build_file, &goal_refs).is_empty());
 }
+
+/// The viewer's environments (examples/Makefile ENVS, docs/PIPELINE.md): make
+/// and the Ninja file plan the same exports for `web`, the studio one only
+/// with an HDR image (HDRI), and the sky alone without it. Plans only (`-n`),
+/// nothing is built.
+#[test]
+fn ninja_and_make_plan_the_same_environments() {
+    if !testdata::have_command("ninja", &["--version"]) {
+        return;
+    }
+    let d = scratch("ninja-envs");
+    let hdri = d.join("studio.exr");
+    std::fs::write(&hdri, b"not read: plans only").unwrap();
+    for (with_map, want) in [(true, ["sky", "studio"].as_slice()), (false, &["sky"])] {
+        let out = d.join(format!("out-{with_map}"));
+        let mut vars = small_vars(&bin_dir(), &out);
+        vars.push("SHARED=".into());
+        vars.push(format!(
+            "HDRI={}",
+            if with_map {
+                hdri.display().to_string()
+            } else {
+                String::new()
+            }
+        ));
+        let g = Command::new(workspace_root().join("examples/ninja.sh"))
+            .args(&vars)
+            .output()
+            .expect("run examples/ninja.sh");
+        assert!(g.status.success(), "{}", String::from_utf8_lossy(&g.stderr));
+        let ninja_plan: BTreeSet<String> = planned(&out.join("build.ninja"), &["web"])
+            .into_iter()
+            .filter_map(|s| s.strip_prefix("export_environment ").map(String::from))
+            .collect();
+        let o = Command::new("make")
+            .arg("-C")
+            .arg(workspace_root().join("examples"))
+            .arg("-n")
+            .args(&vars)
+            .arg("web")
+            .output()
+            .expect("run make -n");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let make_plan: BTreeSet<String> = String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .filter_map(|l| l.split_once("--export-environment "))
+            .map(|(_, r)| r.split_whitespace().next().unwrap().to_string())
+            .collect();
+        let o = out.display();
+        let expected: BTreeSet<String> = want
+            .iter()
+            .flat_map(|e| ["elaphe", "xeno"].map(|m| format!("{o}/env-{e}-{m}")))
+            .collect();
+        assert_eq!(make_plan, expected, "make -n web");
+        assert_eq!(ninja_plan, expected, "ninja -n web");
+    }
+}

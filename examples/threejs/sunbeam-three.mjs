@@ -584,9 +584,11 @@ export function sceneCamera(scene, aspect) {
  * drawn first, showing the environment along each pixel's view ray as the
  * player's background pass does: the exported sb_env_texel (the texel of the
  * coefficient table holding the direction; here level 0 of the chain) times
- * basis_to_rgb, times 2^exposure. `camera` is the scene camera.
+ * basis_to_rgb, times 2^exposure. `camera` is the scene camera (a moving
+ * camera: update the uniforms sbInvViewProj and sbEye per frame). `display`:
+ * clip and sRGB-encode, as sunbeamMaterial's (drawing to a canvas).
  */
-export function environmentBackground(exportedGlsl, environment, camera, exposure = 0) {
+export function environmentBackground(exportedGlsl, environment, camera, exposure = 0, display = false) {
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array([-1, -1, 0, 3, -1, 0, -1, 3, 0]), 3));
   const m = environment.basisToRgb;
@@ -602,13 +604,19 @@ uniform vec3 sbEye;
 uniform mat3 sbBasisToRgb;
 uniform uvec2 sbTable;
 uniform float sbExposure;
+uniform int sbDisplay;
 uniform highp sampler2D sbChain;
 in vec2 vNdc;
 layout(location = 0) out vec4 fragColor;
 void main() {
   vec4 p = sbInvViewProj * vec4(vNdc, 1.0, 1.0);
   vec3 d = normalize(p.xyz / p.w - sbEye);
-  fragColor = vec4(sbBasisToRgb * sb_env_texel(sbChain, sbTable.x, sbTable.y, d) * sbExposure, 1.0);
+  vec3 c = sbBasisToRgb * sb_env_texel(sbChain, sbTable.x, sbTable.y, d) * sbExposure;
+  if (sbDisplay == 1) {
+    c = clamp(c, 0.0, 1.0);
+    c = mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+  }
+  fragColor = vec4(c, 1.0);
 }`,
     uniforms: {
       sbInvViewProj: { value: new THREE.Matrix4().multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse).invert() },
@@ -617,6 +625,7 @@ void main() {
       sbBasisToRgb: { value: new THREE.Matrix3().set(...m[0], ...m[1], ...m[2]) },
       sbTable: { value: new THREE.Vector2(environment.json.chain.width, environment.json.chain.height) },
       sbExposure: { value: Math.pow(2, exposure) },
+      sbDisplay: { value: display ? 1 : 0 },
       sbChain: { value: environment.chain },
     },
     depthTest: false,
