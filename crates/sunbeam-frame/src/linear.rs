@@ -190,28 +190,34 @@ pub fn interior_pixels(frames: &[&LinearImage]) -> Vec<usize> {
         .collect()
 }
 
-/// CIEDE2000 between two linear images over the pixels that are lit in the
-/// reference `b` (`Y >= LIT_Y`): mean, 99th percentile, max (PHYSICS.md 4, with
-/// Lab relative to the D65 white of Y = 1, so values above 1 are allowed).
-pub fn compare_linear(a: &LinearImage, reference: &LinearImage) -> Result<ColourDiff> {
+/// CIEDE2000 of each pixel of `a` against `reference` (same size), `None`
+/// where the reference is unlit (`Y < LIT_Y`).
+pub fn per_pixel_de(a: &LinearImage, reference: &LinearImage) -> Result<Vec<Option<f64>>> {
     if a.width != reference.width || a.height != reference.height {
         return Err(Error::input(format!(
             "image sizes differ: {}x{} vs {}x{}",
             a.width, a.height, reference.width, reference.height
         )));
     }
-    let mut d: Vec<f64> = a
-        .rgb
+    Ok(a.rgb
         .iter()
         .zip(&reference.rgb)
-        .filter(|(_, q)| luminance(**q) >= LIT_Y)
         .map(|(p, q)| {
-            colour::ciede2000_xyz(
-                colour::linear_srgb_to_xyz(p.map(|v| f64::from(v).max(0.0))),
-                colour::linear_srgb_to_xyz(q.map(|v| f64::from(v).max(0.0))),
-            )
+            (luminance(*q) >= LIT_Y).then(|| {
+                colour::ciede2000_xyz(
+                    colour::linear_srgb_to_xyz(p.map(|v| f64::from(v).max(0.0))),
+                    colour::linear_srgb_to_xyz(q.map(|v| f64::from(v).max(0.0))),
+                )
+            })
         })
-        .collect();
+        .collect())
+}
+
+/// CIEDE2000 between two linear images over the pixels that are lit in the
+/// reference `b` (`Y >= LIT_Y`): mean, 99th percentile, max (PHYSICS.md 4, with
+/// Lab relative to the D65 white of Y = 1, so values above 1 are allowed).
+pub fn compare_linear(a: &LinearImage, reference: &LinearImage) -> Result<ColourDiff> {
+    let mut d: Vec<f64> = per_pixel_de(a, reference)?.into_iter().flatten().collect();
     Ok(stats(&mut d))
 }
 

@@ -86,6 +86,21 @@ impl Irradiance {
         (plain, v.next().expect("two tables"))
     }
 
+    /// Radiance (linear sRGB) from direction `d` without the sun's disc
+    /// (inside the disc, the sky behind it; the disc is added in [`Irradiance::at`]).
+    fn radiance_without_sun(env: &Environment, d: [f64; 3]) -> [f64; 3] {
+        match env.sun() {
+            Some(s) if s.in_sun(d) => {
+                let c = s.coefficients(d);
+                let b = crate::daylight::basis_xyz();
+                colour::xyz_to_linear_srgb(std::array::from_fn(|a| {
+                    (0..3).map(|k| c[k] * b[k][a]).sum()
+                }))
+            }
+            _ => env.rgb(d),
+        }
+    }
+
     /// The tables of one environment for several weights.
     ///
     /// The midpoint sum over the directions, evaluated as a circular
@@ -113,17 +128,7 @@ impl Irradiance {
                 (0..dw)
                     .map(|i| {
                         let phi = 2.0 * PI * (i as f64 + 0.5) / dw as f64;
-                        let d = crate::direction(y, phi);
-                        match sun {
-                            Some(s) if s.in_sun(d) => {
-                                let c = s.coefficients(d);
-                                let b = crate::daylight::basis_xyz();
-                                colour::xyz_to_linear_srgb(std::array::from_fn(|a| {
-                                    (0..3).map(|k| c[k] * b[k][a]).sum()
-                                }))
-                            }
-                            _ => env.rgb(d),
-                        }
+                        Self::radiance_without_sun(env, crate::direction(y, phi))
                     })
                     .collect()
             })
@@ -152,6 +157,9 @@ impl Irradiance {
         // direction columns: phi_n - phi_d = 2 pi (m - shift) / dw for
         // m = i_d - step i_n.
         let shift = (step as f64 - 1.0) / 2.0;
+        let cos_dphi: Vec<f64> = (0..dw)
+            .map(|m| (2.0 * PI * (m as f64 - shift) / dw as f64).cos())
+            .collect();
         let tables: Vec<Vec<Vec<[f64; 3]>>> = (0..nh)
             .into_par_iter()
             .map(|jn| {
@@ -166,24 +174,25 @@ impl Irradiance {
                     weights.len()
                 ];
                 let mut kernel = vec![0.0; dw];
+                let mut cosines = vec![0.0; dw];
                 let mut kspec = fwd.make_output_vec();
                 for (j, spec) in spectra.iter().enumerate() {
                     let y = 1.0 - 2.0 * (j as f64 + 0.5) / dh as f64;
                     let sd = (1.0 - y * y).max(0.0).sqrt();
+                    // Both rows see each other only if some cosine is positive.
+                    if sn * sd + yn * y <= 0.0 {
+                        continue;
+                    }
+                    for (c, &cp) in cosines.iter_mut().zip(&cos_dphi) {
+                        *c = sn * sd * cp + yn * y;
+                    }
                     for (wi, weight) in weights.iter().enumerate() {
-                        let mut any = false;
-                        for (m, k) in kernel.iter_mut().enumerate() {
-                            let dphi = 2.0 * PI * (m as f64 - shift) / dw as f64;
-                            let c = sn * sd * dphi.cos() + yn * y;
+                        for (k, &c) in kernel.iter_mut().zip(&cosines) {
                             *k = if c > 0.0 {
-                                any = true;
                                 Self::weight_at(weight, c)
                             } else {
                                 0.0
                             };
-                        }
-                        if !any {
-                            continue;
                         }
                         fwd.process(&mut kernel, &mut kspec)
                             .expect("FFT of a kernel row");
@@ -365,7 +374,6 @@ mod tests {
         let sky = Environment::Sky(Box::new(Sky::new(35.0, 70.0, 3.0, 1.0)));
         for env in [map, sky] {
             let (plain, trans) = Irradiance::pair(&env, 1.5);
-            let sun = env.sun();
             let (dw, dh) = (DIRS_W, DIRS_W / 2);
             let (nw, nh) = (NORMALS_W, NORMALS_W / 2);
             let big = plain
@@ -393,16 +401,7 @@ mod tests {
                         if c <= 0.0 {
                             continue;
                         }
-                        let l = match sun {
-                            Some(s) if s.in_sun(d) => {
-                                let k = s.coefficients(d);
-                                let b = crate::daylight::basis_xyz();
-                                colour::xyz_to_linear_srgb(std::array::from_fn(|a| {
-                                    (0..3).map(|q| k[q] * b[q][a]).sum()
-                                }))
-                            }
-                            _ => env.rgb(d),
-                        };
+                        let l = Irradiance::radiance_without_sun(&env, d);
                         let wt = [c, Irradiance::weight_at(&trans.weight, c)];
                         for t in 0..2 {
                             for a in 0..3 {

@@ -9,27 +9,9 @@
 use serde_json::json;
 use std::path::Path;
 use sunbeam_common::Result;
-use sunbeam_optics::colour;
 use sunbeam_raster::diff::stats;
-use sunbeam_raster::linear::{interior_pixels, luminance, LIT_Y};
+use sunbeam_raster::linear::{interior_pixels, per_pixel_de};
 use sunbeam_raster::{Image, LinearImage};
-
-/// Per-pixel CIEDE2000 of `a` against `reference` (`None` where the
-/// reference is unlit).
-fn per_pixel(a: &LinearImage, reference: &LinearImage) -> Vec<Option<f64>> {
-    a.rgb
-        .iter()
-        .zip(&reference.rgb)
-        .map(|(p, q)| {
-            (luminance(*q) >= LIT_Y).then(|| {
-                colour::ciede2000_xyz(
-                    colour::linear_srgb_to_xyz(p.map(|v| f64::from(v).max(0.0))),
-                    colour::linear_srgb_to_xyz(q.map(|v| f64::from(v).max(0.0))),
-                )
-            })
-        })
-        .collect()
-}
 
 /// Black (0) through red to yellow (at `scale` and above); unlit pixels dark blue.
 fn heat(d: Option<f64>, scale: f64) -> [f32; 3] {
@@ -60,7 +42,7 @@ pub(crate) fn run(
             ),
         ));
     }
-    let d = per_pixel(&a, &r);
+    let d = per_pixel_de(&a, &r)?;
     let interior = interior_pixels(&[&r]);
     let mut is_interior = vec![false; d.len()];
     for &i in &interior {
