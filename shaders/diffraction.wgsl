@@ -112,6 +112,8 @@ struct Material {
     scales_wrap: u32,
     _s1: f32,
     _s2: f32,
+    // the energy bound's table (SbSkin.energy)
+    energy: mat4x4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -479,7 +481,7 @@ fn resp_grid() -> SbGrid {
 
 // This mesh's skin (shaders/material.wgsl).
 fn skin() -> SbSkin {
-    return SbSkin(mat.ior, mat.norm, vec2<f32>(mat.mask_sx, mat.mask_sy));
+    return SbSkin(mat.ior, mat.norm, vec2<f32>(mat.mask_sx, mat.mask_sy), mat.energy);
 }
 
 fn response_map_xyz(wi: vec3<f32>, uvw: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, jx: vec3<f32>, jy: vec3<f32>) -> vec3<f32> {

@@ -31,6 +31,11 @@ struct SunbeamMaterial {
     // for relative), zw: Smith masking's rms slopes along t and b (the pack's
     // rms_slope; (0, 0): no masking)
     skin: vec4<f32>,
+    // the energy bound's table (PHYSICS.md 2b, docs/LIGHTING.md "Energy
+    // bound"): b at t = sqrt(cos theta_r) = k / 15, k = 4 column + row: the
+    // response map's info `energy.off` (or `energy.smith` with masking) in
+    // column-major order for absolute reflectance; all 0 (no bound) for relative
+    energy: mat4x4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> sunbeam: SunbeamMaterial;
@@ -56,7 +61,7 @@ fn sunbeam_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: ve
     let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
     let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
     let gr = SbGrid(sunbeam.grid.xyz, sunbeam.warp.x, sunbeam.warp.y);
-    let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw);
+    let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw, sunbeam.energy);
     let dw = sunbeam.warp.z;
     var diff = vec3<f32>(0.0);
     if (wi_l.z > 0.0 && wr_l.z > 0.0) {

@@ -64,7 +64,7 @@ fn env_cells_layers() -> u32 {
 }
 
 fn env_cells_gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    return sb_gain(wi, wr, SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw)) * sb_masking(wi, wr, sunbeam.skin.zw);
+    return sb_gain(wi, wr, SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw, sunbeam.energy)) * sb_masking(wi, wr, sunbeam.skin.zw);
 }
 
 fn env_chain_height() -> u32 {
@@ -118,7 +118,7 @@ fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr
     }
     let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
     let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
-    let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw);
+    let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw, sunbeam.energy);
     let dw = sunbeam.warp.z;
     var diff = vec3<f32>(0.0);
     if (wi_l.z > 0.0 && wr_l.z > 0.0 && sunbeam_env.sun_grid.x > 0.0) {

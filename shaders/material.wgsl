@@ -1,5 +1,5 @@
 // Sunbeam's skin material (PHYSICS.md 2): the one WGSL version of the Fresnel
-// reflectance, the gain G, Smith's shadowing-masking, the diffuse base's share
+// reflectance, the gain G with its energy bound, Smith's shadowing-masking, the diffuse base's share
 // and the shading frame. Every shader that shades calls these: the player's
 // point lights (shaders/diffraction.wgsl) and environment (shaders/environment.wgsl),
 // the response-map material (shaders/response_map.wgsl) and the engines' export
@@ -20,7 +20,27 @@ struct SbSkin {
     norm: f32,
     // Smith masking: rms slopes of the height field along t and b; (0, 0) = off
     slope: vec2<f32>,
+    // the energy bound's table (sunbeam_optics::energy::EnergyBound::columns):
+    // b at t = sqrt(cos theta_r) = k / 15 in column k / 4, row k % 4; all 0 = no bound
+    energy: mat4x4<f32>,
 };
+
+// sunbeam_optics::energy::EnergyBound::factor: the energy bound on G at view
+// cosine cos_r, min(1, cos_r / b(cos_r)) with b linear in sqrt(cos_r)
+// between the table's 16 knots (1 where b <= cos_r: the albedo is <= 1 there).
+fn sb_energy(cos_r: f32, e: mat4x4<f32>) -> f32 {
+    let c = clamp(cos_r, 0.0, 1.0);
+    let t = sqrt(c) * 15.0;
+    let k = min(u32(t), 14u);
+    let f = t - f32(k);
+    var m = e;
+    let k1 = k + 1u;
+    let b = m[k / 4u][k % 4u] * (1.0 - f) + m[k1 / 4u][k1 % 4u] * f;
+    if (b <= c) {
+        return 1.0;
+    }
+    return c / b;
+}
 
 // The exact unpolarised Fresnel power reflectance F = (r_s^2 + r_p^2) / 2 from
 // air into index `ior` at incidence cos_theta (clamped to [0, 1]), and the
@@ -51,7 +71,7 @@ fn sb_fresnel(cos_theta: f32, ior: f32) -> f32 {
 }
 
 // sunbeam_optics::gain::g: G = F(theta_d) (1 + wi.wr)^2 / ((cos th_i + cos th_r)^2 cos th_r) / norm,
-// Fresnel taken once. 0 unless both directions are above the horizon. For
+// Fresnel taken once, times the skin's energy bound at wr (sb_energy). 0 unless both directions are above the horizon. For
 // unit directions 1 + wi.wr = |wi + wr|^2 / 2 and cos theta_d = wi.h = |wi + wr| / 2:
 // written so, G keeps its digits where wi and wr are nearly opposite (both
 // grazing), where 1 + wi.wr cancels in float32.
@@ -65,7 +85,7 @@ fn sb_gain(wi: vec3<f32>, wr: vec3<f32>, skin: SbSkin) -> f32 {
     let s2 = dot(s, s);
     let f = sb_fresnel(0.5 * sqrt(s2), skin.ior);
     let c = ci + cr;
-    return f * (0.25 * s2 * s2) / (skin.norm * c * c * cr);
+    return f * (0.25 * s2 * s2) / (skin.norm * c * c * cr) * sb_energy(cr, skin.energy);
 }
 
 // erf by Abramowitz & Stegun 7.1.26 (sunbeam_optics::masking::erf).

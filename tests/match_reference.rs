@@ -179,6 +179,7 @@ fn relative_reflectance_and_index_match_reference() {
     p.meshes[0].1.skin = sunbeam_optics::gain::Material {
         ior: 1.33,
         reflectance: sunbeam_optics::gain::Reflectance::Relative,
+        ..Default::default()
     };
     // relative: back to the fixture's own exposure
     p.scene.exposure -= absolute_exposure();

@@ -4,7 +4,7 @@
 //! (`sunbeam_optics::gain`, `sunbeam_optics::masking`,
 //! `sunbeam_raster::shade::frame`) over random direction pairs, grazing ones
 //! included (cos down to 1e-4), random indices, both normalisations and random
-//! (anisotropic, or off) slopes: relative error below 1e-4 wherever the value
+//! (anisotropic, or off) slopes and random energy bounds (or none): relative error below 1e-4 wherever the value
 //! is above 1e-6. The shader is the player's own module
 //! (`renderer::MATERIAL_WGSL`, the file the player and the export begin with)
 //! plus a small entry point, not a copy.
@@ -13,6 +13,7 @@ mod gpu;
 
 use gpu::gpu;
 use sunbeam_common::rng::SplitMix64;
+use sunbeam_optics::energy::EnergyBound;
 use sunbeam_optics::gain::{self, Material, Reflectance};
 use sunbeam_optics::masking::Masking;
 use sunbeam_render::renderer::MATERIAL_WGSL;
@@ -33,6 +34,7 @@ struct Case {
     tangent: vec4<f32>,
     // ior, norm, slope x, slope y
     skin: vec4<f32>,
+    energy: mat4x4<f32>,
 };
 
 struct Out {
@@ -53,7 +55,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let c = cases[i];
-    let skin = SbSkin(c.skin.x, c.skin.y, c.skin.zw);
+    let skin = SbSkin(c.skin.x, c.skin.y, c.skin.zw, c.energy);
     let f = sb_frame(c.normal.xyz, c.tangent.xyz);
     var o: Out;
     o.vals = vec4<f32>(
@@ -77,6 +79,8 @@ struct Case {
     normal: [f32; 4],
     tangent: [f32; 4],
     skin: [f32; 4],
+    /// The energy bound's table (`EnergyBound::columns`).
+    energy: [[f32; 4]; 4],
 }
 
 #[repr(C)]
@@ -138,6 +142,7 @@ fn cases() -> Vec<Case> {
             } else {
                 Reflectance::Relative
             },
+            ..Default::default()
         };
         let slope = match (r.unit() * 4.0) as u32 {
             0 => [0.0, 0.0],
@@ -152,6 +157,14 @@ fn cases() -> Vec<Case> {
         let k = 0.5 * (2.0 * r.unit() - 1.0);
         let tangent = [0, 1, 2].map(|i| a[i] - d * n[i] + k * n[i]);
         let scale = 0.5 + 1.5 * r.unit();
+        // Half the cases with an energy bound: b from 0.02 to 0.1 (the
+        // factor is below 1 at cos(theta_r) below b).
+        let mut energy = EnergyBound::OFF;
+        if r.unit() < 0.5 {
+            for b in energy.b.iter_mut() {
+                *b = (0.02 + 0.08 * r.unit()) as f32;
+            }
+        }
         out.push(Case {
             wi: v4(f32x3(wi), 0.0),
             wr: v4(f32x3(wr), 0.0),
@@ -163,6 +176,7 @@ fn cases() -> Vec<Case> {
                 slope[0] as f32,
                 slope[1] as f32,
             ],
+            energy: energy.columns(),
         });
     };
     // Exact mirror pairs (specular; negating x and y is exact in float32) at
@@ -302,6 +316,9 @@ fn material_functions_match_float64() {
                 Reflectance::Absolute
             } else {
                 Reflectance::Relative
+            },
+            energy: EnergyBound {
+                b: std::array::from_fn(|k| c.energy[k / 4][k % 4]),
             },
         };
         let slope = [f64::from(c.skin[2]), f64::from(c.skin[3])];

@@ -184,6 +184,26 @@ export function skinUniform({ ior = 1.5, reflectance = 'absolute', rmsSlope = [0
 }
 
 /**
+ * The exported material's `energy` uniform (docs/ENGINES.md, docs/LIGHTING.md
+ * "Energy bound"): the energy bound's table from the response map's info
+ * (`energy.off`, or `energy.smith` when masking with the pack's table
+ * present), 16 values in column-major order; zero (no bound) for relative
+ * reflectance or a map without tables. The same choice as
+ * sunbeam_response::energy::EnergyInfo::bound.
+ */
+export function energyUniform(map, { reflectance = 'absolute', rmsSlope = [0, 0] } = {}) {
+  const m = new THREE.Matrix4().set(0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+  const e = map?.info?.energy;
+  if (!e || reflectance !== 'absolute') return m;
+  const s = typeof rmsSlope === 'number' ? [rmsSlope, rmsSlope] : rmsSlope;
+  const masked = s[0] > 0 || s[1] > 0;
+  const b = masked && e.smith ? e.smith : e.off;
+  if (b.length !== 16) throw new Error(`response map: energy table of ${b.length} values, expected 16`);
+  m.fromArray(b);
+  return m;
+}
+
+/**
  * The rms slopes a mesh masks with (sunbeam_scene::MeshInstance::masking_slope):
  * none ([0, 0]) unless `masking` is 'smith'; then `rmsSlope` (a number or
  * [x, y]) if given, else the pack's (`rms_slope` of its manifest, which the
@@ -373,6 +393,7 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
           warp: new THREE.Vector4(g.r0, Math.asinh(2 / g.r0), map ? diffuseWeight : 1, 0),
           base: new THREE.Vector4(baseColor[0], baseColor[1], baseColor[2], 0),
           skin: skinUniform({ ior, reflectance, rmsSlope }),
+          energy: energyUniform(map, { reflectance, rmsSlope }),
         },
       },
     },

@@ -226,6 +226,8 @@ pub fn prepare_with(scene: &Scene, load_pack: &dyn Fn(&Path) -> Result<Pack>) ->
                     sunbeam_optics::gain::Reflectance::Relative
                 }
             },
+            // filled by the renderer from the pack's response map
+            energy: sunbeam_optics::energy::EnergyBound::OFF,
         };
         let masking = match (&pack, &mi.pack) {
             (Some(k), Some(path)) => mi

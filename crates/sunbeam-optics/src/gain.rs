@@ -17,6 +17,8 @@
 //! reference, the response maps' environment paths and the tests call it; the
 //! GPU's is `shaders/material.wgsl` (`sb_fresnel`, `sb_gain`), checked against this one.
 
+use crate::energy::EnergyBound;
+
 /// Default index of refraction (PHYSICS.md 2).
 pub const DEFAULT_IOR: f64 = 1.5;
 
@@ -57,6 +59,9 @@ pub struct Material {
     /// Refractive index of the skin (from air); > 1 for the default 1.5.
     pub ior: f64,
     pub reflectance: Reflectance,
+    /// The energy bound on `G` of this skin on its pack (OFF: none; built by
+    /// `sunbeam_response::energy`).
+    pub energy: EnergyBound,
 }
 
 impl Default for Material {
@@ -64,6 +69,7 @@ impl Default for Material {
         Material {
             ior: DEFAULT_IOR,
             reflectance: Reflectance::Absolute,
+            energy: EnergyBound::OFF,
         }
     }
 }
@@ -73,6 +79,7 @@ impl Material {
     pub const RELATIVE: Material = Material {
         ior: DEFAULT_IOR,
         reflectance: Reflectance::Relative,
+        energy: EnergyBound::OFF,
     };
 
     /// The factor `G` is divided by: 1 (absolute) or `F(0)` (relative).
@@ -127,7 +134,8 @@ pub fn cos_half(wi: [f64; 3], wr: [f64; 3]) -> f64 {
     }
 }
 
-/// `G(wi, wr)` for `mat`. Zero when either direction is at or below the horizon (`d.n <= 0`).
+/// `G(wi, wr)` for `mat`, times its energy bound at `wr` ([`EnergyBound`]; 1
+/// without one). Zero when either direction is at or below the horizon (`d.n <= 0`).
 pub fn g(wi: [f64; 3], wr: [f64; 3], mat: Material) -> f64 {
     let ci = wi[2];
     let cr = wr[2];
@@ -138,7 +146,7 @@ pub fn g(wi: [f64; 3], wr: [f64; 3], mat: Material) -> f64 {
     let dot = wi[0] * wr[0] + wi[1] * wr[1] + wi[2] * wr[2];
     let num = f * (1.0 + dot) * (1.0 + dot);
     let den = mat.norm() * (ci + cr) * (ci + cr) * cr;
-    num / den
+    num / den * mat.energy.factor(cr)
 }
 
 #[cfg(test)]

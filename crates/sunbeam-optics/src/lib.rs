@@ -6,6 +6,7 @@
 //!   the spectral integral of PHYSICS.md 2.
 //! - [`colour`]: XYZ -> linear sRGB, CIELAB, CIEDE2000, and THE tone mapping +
 //!   sRGB encoding shared by the player and the CPU reference renderer.
+//! - [`energy`]: the energy bound on `G` at grazing views (albedo <= 1).
 //! - [`gain`]: `G(wi, wr)` with the exact Fresnel power reflectance, once
 //!   (n = 1.5, absolute reflectance by default), and the diffuse base's `1 - F`.
 //! - [`grazing`]: the window model's exact Kirchhoff amplitude (PHYSICS.md 2b).
@@ -16,6 +17,7 @@
 pub mod cie;
 mod cie_data;
 pub mod colour;
+pub mod energy;
 pub mod gain;
 pub mod grazing;
 pub mod masking;

@@ -1,5 +1,6 @@
-//! The reference's environment shaders, built once per prepared scene: kept
-//! in the scene's [`sunbeam_frame::RendererCache`] slot.
+//! The reference's environment shaders and its packs' energy-bound tables,
+//! built once per prepared scene: kept in the scene's
+//! [`sunbeam_frame::RendererCache`] slot.
 
 use crate::environment;
 use std::sync::{Arc, Mutex};
@@ -18,7 +19,13 @@ pub(crate) fn of(p: &Prepared) -> Arc<EnvCache> {
 /// holds them, so their addresses cannot be reused by others while cached)
 /// and the meshes' masking and skins.
 #[derive(Default)]
-pub(crate) struct EnvCache(Mutex<Vec<EnvEntry>>);
+pub(crate) struct EnvCache(Mutex<Vec<EnvEntry>>, Mutex<Vec<EnergyEntry>>);
+
+/// A pack's energy-bound tables (the same `Arc` keys them).
+struct EnergyEntry {
+    pack: Arc<Pack>,
+    info: Arc<sunbeam_response::energy::EnergyInfo>,
+}
 
 struct EnvEntry {
     estimator: environment::EnvEstimator,
@@ -30,6 +37,24 @@ struct EnvEntry {
 }
 
 impl EnvCache {
+    /// The energy bound's tables of `pack`, built on first use as
+    /// `sunbeam-pack --response` builds them.
+    pub(crate) fn energy(&self, pack: &Arc<Pack>) -> Arc<sunbeam_response::energy::EnergyInfo> {
+        let mut v = self.1.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(e) = v.iter().find(|e| Arc::ptr_eq(&e.pack, pack)) {
+            return e.info.clone();
+        }
+        let info = Arc::new(sunbeam_response::energy::EnergyInfo::from_pack(
+            pack,
+            &sunbeam_response::Options::default(),
+        ));
+        v.push(EnergyEntry {
+            pack: pack.clone(),
+            info: info.clone(),
+        });
+        info
+    }
+
     /// The shader for `env`, `packs` (with their meshes' `masking` and
     /// `skins`) and `estimator`, built on first use.
     pub(crate) fn get(

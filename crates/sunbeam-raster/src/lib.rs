@@ -105,6 +105,7 @@ pub fn render_linear(scene: &Scene, opts: &Options) -> Result<LinearImage> {
 
 /// Linear frame of an already prepared scene (see [`render_linear`]).
 pub fn render_prepared_linear(p: &Prepared, opts: &Options) -> Result<LinearImage> {
+    let p = &bounded(p);
     if let Some(env) = &p.environment {
         return render_environment(p, env.clone(), opts);
     }
@@ -259,6 +260,7 @@ fn for_rows<T: Send>(
 /// Render an already prepared scene (display values). With `opts.samples > 1`
 /// the sub-pixel samples are averaged in linear light before the display transform.
 pub fn render_prepared(p: &Prepared, opts: &Options) -> Image {
+    let p = &bounded(p);
     if opts.samples > 1 || p.environment.is_some() {
         if let Ok(lin) = render_prepared_linear(p, opts) {
             return lin.display(opts.curve);
@@ -278,4 +280,24 @@ pub fn render_prepared(p: &Prepared, opts: &Options) -> Image {
         height: h,
         rgb,
     }
+}
+
+/// `p` with every skin's energy bound filled (sunbeam_optics::energy): the
+/// tables of its pack (built once per prepared scene, as `sunbeam-pack
+/// --response` builds them), the masked one for a masked mesh; OFF for
+/// relative reflectance and meshes without a pack. Idempotent.
+pub fn bounded(p: &Prepared) -> Prepared {
+    let cache = env_cache::of(p);
+    let mut q = p.clone();
+    for (_, m) in q.meshes.iter_mut() {
+        m.skin.energy = match &m.pack {
+            Some(pack) if m.skin.reflectance == sunbeam_optics::gain::Reflectance::Absolute => {
+                cache
+                    .energy(pack)
+                    .bound(m.skin, m.masking != sunbeam_optics::masking::Masking::Off)
+            }
+            _ => sunbeam_optics::energy::EnergyBound::OFF,
+        };
+    }
+    q
 }

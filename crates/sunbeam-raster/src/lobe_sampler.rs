@@ -693,6 +693,7 @@ fn gain_over_cos(wi: [f64; 3], wr: [f64; 3], ior: f64, min_cos: f64) -> f64 {
     let skin = gain::Material {
         ior,
         reflectance: gain::Reflectance::Absolute,
+        ..Default::default()
     };
     gain::g(wi_g, wr, skin) * wr[2] / wi[2].max(min_cos)
 }

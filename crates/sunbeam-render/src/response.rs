@@ -107,6 +107,46 @@ pub fn load_or_build(
     Ok((Arc::new(r), note))
 }
 
+/// The energy bound's tables of `pack` (sunbeam_response::energy): those of
+/// its point map `resp` when loaded, else of the map beside the pack, else
+/// built from the pack (with a note: the pipeline's map carries them).
+pub(crate) fn energy_info(
+    pack: &Arc<Pack>,
+    path: Option<&Path>,
+    opts: &sunbeam_response::Options,
+    resp: Option<&Arc<Response>>,
+    warnings: &mut Vec<String>,
+) -> Result<sunbeam_response::energy::EnergyInfo> {
+    if let Some(e) = resp.and_then(|r| r.info.energy.clone()) {
+        return Ok(e);
+    }
+    if let Some(p) = path {
+        if let Ok(r) = ktx2::read(&sidecar(p)) {
+            if r.info.pack == pack.manifest {
+                if let Some(e) = r.info.energy {
+                    return Ok(e);
+                }
+            }
+        }
+    }
+    let full;
+    let pack = match path {
+        Some(p) if !pack.has_terms() => {
+            full = Arc::new(Pack::read(p)?);
+            &full
+        }
+        _ => pack,
+    };
+    let t = std::time::Instant::now();
+    let e = sunbeam_response::energy::EnergyInfo::from_pack(pack, opts);
+    warnings.push(format!(
+        "built the energy bound's tables of {} in {:.1} s (`sunbeam-pack --response` stores them in the response map)",
+        path.map_or("the pack".to_string(), |p| p.display().to_string()),
+        t.elapsed().as_secs_f64()
+    ));
+    Ok(e)
+}
+
 /// A 3D RGBA16F texture holding a response map.
 pub(crate) fn response_texture(gpu: &Gpu, r: &sunbeam_response::Response) -> wgpu::TextureView {
     let g = r.info.grid;

@@ -367,6 +367,8 @@ fn half_sums(out: [&mut Vec<f32>; 4], cl: &[f32], g: &[f32], h: &[f32], ne: usiz
 /// terms' gradient at `-kappa` is `-conj` of that at `kappa`; along the
 /// mirrored ray (`a -> -a`) the two signs cancel and `D_n(-f) = conj D_n(f)`,
 /// the same symmetry as the terms': the half sums above serve `D` too.
+/// The map carries the energy bound's tables for the default skin
+/// ([`crate::energy::EnergyInfo`]).
 pub fn build(pack: &Pack, o: &Options) -> Response {
     let g = o.grid.unwrap_or_else(|| auto_grid(pack, o.budget_bytes));
     let lw = wavelength_weights(o.lambda_samples);
@@ -374,12 +376,27 @@ pub fn build(pack: &Pack, o: &Options) -> Response {
         lambdas: lw.iter().map(|l| l.0).collect(),
         sets: vec![lw.iter().map(|l| l.1).collect()],
     };
-    let xyz = build_sets(pack, &g, &ws).pop().expect("one weight set");
+    let ws = WeightSets {
+        sets: vec![
+            ws.sets[0].clone(),
+            crate::energy::white_weights(pack, o.lambda_samples),
+        ],
+        ..ws
+    };
+    let mut sets = build_sets(pack, &g, &ws);
+    let white = sets.pop().expect("the white furnace's set");
+    let xyz = sets.pop().expect("the point map's set");
     let quantity = format!(
         "XYZ without G: sum_l {}(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)",
         reflectance_name(pack)
     );
-    to_response(pack, g, lw.len(), &xyz, true, &quantity)
+    let mut resp = to_response(pack, g, lw.len(), &xyz, true, &quantity);
+    resp.info.energy = Some(crate::energy::EnergyInfo::from_white(
+        g,
+        &white,
+        pack.manifest.rms_slope,
+    ));
+    resp
 }
 
 /// What the maps of `pack` hold per wavelength: `R_U` (the window model with
@@ -473,6 +490,7 @@ pub fn to_response(
             lambda_range_nm: [cie::DEFAULT_RANGE_NM.0, cie::DEFAULT_RANGE_NM.1],
             quantity: quantity.to_string(),
             pack: pack.manifest.clone(),
+            energy: None,
         },
         data,
     }

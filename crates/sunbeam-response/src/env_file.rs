@@ -254,6 +254,7 @@ fn map_info(i: &EnvInfo, e: &MapEntry) -> Info {
             sunbeam_optics::cie::DEFAULT_RANGE_NM.1,
         ],
         quantity: e.quantity.clone(),
+        energy: None,
         pack: i.pack.clone(),
     }
 }

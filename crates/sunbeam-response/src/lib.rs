@@ -18,6 +18,7 @@
 
 pub mod build;
 pub mod cells;
+pub mod energy;
 pub mod env;
 pub mod env_file;
 pub mod exr;
@@ -59,6 +60,10 @@ pub struct Info {
     pub quantity: String,
     /// The manifest of the pack it was built from.
     pub pack: Manifest,
+    /// The energy bound's tables for the default skin ([`energy`]; written
+    /// by `sunbeam-pack --response`; maps without it build theirs on load).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub energy: Option<energy::EnergyInfo>,
 }
 
 /// Where the map of a pack lives: `dir/NAME.response.ktx2` for `dir/NAME.ext`

@@ -91,6 +91,9 @@ pub struct EnvQuadrature {
     rows: Vec<Row>,
     /// The sky's coefficients tabulated (None: ask the environment).
     table: Option<OctTable>,
+    /// A white furnace's map ([`EnvQuadrature::from_xyz`]): the
+    /// coefficients are `(1, 0, 0)` without asking the environment.
+    white: bool,
 }
 
 impl EnvQuadrature {
@@ -125,6 +128,29 @@ impl EnvQuadrature {
             q.table = Some(OctTable::new(env, OCT_SIDE));
         }
         q
+    }
+
+    /// The quadrature of one map `xyz` (XYZ per texel, response-map order,
+    /// on `grid`) under an environment whose first coefficient is 1
+    /// everywhere (a constant white map): the map is put in the first basis
+    /// slot. What [`crate::energy`] integrates the directional albedo with.
+    pub fn from_xyz(grid: Grid, xyz: &[f32]) -> EnvQuadrature {
+        let (nt, nr, ns) = (grid.n_theta, grid.n_rho, grid.n_s);
+        assert_eq!(xyz.len(), nt * nr * ns * 3, "map size");
+        let mut basis = vec![0.0f32; nt * nr * ns * 9];
+        for k in 0..ns {
+            for j in 0..nr {
+                for i in 0..nt {
+                    let src = 3 * ((k * nr + j) * nt + i);
+                    let dst = ((j * nt + i) * ns + k) * 9;
+                    basis[dst..dst + 3].copy_from_slice(&xyz[src..src + 3]);
+                }
+            }
+        }
+        EnvQuadrature {
+            white: true,
+            ..Self::from_parts(grid, basis, Vec::new())
+        }
     }
 
     /// The reference's options: the point map's automatic grid,
@@ -186,6 +212,7 @@ impl EnvQuadrature {
             cols,
             rows,
             table: None,
+            white: false,
         }
     }
 
@@ -449,6 +476,7 @@ struct View<'a> {
     rho_v: f64,
     phi_v: f64,
     table: Option<&'a OctTable>,
+    white: bool,
     env: &'a Environment,
 }
 
@@ -466,6 +494,7 @@ impl<'a> View<'a> {
             rho_v: wr[0].hypot(wr[1]),
             phi_v: wr[1].atan2(wr[0]),
             table: quad.table.as_ref(),
+            white: quad.white,
             env,
         })
     }
@@ -495,6 +524,9 @@ impl<'a> View<'a> {
     }
 
     fn coefficients(&self, d: [f64; 3]) -> [f64; 3] {
+        if self.white {
+            return [1.0, 0.0, 0.0];
+        }
         let (t, b, n) = self.frame;
         let w = [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
         match self.table {

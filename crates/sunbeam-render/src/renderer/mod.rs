@@ -362,6 +362,23 @@ impl Renderer {
                             &mut warnings,
                         )?);
                     }
+                    // The energy bound (sunbeam_optics::energy) of an
+                    // absolute skin, from the map's tables; the thesis mode
+                    // keeps the thesis' unbounded model.
+                    if settings.mode != Mode::Thesis
+                        && mat.skin.reflectance == sunbeam_optics::gain::Reflectance::Absolute
+                    {
+                        let path = p.scene.meshes.get(mi).and_then(|m| m.pack.as_deref());
+                        let info = crate::response::energy_info(
+                            pack,
+                            path,
+                            &settings.response,
+                            resp_map.as_ref(),
+                            &mut warnings,
+                        )?;
+                        let masked = mat.masking != sunbeam_optics::masking::Masking::Off;
+                        mu.energy = info.bound(mat.skin, masked).columns();
+                    }
                     if settings.mode == Mode::Table {
                         response = Some(baselines::response_table(
                             pack, &samples, settings, &table, dt, mi, device, &mut mu,

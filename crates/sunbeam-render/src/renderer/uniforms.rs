@@ -95,6 +95,8 @@ pub(super) struct MaterialU {
     /// t, bits 2-3 the orientation map's.
     pub(super) scales_wrap: u32,
     pub(super) _s: [f32; 2],
+    /// The energy bound's table (`sunbeam_optics::energy::EnergyBound::columns`).
+    pub(super) energy: [[f32; 4]; 4],
 }
 
 /// Smallest term count whose truncation bound stays below `tol` for every |t| up to `t`.
@@ -333,7 +335,8 @@ mod layout_tests {
                 resp_footprint,
                 norm,
                 window_sigma_um,
-                scales_wrap
+                scales_wrap,
+                energy
             ),
         );
     }

@@ -58,14 +58,34 @@
 //! - the literal diffuse form adds 0.454 at every view and crosses 1 earlier
 //!   (from 80 deg on unmasked).
 
-mod common;
-use common::*;
 use rayon::prelude::*;
 use std::f64::consts::PI;
+use sunbeam_field::HeightField;
 use sunbeam_optics::gain::{self, Material};
 use sunbeam_optics::masking::Masking;
 use sunbeam_pack::build::BuildOptions;
 use sunbeam_pack::{Model, Pack};
+use sunbeam_response::energy;
+
+/// A height field of `w x h` samples from `f(x, y)` (x along columns, y up the image).
+fn field(w: usize, h: usize, dx: f64, dy: f64, f: impl Fn(f64, f64) -> f64) -> HeightField {
+    let d = (0..h)
+        .flat_map(|r| (0..w).map(move |c| (c, r)))
+        .map(|(c, r)| f(c as f64 * dx, (h - 1 - r) as f64 * dy))
+        .collect();
+    HeightField::new(w, h, dx, dy, d).unwrap()
+}
+
+fn build(f: &HeightField, o: &BuildOptions) -> Pack {
+    let r = sunbeam_pack::FieldRef {
+        width: f.width,
+        height: f.height,
+        dx: f.dx,
+        dy: f.dy,
+        data: &f.data,
+    };
+    sunbeam_pack::build(r, o, &mut |_, _| {}).unwrap()
+}
 
 const LAMBDA: f64 = 500e-9;
 const BASE: f64 = 0.5;
@@ -272,17 +292,18 @@ fn ridges(
     rough: f64,
     seed: u64,
 ) -> sunbeam_field::HeightField {
-    let mut rng = Rng(seed);
+    let mut rng = sunbeam_common::rng::SplitMix64(seed);
+    let mut range = |a: f64, b: f64| a + (b - a) * rng.unit();
     let bumps: Vec<(f64, f64, f64)> = (0..(n * n / 400).max(8))
         .map(|_| {
             (
-                rng.range(0.0, n as f64 * px),
-                rng.range(0.0, n as f64 * px),
-                rng.range(-1.0, 1.0),
+                range(0.0, n as f64 * px),
+                range(0.0, n as f64 * px),
+                range(-1.0, 1.0),
             )
         })
         .collect();
-    let phases: Vec<f64> = (0..64).map(|_| rng.next()).collect();
+    let phases: Vec<f64> = (0..64).map(|_| rng.unit()).collect();
     let bump_s = 0.15e-6;
     field(n, n, px, px, |x0, y| {
         let x = x0 + wave.0 * (2.0 * PI * y / wave.1).sin();
@@ -499,6 +520,150 @@ fn directional_albedo_at_most_one() {
     );
     for s in &summary {
         println!("{s}");
+    }
+    println!("total {:.1} s", t0.elapsed().as_secs_f64());
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+// ------------------------------------------------------ the energy bound
+
+/// Wavelengths of the spectral check (midpoints over 380..780 nm).
+const SPECTRAL: usize = 12;
+/// Views of the spectral check (degrees): where the bound acts.
+const BOUND_VIEWS: [f64; 3] = [88.0, 89.5, 89.9];
+
+/// The diffraction term's albedo towards `wr` in linear sRGB under a white
+/// furnace (D65 of luminance 1), (unmasked, masked), from the pack's `R_U`
+/// per wavelength ([`SPECTRAL`] of them), not from the maps the bound's
+/// tables come from: `XYZ = sum_l sum_nodes G R_U (A / l^2) D65 cmf wt /
+/// sum_l D65 ybar`.
+fn spectral_albedo(case: &Case, wr: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    use sunbeam_optics::{cie, colour};
+    let mat = Material::default();
+    let smith = Masking::smith(case.pack.manifest.rms_slope.unwrap_or([0.0, 0.0]));
+    let dl = 400e-9 / SPECTRAL as f64;
+    let lambdas: Vec<f64> = (0..SPECTRAL)
+        .map(|i| 380e-9 + (i as f64 + 0.5) * dl)
+        .collect();
+    let norm: f64 = lambdas
+        .iter()
+        .map(|&l| cie::d65_at(l) * cie::cmf_at(l)[1])
+        .sum();
+    let weights: Vec<[f64; 3]> = lambdas
+        .iter()
+        .map(|&l| cie::cmf_at(l).map(|c| c * cie::d65_at(l) * case.area / (l * l) / norm))
+        .collect();
+    // Lobes are narrower at the shortest wavelength than at LAMBDA.
+    let delta = case.delta * 380.0 / 500.0;
+    let az0 = wr[1].atan2(wr[0]);
+    let sums: Vec<[f64; 6]> = nodes(delta, wr[2], az0)
+        .par_iter()
+        .map(|group| {
+            let mut s = [0.0; 6];
+            for &(wi, wt) in group {
+                let g = gain::g(wi, wr, mat) * wt;
+                if g == 0.0 {
+                    continue;
+                }
+                let m = smith.factor(wi, wr);
+                for (&l, w) in lambdas.iter().zip(&weights) {
+                    let r = case.pack.shading_reflectance(
+                        -wi[0] - wr[0],
+                        -wi[1] - wr[1],
+                        -wi[2] - wr[2],
+                        l,
+                    );
+                    for c in 0..3 {
+                        s[c] += g * r * w[c];
+                        s[3 + c] += g * m * r * w[c];
+                    }
+                }
+            }
+            s
+        })
+        .collect();
+    let t = sums.iter().fold([0.0; 6], |mut a, b| {
+        for i in 0..6 {
+            a[i] += b[i];
+        }
+        a
+    });
+    (
+        colour::xyz_to_linear_srgb([t[0], t[1], t[2]]),
+        colour::xyz_to_linear_srgb([t[3], t[4], t[5]]),
+    )
+}
+
+fn max3(v: [f64; 3]) -> f64 {
+    v[0].max(v[1]).max(v[2])
+}
+
+/// The energy bound (sunbeam_optics::energy, sunbeam_response::energy): its
+/// tables, built from the pack's white-furnace map as the pipeline builds
+/// them, keep the diffraction term's albedo (largest linear-sRGB channel,
+/// from the pack's `R_U` per wavelength, not the maps) at most 1 at the
+/// grazing views where the unbounded term exceeds it, masked or not, both
+/// models; and the tables' albedo is not below the truth's there.
+#[test]
+fn energy_bound_keeps_albedo_at_most_one() {
+    let t0 = std::time::Instant::now();
+    let flat = field(180, 180, 100e-9, 100e-9, |_, _| 2e-7);
+    let small = elaphe(200, 25e-9);
+    let big = xenopeltis(640, 31.25e-9);
+    let cases = [
+        make_case(HOLDS_UP_TO[0].0, &flat, Model::Window, vec![0.0]),
+        make_case(HOLDS_UP_TO[3].0, &small, Model::Tiled, vec![0.0, 90.0]),
+        make_case(HOLDS_UP_TO[4].0, &big, Model::Window, vec![0.0, 90.0]),
+    ];
+    let mut failures = vec![];
+    for case in &cases {
+        let t = std::time::Instant::now();
+        let info = energy::EnergyInfo::from_pack(&case.pack, &sunbeam_response::Options::default());
+        println!(
+            "\n{}: tables (white map and quadrature) in {:.2} s; b unmasked {:?}",
+            case.name,
+            t.elapsed().as_secs_f64(),
+            info.off
+        );
+        let mat = Material::default();
+        for masked in [false, true] {
+            let bound = info.bound(mat, masked);
+            for &az in &case.azimuths {
+                for &th in &BOUND_VIEWS {
+                    let wr = view(th, az);
+                    let (u, m) = spectral_albedo(case, wr);
+                    let a = max3(if masked { m } else { u });
+                    let f = bound.factor(wr[2]);
+                    let table = bound.b_at(wr[2]) / wr[2];
+                    println!(
+                        "  {} {th:6.2} {az:4.0}: albedo {a:8.4}, table {table:8.4}, factor {f:.4}, bounded {:.4}",
+                        if masked { "masked  " } else { "unmasked" },
+                        a * f
+                    );
+                    if a * f > 1.03 {
+                        failures.push(format!(
+                            "{} {} at {th} deg, az {az}: bounded albedo {:.4}",
+                            case.name,
+                            if masked { "masked" } else { "unmasked" },
+                            a * f
+                        ));
+                    }
+                    if a > 1.0 && table < 0.97 * a {
+                        failures.push(format!(
+                            "{} at {th} deg, az {az}: the table's albedo {table:.4} is below the truth's {a:.4}",
+                            case.name
+                        ));
+                    }
+                }
+            }
+        }
+        // Without the bound the term exceeds 1 at 89.9 deg (what the bound is for).
+        let (u, _) = spectral_albedo(case, view(89.9, case.azimuths[0]));
+        assert!(
+            max3(u) > 1.5,
+            "{}: unbounded albedo at 89.9 deg {u:?}",
+            case.name
+        );
     }
     println!("total {:.1} s", t0.elapsed().as_secs_f64());
     assert!(failures.is_empty(), "{failures:#?}");
