@@ -161,7 +161,9 @@ fn masked_snake_matches_reference() {
     let masked = sunbeam_raster::render_prepared(&p, &Options::default());
     let d = sunbeam_frame::compare(&masked, &unmasked).unwrap();
     eprintln!("masked vs unmasked reference: {d}");
-    assert!(d.max > 8.0, "masking changed nothing visible: {d}");
+    // Where masking acts, the energy bound (docs/LIGHTING.md "Energy bound")
+    // already darkens the unmasked limb: 7.3 here (above 8 without the bound).
+    assert!(d.max > 4.0, "masking changed nothing visible: {d}");
     check("snake-xeno-masked", &gpu, &p, 0.5, 2.0);
 }
 

@@ -8,7 +8,7 @@
 //! rgb += intensity * ( dw * base * max(wi'.z, 0) (1 - F(th_i)) + (1 - dw) * M_srgb XYZ )
 //! ```
 //! with `(u, v, w) = -wi' - wr'`, `G` the mesh's skin's (absolute by default,
-//! `sunbeam_optics::gain`) times its masking, `R_U` the reflectance with the
+//! `sunbeam_optics::gain`, with its energy bound: [`crate::bounded`]) times its masking, `R_U` the reflectance with the
 //! window's exact grazing term (`Pack::shading_reflectance`, PHYSICS.md 2b),
 //! `dw` the mesh's diffuse weight (1 and no `(1 - F)` for a mesh without a
 //! pack: base colour only). The background is its linear colour, or under

@@ -121,9 +121,10 @@ pub(crate) fn energy_info(
         return Ok(e);
     }
     if let Some(p) = path {
-        if let Ok(r) = ktx2::read(&sidecar(p)) {
-            if r.info.pack == pack.manifest {
-                if let Some(e) = r.info.energy {
+        // The map's head only: an environment scene does not read its texels.
+        if let Ok(info) = ktx2::read_info(&sidecar(p)) {
+            if info.pack == pack.manifest {
+                if let Some(e) = info.energy {
                     return Ok(e);
                 }
             }

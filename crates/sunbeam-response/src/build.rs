@@ -367,36 +367,29 @@ fn half_sums(out: [&mut Vec<f32>; 4], cl: &[f32], g: &[f32], h: &[f32], ne: usiz
 /// terms' gradient at `-kappa` is `-conj` of that at `kappa`; along the
 /// mirrored ray (`a -> -a`) the two signs cancel and `D_n(-f) = conj D_n(f)`,
 /// the same symmetry as the terms': the half sums above serve `D` too.
-/// The map carries the energy bound's tables for the default skin
-/// ([`crate::energy::EnergyInfo`]).
-pub fn build(pack: &Pack, o: &Options) -> Response {
+/// With `extra` weight sets (at the point map's wavelengths) built in the
+/// same pass: their texels are returned beside the map (the energy bound's
+/// white furnace, in the point module).
+pub fn build_with(
+    pack: &Pack,
+    o: &Options,
+    extra: Vec<Vec<[f64; 3]>>,
+) -> (Response, Vec<Vec<f32>>) {
     let g = o.grid.unwrap_or_else(|| auto_grid(pack, o.budget_bytes));
     let lw = wavelength_weights(o.lambda_samples);
+    let mut sets = vec![lw.iter().map(|l| l.1).collect()];
+    sets.extend(extra);
     let ws = WeightSets {
         lambdas: lw.iter().map(|l| l.0).collect(),
-        sets: vec![lw.iter().map(|l| l.1).collect()],
+        sets,
     };
-    let ws = WeightSets {
-        sets: vec![
-            ws.sets[0].clone(),
-            crate::energy::white_weights(pack, o.lambda_samples),
-        ],
-        ..ws
-    };
-    let mut sets = build_sets(pack, &g, &ws);
-    let white = sets.pop().expect("the white furnace's set");
-    let xyz = sets.pop().expect("the point map's set");
+    let mut out = build_sets(pack, &g, &ws);
+    let xyz = out.remove(0);
     let quantity = format!(
         "XYZ without G: sum_l {}(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)",
         reflectance_name(pack)
     );
-    let mut resp = to_response(pack, g, lw.len(), &xyz, true, &quantity);
-    resp.info.energy = Some(crate::energy::EnergyInfo::from_white(
-        g,
-        &white,
-        pack.manifest.rms_slope,
-    ));
-    resp
+    (to_response(pack, g, lw.len(), &xyz, true, &quantity), out)
 }
 
 /// What the maps of `pack` hold per wavelength: `R_U` (the window model with

@@ -7,7 +7,7 @@
 //! How: the white furnace's map `E_w(u, v, w) = sum_l R (A / l^2) D65 cmf /
 //! sum_l D65 ybar` (the extended-light maps' weights for the spectrum D65,
 //! [`crate::env::weight_sets`]) on the point map's grid, built in the same
-//! pass over the pack as the point map (`build::build`), and the reference's
+//! pass over the pack as the point map (by `sunbeam_response::build`), and the reference's
 //! quadrature over it ([`EnvQuadrature::from_xyz`]: the sum over the texels
 //! with the closed form of `G / cos(theta_i)` at the horizon) at
 //! [`AZIMUTHS`] azimuths over half a turn (the pack's axes among them) (a real height field's `|FT|^2` is

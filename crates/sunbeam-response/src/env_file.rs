@@ -97,7 +97,7 @@ fn sun_key(sky: &Sky, lambdas: &[f64]) -> Option<Vec<u64>> {
 
 /// Build every basis map of `pack` (sky and map) and, when `sky`'s sun is up,
 /// its sun's map, in one pass over the pack's `R`; on the grid of
-/// [`crate::build::build`] for the same options.
+/// [`crate::point::build`] for the same options.
 pub fn build(pack: &Pack, sky: Option<&Sky>, opts: &Options) -> EnvFile {
     let g = opts
         .grid

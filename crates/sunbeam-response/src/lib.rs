@@ -10,7 +10,7 @@
 //! [`grid`], as one RGBA16F 3D texture (XYZ in RGB). A shader then reads it with
 //! one trilinear sample per light (more when a pixel's footprint spans several
 //! texels), times `G`. It is built once, offline, by `sunbeam-pack --response`
-//! ([`build::build`]); the player only loads it.
+//! ([`point::build`]); the player only loads it.
 //!
 //! Files: KTX2 (a 3D texture, `VK_FORMAT_R16G16B16A16_SFLOAT`, the [`Info`] JSON
 //! under the key `sunbeam.response`), see [`ktx2`]; an OpenEXR atlas of the same
@@ -26,12 +26,14 @@ pub mod grid;
 pub mod hotspots;
 pub mod ktx2;
 pub mod nvr;
+pub mod point;
 pub mod proposal;
 pub mod quadrature;
 
-pub use build::{build, Options};
+pub use build::Options;
 pub use env::{build_env, EnvResponse};
 pub use grid::Grid;
+pub use point::build;
 pub use proposal::Proposal;
 
 use serde::{Deserialize, Serialize};

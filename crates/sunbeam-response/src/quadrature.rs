@@ -133,7 +133,7 @@ impl EnvQuadrature {
     /// The quadrature of one map `xyz` (XYZ per texel, response-map order,
     /// on `grid`) under an environment whose first coefficient is 1
     /// everywhere (a constant white map): the map is put in the first basis
-    /// slot. What [`crate::energy`] integrates the directional albedo with.
+    /// slot. What the energy bound's tables integrate the directional albedo with.
     pub fn from_xyz(grid: Grid, xyz: &[f32]) -> EnvQuadrature {
         let (nt, nr, ns) = (grid.n_theta, grid.n_rho, grid.n_s);
         assert_eq!(xyz.len(), nt * nr * ns * 3, "map size");
