@@ -110,19 +110,10 @@ impl EnvQuadrature {
         } else {
             Vec::new()
         };
-        let (nt, nr, ns) = (g.n_theta, g.n_rho, g.n_s);
-        let mut basis = vec![0.0f32; nt * nr * ns * 9];
-        for k in 0..ns {
-            for j in 0..nr {
-                for i in 0..nt {
-                    let src = 3 * ((k * nr + j) * nt + i);
-                    let dst = ((j * nt + i) * ns + k) * 9;
-                    for (b, set) in sets.iter().take(3).enumerate() {
-                        basis[dst + 3 * b..dst + 3 * b + 3].copy_from_slice(&set[src..src + 3]);
-                    }
-                }
-            }
-        }
+        let basis = interleave(
+            g,
+            &sets.iter().take(3).map(Vec::as_slice).collect::<Vec<_>>(),
+        );
         let mut q = Self::from_parts(g, basis, sun);
         if let Environment::Sky(_) = env {
             q.table = Some(OctTable::new(env, OCT_SIDE));
@@ -135,21 +126,10 @@ impl EnvQuadrature {
     /// everywhere (a constant white map): the map is put in the first basis
     /// slot. What the energy bound's tables integrate the directional albedo with.
     pub fn from_xyz(grid: Grid, xyz: &[f32]) -> EnvQuadrature {
-        let (nt, nr, ns) = (grid.n_theta, grid.n_rho, grid.n_s);
-        assert_eq!(xyz.len(), nt * nr * ns * 3, "map size");
-        let mut basis = vec![0.0f32; nt * nr * ns * 9];
-        for k in 0..ns {
-            for j in 0..nr {
-                for i in 0..nt {
-                    let src = 3 * ((k * nr + j) * nt + i);
-                    let dst = ((j * nt + i) * ns + k) * 9;
-                    basis[dst..dst + 3].copy_from_slice(&xyz[src..src + 3]);
-                }
-            }
-        }
+        assert_eq!(xyz.len(), grid.texels() * 3, "map size");
         EnvQuadrature {
             white: true,
-            ..Self::from_parts(grid, basis, Vec::new())
+            ..Self::from_parts(grid, interleave(grid, &[xyz]), Vec::new())
         }
     }
 
@@ -450,6 +430,26 @@ impl OctTable {
             top * (1.0 - ty) + bot * ty
         })
     }
+}
+
+/// Up to three maps (XYZ per texel, response-map order `(k * n_rho + j) *
+/// n_theta + i`) laid out for the sum: per texel `(j, i)` its `n_s` layers of
+/// 9 values (the maps' XYZ in order; missing maps 0).
+fn interleave(g: Grid, maps: &[&[f32]]) -> Vec<f32> {
+    let (nt, nr, ns) = (g.n_theta, g.n_rho, g.n_s);
+    let mut basis = vec![0.0f32; nt * nr * ns * 9];
+    for k in 0..ns {
+        for j in 0..nr {
+            for i in 0..nt {
+                let src = 3 * ((k * nr + j) * nt + i);
+                let dst = ((j * nt + i) * ns + k) * 9;
+                for (b, m) in maps.iter().enumerate() {
+                    basis[dst + 3 * b..dst + 3 * b + 3].copy_from_slice(&m[src..src + 3]);
+                }
+            }
+        }
+    }
+    basis
 }
 
 /// One shading point of [`EnvQuadrature::integrate_many`].
