@@ -9,6 +9,20 @@ pub(crate) enum UvDir {
     V,
 }
 
+/// `--reflectance` values (the scene's `meshes[].reflectance`).
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum ReflectanceArg {
+    Absolute,
+    Relative,
+}
+
+/// `--masking` values (the scene's `meshes[].masking`).
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum MaskingArg {
+    Off,
+    Smith,
+}
+
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub(crate) enum InterpArg {
     Natural,
@@ -38,6 +52,24 @@ pub(crate) struct Cli {
     /// Diffuse weight written with --pack (the scene's diffuse_weight, docs/SCENE.md).
     #[arg(long, default_value_t = 0.2, requires = "pack")]
     pub(crate) diffuse_weight: f64,
+    /// The skin's refractive index written with --pack (`ior`; the scene's
+    /// meshes[].ior, in (1, 4]).
+    #[arg(long, value_name = "N", default_value_t = 1.5, requires = "pack",
+          value_parser = ior)]
+    pub(crate) ior: f64,
+    /// Reflectance written with --pack (`reflectance`): absolute (physical, what
+    /// engines assume for a dielectric) or relative (divided by F(0)).
+    #[arg(long, value_enum, default_value = "absolute", requires = "pack")]
+    pub(crate) reflectance: ReflectanceArg,
+    /// Shadowing-masking written with --pack (`masking`): off, or smith (Smith with
+    /// Beckmann slopes: --rms-slope, else the pack's own rms_slope).
+    #[arg(long, value_enum, default_value = "off", requires = "pack")]
+    pub(crate) masking: MaskingArg,
+    /// The rms slopes smith uses, "S" or "SX,SY" (along the tangent, along the
+    /// bitangent), written as `rmsSlope`; none: the pack's.
+    #[arg(long, value_name = "S[,SY]", requires = "pack", allow_hyphen_values = true,
+          value_parser = rms_slope)]
+    pub(crate) rms_slope: Option<[f64; 2]>,
 
     /// A world direction projected onto each tangent plane.
     #[arg(
@@ -152,6 +184,40 @@ pub(crate) struct Cli {
 }
 
 /// A clap value parser for a finite f64 in [lo, hi].
+/// `--ior`: in (1, 4], as the scene's meshes[].ior.
+fn ior(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number"))?;
+    if v > 1.0 && v <= 4.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} is outside (1, 4]"))
+    }
+}
+
+/// `--rms-slope`: one slope for both axes or two, each finite and >= 0.
+fn rms_slope(s: &str) -> Result<[f64; 2], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let parse = |t: &str| -> Result<f64, String> {
+        let v: f64 = t
+            .trim()
+            .parse()
+            .map_err(|_| format!("{t:?} is not a number"))?;
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(format!("{v} is not a slope (finite, >= 0)"))
+        }
+    };
+    match parts.as_slice() {
+        [a] => parse(a).map(|a| [a, a]),
+        [a, b] => Ok([parse(a)?, parse(b)?]),
+        _ => Err(format!("{s:?}: expected S or SX,SY")),
+    }
+}
+
 fn ranged(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
     move |s: &str| {
         let v: f64 = s

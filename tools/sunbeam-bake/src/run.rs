@@ -264,10 +264,24 @@ fn diffraction_ext(pack: &Path, cli: &Cli) -> Result<(serde_json::Value, Vec<Pat
         "responseMap": { "uri": uri(&map_path)?, "mimeType": "image/ktx2" },
         "pack": { "uri": uri(pack)? },
         "grid": { "nTheta": g.n_theta, "nRho": g.n_rho, "nS": g.n_s, "r0": g.r0 },
-        "f0": 0.04,
+        // `f0` beside `ior` for readers that know only `f0`.
+        "f0": sunbeam_optics::gain::f0(cli.ior),
+        "ior": cli.ior,
+        "reflectance": match cli.reflectance {
+            ReflectanceArg::Absolute => "absolute",
+            ReflectanceArg::Relative => "relative",
+        },
+        "masking": match cli.masking {
+            MaskingArg::Off => "off",
+            MaskingArg::Smith => "smith",
+        },
         "diffuseWeight": cli.diffuse_weight,
         "baseColor": base,
     });
+    let mut ext = ext;
+    if let Some(s) = cli.rms_slope {
+        ext["rmsSlope"] = serde_json::json!(s);
+    }
     Ok((ext, vec![pack.to_path_buf(), map_path]))
 }
 

@@ -527,6 +527,13 @@ fn rich_gltf_keeps_everything() {
     let _ = std::fs::remove_dir_all(d);
 }
 
+/// The JSON chunk of a GLB.
+fn glb_json(glb: &Path) -> serde_json::Value {
+    let b = std::fs::read(glb).unwrap();
+    let len = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
+    serde_json::from_slice(&b[20..20 + len]).unwrap()
+}
+
 /// `--pack`: the SUNBEAM_materials_diffraction extension names the pack and its
 /// response map relative to the GLB, carries the map's grid as the map's own
 /// header says, is used but not required, lands on every material (one is made
@@ -593,9 +600,7 @@ fn pack_writes_the_diffraction_extension() {
         "--depfile",
         &s(&dep),
     ]));
-    let b = std::fs::read(&glb).unwrap();
-    let len = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
-    let j: serde_json::Value = serde_json::from_slice(&b[20..20 + len]).unwrap();
+    let j = glb_json(&glb);
     assert!(j["extensionsUsed"]
         .as_array()
         .unwrap()
@@ -615,6 +620,12 @@ fn pack_writes_the_diffraction_extension() {
         assert_eq!(e["responseMap"]["uri"], "../packs/x.response.ktx2");
         assert_eq!(e["pack"]["uri"], "../packs/x.ktx2");
         assert_eq!(e["diffuseWeight"], 0.3);
+        // The skin: the flags' defaults, f0 from the index (0.04 at 1.5).
+        assert_eq!(e["ior"], 1.5);
+        assert!((e["f0"].as_f64().unwrap() - 0.04).abs() < 1e-15);
+        assert_eq!(e["reflectance"], "absolute");
+        assert_eq!(e["masking"], "off");
+        assert!(e.get("rmsSlope").is_none());
         // The grid as the map's own header records it.
         let n_theta = e["grid"]["nTheta"].as_u64().unwrap();
         assert!(
@@ -628,4 +639,57 @@ fn pack_writes_the_diffraction_extension() {
     let deps = std::fs::read_to_string(&dep).unwrap();
     assert!(deps.contains("x.response.ktx2") && deps.contains("x.ktx2"));
     validate(&[&glb]);
+
+    // The skin as given: written as the scene's fields spell them.
+    let glb2 = d.join("out").join("skin.glb");
+    let snake_with = |flags: &[&str], out: &Path| {
+        let (p, o) = (s(&pack), s(out));
+        let mut a = vec!["--generate-snake", "--snake-detail", "0.3", "--pack", &p];
+        a.extend_from_slice(flags);
+        a.extend(["-o", &o]);
+        bake(&a)
+    };
+    ok(&snake_with(
+        &[
+            "--ior",
+            "1.33",
+            "--reflectance",
+            "relative",
+            "--masking",
+            "smith",
+            "--rms-slope",
+            "0.1,0.2",
+        ],
+        &glb2,
+    ));
+    let j = glb_json(&glb2);
+    let e = &j["materials"][0]["extensions"]["SUNBEAM_materials_diffraction"];
+    assert_eq!(e["ior"], 1.33);
+    let f0 = (0.33f64 / 2.33).powi(2);
+    assert!(
+        (e["f0"].as_f64().unwrap() - f0).abs() < 1e-15,
+        "{}",
+        e["f0"]
+    );
+    assert_eq!(e["reflectance"], "relative");
+    assert_eq!(e["masking"], "smith");
+    assert_eq!(e["rmsSlope"], serde_json::json!([0.1, 0.2]));
+    validate(&[&glb2]);
+    // Bad values are usage errors naming the flag; nothing written.
+    for (flag, v) in [
+        ("--ior", "1.0"),
+        ("--ior", "x"),
+        ("--rms-slope", "-1"),
+        ("--masking", "on"),
+    ] {
+        let bad = d.join("out").join("bad.glb");
+        let o = snake_with(&[flag, v], &bad);
+        assert_eq!(o.status.code(), Some(1), "{flag} {v}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains(flag),
+            "{flag} {v}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(!bad.exists());
+    }
 }
