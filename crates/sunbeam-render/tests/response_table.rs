@@ -8,7 +8,7 @@
 
 use sunbeam_frame::spectral::Samples;
 use sunbeam_pack::{BuildOptions, FieldRef, Model, Pack};
-use sunbeam_render::table::{self, Dims, ResponseTable, U_MIN, W_MIN};
+use sunbeam_render::table::{self, Dims, ResponseTable};
 
 /// A small crossed grating with an oblique third component (64 x 64 pixels
 /// of 30 nm, heights within +-110 nm): orders along `u`, along `v` and off
@@ -179,35 +179,5 @@ fn tiled_and_windowless_tables_hold_r() {
             s.integrate(|l| pack.reflectance(u, v, w, l))
         });
         assert!(e_r < 1e-4, "{name}: table vs R: relative {e_r:.3e}");
-    }
-}
-
-/// The table's build time at the player's size (256 x 256 x 32, 48
-/// wavelengths, every term) for the pack at `$SUNBEAM_TABLE_PACK`: a
-/// measurement, not a check (`cargo test --release -p sunbeam-render --test
-/// response_table -- --ignored --nocapture`).
-#[test]
-#[ignore]
-fn build_time() {
-    let Ok(path) = std::env::var("SUNBEAM_TABLE_PACK") else {
-        eprintln!("SUNBEAM_TABLE_PACK is not set");
-        return;
-    };
-    let pack = Pack::read(std::path::Path::new(&path)).unwrap();
-    let s = Samples::uniform(48, (380, 780));
-    let m = &pack.manifest;
-    for _ in 0..2 {
-        let t0 = std::time::Instant::now();
-        let t = table::build(&pack, &s, Dims::default(), &|_| usize::MAX);
-        eprintln!(
-            "{:?} {}x{} crop, {} terms, window sigma {:.2} um: table {:?} in {:.2?} (u0 {U_MIN}, w0 {W_MIN})",
-            m.model,
-            m.crop.width,
-            m.crop.height,
-            m.terms,
-            m.window_sigma_m * 1e6,
-            t.dims,
-            t0.elapsed()
-        );
     }
 }
