@@ -1,20 +1,33 @@
-//! The response table of the default mode: the spectral integral of a pack,
-//! `T(u, v, w) = sum_l R(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)` (XYZ, without
-//! `G`), on a regular grid over `u, v` in [-2, 2] and `w` in [-2, 0], built once when
-//! a pack loads. A fragment then reads 8 cells and interpolates trilinearly
-//! instead of summing terms, taps and wavelengths (docs/PLAY.md "Response table";
-//! its error against the direct path is measured in the tests and docs/bench/play.md).
+//! The response table of `--mode table`: the spectral integral of a pack,
+//! `T(u, v, w) = sum_l R_s(u, v, w, l) S(l) cmf(l) / sum_l S(l) ybar(l)` (XYZ,
+//! without `G`), on a regular grid over `u, v` in [-2, 2] and `w` in [-2, 0],
+//! built once when a pack loads. A fragment then reads 8 cells and interpolates
+//! trilinearly instead of summing terms, taps and wavelengths (docs/PLAY.md
+//! "Response table").
 //!
-//! Built on the CPU in float64 with exactly the pack's evaluation
-//! (`Pack::reflectance`: same coefficients, taps, kernel and model) but arranged so
-//! that each (w, wavelength) pair costs one pass over the crop plus a separable
-//! interpolation: `A = sum_n c_n D_n` on the crop, then the x taps for every
-//! table column, then the y taps for every table row.
+//! `R_s` is the reflectance that shading uses, exactly as
+//! `Pack::shading_reflectance` defines it (same coefficients, taps, kernel and
+//! model; the term count per |t| from `terms_at`), in float64: for the window
+//! model with a window (`window_sigma_m > 0`) `R_U` of PHYSICS.md 2b
+//! (`sunbeam_optics::grazing::window_reflectance`, from the amplitude and its
+//! derivatives along `u` and `v` through the derivative of the same
+//! Kaiser-Bessel kernel, `kernel::kb_derivative`), otherwise `R` (the tiled
+//! model keeps Beckmann's factor). tests/response_table.rs checks the grid
+//! nodes against the pack's evaluator; the trilinear lookup's error against
+//! the direct path is in docs/bench/play.md.
+//!
+//! Arranged so that each (w, wavelength) pair costs one pass over the crop
+//! plus separable interpolations (the taps, which depend on the wavelength
+//! only, are computed once per wavelength): `A = sum_n c_n D_n` on the crop;
+//! then the x taps for every table column (for `R_U` also the x derivative
+//! taps: `dA/dkappa_x`); then the y taps for every table row (for `R_U` also
+//! the y taps of `dA/dkappa_x` and the y derivative taps of `A`: three
+//! interpolations of the one crop sum, where `R` needs one).
 
 use rayon::prelude::*;
 
 use sunbeam_frame::spectral::Samples;
-use sunbeam_pack::{kernel, series, Model, Pack};
+use sunbeam_pack::{kernel, series, Manifest, Model, Pack};
 
 /// Table resolution.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,37 +61,77 @@ pub struct ResponseTable {
 pub const U_MIN: f64 = -2.0;
 pub const W_MIN: f64 = -2.0;
 
-#[derive(Clone, Copy, Default)]
-struct C {
-    re: f64,
-    im: f64,
+/// A complex value (re, im), as `window_reflectance` takes it.
+type C = [f64; 2];
+
+/// One axis' taps for every table column (x) or row (y) at one wavelength:
+/// the first crop index, the weights (0 outside the crop) and, for `R_U`, the
+/// weights' derivatives along `kappa`; `ok` is false where no tap falls
+/// inside the crop.
+struct AxisTaps {
+    k0: Vec<i64>,
+    w: Vec<f64>,
+    dw: Vec<f64>,
+    ok: Vec<bool>,
 }
 
-/// Taps of one axis at `kappa`: first texel index and weights (0 outside the crop).
-fn taps(
-    m: &sunbeam_pack::Manifest,
-    kappa: f64,
-    k_half: i64,
-    axis: usize,
-    w: &mut [f64],
-) -> (i64, bool) {
-    let n = m.kernel.taps;
-    let k0 = kernel::first_tap(kappa, n);
-    let mut any = false;
-    for (j, wj) in w.iter_mut().enumerate().take(n) {
-        let k = k0 + j as i64;
-        *wj = if k < -k_half || k > k_half {
-            0.0
-        } else {
-            any = true;
-            let d = kappa - k as f64;
-            match m.model {
-                Model::Window => kernel::kb(d, n, m.kernel.beta),
-                Model::Tiled => kernel::gauss(d, m.kernel.sigma_bins[axis]),
-            }
+impl AxisTaps {
+    /// The taps at the `count` coordinates `U_MIN + i d` of `axis` (0: u, 1:
+    /// v) and wavelength `lam`; with `deriv` their derivatives too.
+    fn new(m: &Manifest, lam: f64, count: usize, d: f64, axis: usize, deriv: bool) -> AxisTaps {
+        let n = m.kernel.taps;
+        let mut t = AxisTaps {
+            k0: vec![0; count],
+            w: vec![0.0; count * n],
+            dw: vec![0.0; count * n],
+            ok: vec![false; count],
         };
+        let k_half = if axis == 0 { m.crop.kx } else { m.crop.ky };
+        for (i, ok) in t.ok.iter_mut().enumerate() {
+            let kappa = -(U_MIN + i as f64 * d) / lam * m.bin_scale_m[axis];
+            if kappa.abs() > k_half as f64 + n as f64 {
+                continue;
+            }
+            let k0 = kernel::first_tap(kappa, n);
+            let (w, dw) = (&mut t.w[i * n..(i + 1) * n], &mut t.dw[i * n..(i + 1) * n]);
+            for j in 0..n {
+                let k = k0 + j as i64;
+                (w[j], dw[j]) = if k < -k_half || k > k_half {
+                    (0.0, 0.0)
+                } else {
+                    *ok = true;
+                    let x = kappa - k as f64;
+                    match m.model {
+                        Model::Window => (
+                            kernel::kb(x, n, m.kernel.beta),
+                            if deriv {
+                                kernel::kb_derivative(x, n, m.kernel.beta)
+                            } else {
+                                0.0
+                            },
+                        ),
+                        Model::Tiled => (kernel::gauss(x, m.kernel.sigma_bins[axis]), 0.0),
+                    }
+                };
+            }
+            t.k0[i] = k0 + k_half;
+        }
+        t
     }
-    (k0 + k_half, any)
+}
+
+/// `sum_j w_j v(k0 + j)` for the weights `w` (zero weights skipped).
+#[inline]
+fn dot(w: &[f64], k0: i64, v: impl Fn(usize) -> C) -> C {
+    let mut s = [0.0; 2];
+    for (j, &wt) in w.iter().enumerate() {
+        if wt != 0.0 {
+            let q = v((k0 + j as i64) as usize);
+            s[0] += wt * q[0];
+            s[1] += wt * q[1];
+        }
+    }
+    s
 }
 
 /// Build the table of `pack` with the wavelength `samples` and a per-|t| term
@@ -90,6 +143,10 @@ pub fn build(
     terms_at: &(dyn Fn(f64) -> usize + Sync),
 ) -> ResponseTable {
     let m = &pack.manifest;
+    // The window's sigma when the table holds R_U (PHYSICS.md 2b), as in
+    // `Pack::shading_reflectance`.
+    let sigma = (m.model == Model::Window && m.window_sigma_m > 0.0).then_some(m.window_sigma_m);
+    let deriv = sigma.is_some();
     let (nu, nv, nw) = (dims.nu.max(2), dims.nv.max(2), dims.nw.max(2));
     let du = 4.0 / (nu - 1) as f64;
     let dv = 4.0 / (nv - 1) as f64;
@@ -97,23 +154,34 @@ pub fn build(
     let (cw, ch) = (m.crop.width, m.crop.height);
     let layer = cw * ch;
     let ntaps = m.kernel.taps;
+    // The taps depend on the wavelength, not on w: once per sample.
+    let axes: Vec<[AxisTaps; 2]> = samples
+        .0
+        .par_iter()
+        .map(|s| {
+            let lam = s.lambda_m;
+            [
+                AxisTaps::new(m, lam, nu, du, 0, deriv),
+                AxisTaps::new(m, lam, nv, dv, 1, deriv),
+            ]
+        })
+        .collect();
     let mut data = vec![[0.0f32; 4]; nu * nv * nw];
     data.par_chunks_mut(nu * nv).enumerate().for_each_init(
         || {
             (
-                vec![C::default(); layer],
-                vec![C::default(); ch * nu], // x-interpolated rows
+                vec![[0.0; 2]; layer],
+                // x-interpolated rows: A, and dA/dkappa_x for R_U
+                vec![[0.0; 2]; ch * nu],
+                vec![[0.0; 2]; if deriv { ch * nu } else { 0 }],
                 vec![[0.0f64; 3]; nu * nv],
-                vec![0.0; nu * ntaps],
-                vec![0i64; nu],
-                vec![false; nu],
-                vec![0.0; ntaps],
+                vec![[[0.0; 2]; 3]; nu],
             )
         },
-        |(a, b, acc, wx, kx0, xok, wy), (iw, out)| {
+        |(a, b, bx, acc, ys), (iw, out)| {
             let w = W_MIN + iw as f64 * dw;
             acc.iter_mut().for_each(|v| *v = [0.0; 3]);
-            for s in &samples.0 {
+            for (s, [tx, ty]) in samples.0.iter().zip(&axes) {
                 let lam = s.lambda_m;
                 let t = pack.t(w, lam);
                 let n = terms_at(t.abs()).clamp(1, m.terms);
@@ -129,77 +197,74 @@ pub fn build(
                         im += cn[0] * di + cn[1] * dr;
                     }
                     *ai = match m.model {
-                        Model::Window => C { re, im },
-                        Model::Tiled => C {
-                            re: re * re + im * im,
-                            im: 0.0,
-                        },
+                        Model::Window => [re, im],
+                        Model::Tiled => [re * re + im * im, 0.0],
                     };
                 }
-                // x pass
-                for iu in 0..nu {
-                    let u = U_MIN + iu as f64 * du;
-                    let kappa = -u / lam * m.bin_scale_m[0];
-                    if kappa.abs() > m.crop.kx as f64 + ntaps as f64 {
-                        xok[iu] = false;
-                        continue;
-                    }
-                    let (k0, any) = taps(
-                        m,
-                        kappa,
-                        m.crop.kx,
-                        0,
-                        &mut wx[iu * ntaps..(iu + 1) * ntaps],
-                    );
-                    kx0[iu] = k0;
-                    xok[iu] = any;
-                }
-                for ty in 0..ch {
-                    let row = &a[ty * cw..(ty + 1) * cw];
-                    for iu in 0..nu {
-                        if !xok[iu] {
-                            continue;
+                // x pass (with the derivative taps for R_U)
+                for yy in 0..ch {
+                    let row = &a[yy * cw..(yy + 1) * cw];
+                    for iu in (0..nu).filter(|&iu| tx.ok[iu]) {
+                        let taps = iu * ntaps..(iu + 1) * ntaps;
+                        let k0 = tx.k0[iu];
+                        b[yy * nu + iu] = dot(&tx.w[taps.clone()], k0, |k| row[k]);
+                        if deriv {
+                            bx[yy * nu + iu] = dot(&tx.dw[taps], k0, |k| row[k]);
                         }
-                        let mut sre = 0.0;
-                        let mut sim = 0.0;
-                        for j in 0..ntaps {
-                            let wt = wx[iu * ntaps + j];
-                            if wt != 0.0 {
-                                let v = row[(kx0[iu] + j as i64) as usize];
-                                sre += wt * v.re;
-                                sim += wt * v.im;
-                            }
-                        }
-                        b[ty * nu + iu] = C { re: sre, im: sim };
                     }
                 }
-                // y pass
-                for iv in 0..nv {
+                // y pass: A, dA/du, dA/dv (d/du = -(bin_scale_x / lambda) d/dkappa_x)
+                let (su, sv) = (-m.bin_scale_m[0] / lam, -m.bin_scale_m[1] / lam);
+                let k = 2.0 * std::f64::consts::PI / lam;
+                // The columns with taps in the crop (an interval of u).
+                let lo = tx.ok.iter().position(|&ok| ok).unwrap_or(nu);
+                let hi = tx.ok.iter().rposition(|&ok| ok).map_or(lo, |i| i + 1);
+                for iv in (0..nv).filter(|&iv| ty.ok[iv]) {
                     let v = U_MIN + iv as f64 * dv;
-                    let kappa = -v / lam * m.bin_scale_m[1];
-                    if kappa.abs() > m.crop.ky as f64 + ntaps as f64 {
-                        continue;
-                    }
-                    let (k0, any) = taps(m, kappa, m.crop.ky, 1, wy);
-                    if !any {
-                        continue;
-                    }
-                    for iu in 0..nu {
-                        if !xok[iu] {
+                    let taps = iv * ntaps..(iv + 1) * ntaps;
+                    // Row-wise over the taps (contiguous in u): per column
+                    // A, dA/dkappa_x, dA/dkappa_y, each summed in tap order.
+                    ys[lo..hi].iter_mut().for_each(|y| *y = [[0.0; 2]; 3]);
+                    for (j, (&wt, &dwt)) in ty.w[taps.clone()].iter().zip(&ty.dw[taps]).enumerate()
+                    {
+                        if wt == 0.0 && dwt == 0.0 {
+                            continue; // outside the crop
+                        }
+                        let row = (ty.k0[iv] + j as i64) as usize * nu + lo;
+                        let (br, yr) = (&b[row..row + hi - lo], &mut ys[lo..hi]);
+                        if !deriv {
+                            for (y, q) in yr.iter_mut().zip(br) {
+                                y[0][0] += wt * q[0];
+                                y[0][1] += wt * q[1];
+                            }
                             continue;
                         }
-                        let mut sre = 0.0;
-                        let mut sim = 0.0;
-                        for (j, &wt) in wy.iter().enumerate().take(ntaps) {
-                            if wt != 0.0 {
-                                let q = b[(k0 + j as i64) as usize * nu + iu];
-                                sre += wt * q.re;
-                                sim += wt * q.im;
-                            }
+                        // One pass for the three (a zero weight adds exact zeros).
+                        let bxr = &bx[row..row + hi - lo];
+                        for ((y, q), qx) in yr.iter_mut().zip(br).zip(bxr) {
+                            y[0][0] += wt * q[0];
+                            y[0][1] += wt * q[1];
+                            y[1][0] += wt * qx[0];
+                            y[1][1] += wt * qx[1];
+                            y[2][0] += dwt * q[0];
+                            y[2][1] += dwt * q[1];
                         }
-                        let r = match m.model {
-                            Model::Window => sre * sre + sim * sim,
-                            Model::Tiled => sre,
+                    }
+                    for iu in (lo..hi).filter(|&iu| tx.ok[iu]) {
+                        let [amp, d_x, d_y] = ys[iu];
+                        let r = match (m.model, sigma) {
+                            (Model::Tiled, _) => amp[0],
+                            (Model::Window, None) => amp[0] * amp[0] + amp[1] * amp[1],
+                            (Model::Window, Some(sg)) => {
+                                sunbeam_optics::grazing::window_reflectance(
+                                    [U_MIN + iu as f64 * du, v, w],
+                                    amp,
+                                    d_x.map(|d| d * su),
+                                    d_y.map(|d| d * sv),
+                                    k,
+                                    [sg, sg],
+                                )
+                            }
                         };
                         let cell = &mut acc[iv * nu + iu];
                         for (c, w) in cell.iter_mut().zip(&s.weight) {
