@@ -13,7 +13,10 @@
 //     or as its bits (the child pointers);
 //   env_cells_top(): cells of the top cut; env_cells_nodes(): every node;
 //   env_cells_layers(): the maps' s layers;
-//   env_cells_gain(wi, wr): the mesh's gain G with its masking;
+//   env_cells_view(wr): what the mesh's gain and masking need of the view
+//     alone, once per shading point (sb_gain_view, Smith's Lambda(wr));
+//   env_cells_gain(wi, wr, view): the mesh's gain G with its masking, view
+//     from env_cells_view(wr);
 //   env_chain_height(), env_chain_levels(): the chain's level-0 height and levels;
 //   env_chain_read(uv, level): the chain at equirectangular uv, trilinear;
 //   env_irradiance_read(skin, uv): a table (skin: transmitted, else plain).
@@ -50,6 +53,8 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
     // index and no stack, whose dynamic indexing would live in local memory.
     // Each node is visited at most once, which bounds the loop.
     let n_nodes = env_cells_nodes();
+    // G's and the masking's factors of the view alone, once for all cells.
+    let view = env_cells_view(wr);
     var id = 0u;
     for (var visit = 0u; visit < n_nodes && id != ENV_CELL_NONE; visit = visit + 1u) {
         let o = id * stride;
@@ -81,7 +86,7 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         let sc = s * f32(ns - 1u);
         let k0 = min(u32(floor(sc)), ns - 2u);
         let f = sc - f32(k0);
-        let gw = env_cells_gain(wi, wr) / wi.z * inside;
+        let gw = env_cells_gain(wi, wr, view) / wi.z * inside;
         if (!(gw > 0.0)) {
             continue;
         }

@@ -14,6 +14,8 @@ fn env_hotspots(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3
     let gr = env_grid();
     var xyz = vec3<f32>(0.0);
     let count = arrayLength(&env_lights) / 2u;
+    // G's and the masking's factors of the view alone, once for all taps.
+    let view = env_cells_view(wr);
     for (var i = 0u; i < count; i = i + 1u) {
         let d = env_lights[2u * i].xyz;
         let p = env_lights[2u * i + 1u].xyz;
@@ -24,7 +26,7 @@ fn env_hotspots(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3
         }
         let rc = sb_resp_coords(-wi - wr, gr);
         let e = p.x * env_map(env_e0, rc, gr) + p.y * env_map(env_e1, rc, gr) + p.z * env_map(env_e2, rc, gr);
-        xyz = xyz + gain(wi, wr) * e;
+        xyz = xyz + env_cells_gain(wi, wr, view) * e;
     }
     return xyz;
 }

@@ -488,8 +488,14 @@ fn env_cells_layers() -> u32 {
     return envp.n_s;
 }
 
-fn env_cells_gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    return gain(wi, wr);
+fn env_cells_view(wr: vec3<f32>) -> vec2<f32> {
+    let slope = vec2<f32>(mat.mask_sx, mat.mask_sy);
+    return vec2<f32>(sb_gain_view(wr.z, skin()), sb_smith_lambda(wr, slope));
+}
+
+fn env_cells_gain(wi: vec3<f32>, wr: vec3<f32>, view: vec2<f32>) -> f32 {
+    let slope = vec2<f32>(mat.mask_sx, mat.mask_sy);
+    return sb_gain_pair(wi, wr, mat.ior) * view.x * sb_masking_with(wi, wr.z, view.y, slope);
 }
 
 fn env_chain_height() -> u32 {

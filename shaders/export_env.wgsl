@@ -63,8 +63,13 @@ fn env_cells_layers() -> u32 {
     return u32(sunbeam_env.cells.y);
 }
 
-fn env_cells_gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    return sb_gain(wi, wr, SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw, sunbeam.energy)) * sb_masking(wi, wr, sunbeam.skin.zw);
+fn env_cells_view(wr: vec3<f32>) -> vec2<f32> {
+    let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw, sunbeam.energy);
+    return vec2<f32>(sb_gain_view(wr.z, skin), sb_smith_lambda(wr, sunbeam.skin.zw));
+}
+
+fn env_cells_gain(wi: vec3<f32>, wr: vec3<f32>, view: vec2<f32>) -> f32 {
+    return sb_gain_pair(wi, wr, sunbeam.skin.x) * view.x * sb_masking_with(wi, wr.z, view.y, sunbeam.skin.zw);
 }
 
 fn env_chain_height() -> u32 {

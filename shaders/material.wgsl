@@ -71,11 +71,28 @@ fn sb_fresnel(cos_theta: f32, ior: f32) -> f32 {
 }
 
 // sunbeam_optics::gain::g: G = F(theta_d) (1 + wi.wr)^2 / ((cos th_i + cos th_r)^2 cos th_r) / norm,
-// Fresnel taken once, times the skin's energy bound at wr (sb_energy). 0 unless both directions are above the horizon. For
-// unit directions 1 + wi.wr = |wi + wr|^2 / 2 and cos theta_d = wi.h = |wi + wr| / 2:
-// written so, G keeps its digits where wi and wr are nearly opposite (both
-// grazing), where 1 + wi.wr cancels in float32.
+// Fresnel taken once, times the skin's energy bound at wr (sb_energy). 0 unless both directions are above the horizon.
+// The product of sb_gain_pair and sb_gain_view: a sum over many wi at one view
+// (the environment's cells) computes the view's part once.
 fn sb_gain(wi: vec3<f32>, wr: vec3<f32>, skin: SbSkin) -> f32 {
+    return sb_gain_pair(wi, wr, skin.ior) * sb_gain_view(wr.z, skin);
+}
+
+// The part of G that depends on the view alone: the energy bound over
+// norm cos theta_r (0 unless cos_r > 0).
+fn sb_gain_view(cos_r: f32, skin: SbSkin) -> f32 {
+    if (!(cos_r > 0.0)) {
+        return 0.0;
+    }
+    return sb_energy(cos_r, skin.energy) / (skin.norm * cos_r);
+}
+
+// The rest of G: F(theta_d) (1 + wi.wr)^2 / (cos th_i + cos th_r)^2, 0 unless
+// both directions are above the horizon. For unit directions 1 + wi.wr =
+// |wi + wr|^2 / 2 and cos theta_d = wi.h = |wi + wr| / 2: written so, G keeps
+// its digits where wi and wr are nearly opposite (both grazing), where
+// 1 + wi.wr cancels in float32.
+fn sb_gain_pair(wi: vec3<f32>, wr: vec3<f32>, ior: f32) -> f32 {
     let ci = wi.z;
     let cr = wr.z;
     if (!(ci > 0.0 && cr > 0.0)) {
@@ -83,9 +100,9 @@ fn sb_gain(wi: vec3<f32>, wr: vec3<f32>, skin: SbSkin) -> f32 {
     }
     let s = wi + wr;
     let s2 = dot(s, s);
-    let f = sb_fresnel(0.5 * sqrt(s2), skin.ior);
+    let f = sb_fresnel(0.5 * sqrt(s2), ior);
     let c = ci + cr;
-    return f * (0.25 * s2 * s2) / (skin.norm * c * c * cr) * sb_energy(cr, skin.energy);
+    return f * (0.25 * s2 * s2) / (c * c);
 }
 
 // erf by Abramowitz & Stegun 7.1.26 (sunbeam_optics::masking::erf).
@@ -119,13 +136,19 @@ fn sb_smith_lambda(w: vec3<f32>, slope: vec2<f32>) -> f32 {
 // shadowing-masking G2 = 1 / (1 + Lambda(wi) + Lambda(wr)); 1 when off
 // (both slopes 0), 0 when either direction is at or below the horizon.
 fn sb_masking(wi: vec3<f32>, wr: vec3<f32>, slope: vec2<f32>) -> f32 {
+    return sb_masking_with(wi, wr.z, sb_smith_lambda(wr, slope), slope);
+}
+
+// sb_masking with the view's Lambda given (lambda_r = sb_smith_lambda(wr,
+// slope)): a sum over many wi at one view computes it once.
+fn sb_masking_with(wi: vec3<f32>, cos_r: f32, lambda_r: f32, slope: vec2<f32>) -> f32 {
     if (slope.x <= 0.0 && slope.y <= 0.0) {
         return 1.0;
     }
-    if (wi.z <= 0.0 || wr.z <= 0.0) {
+    if (wi.z <= 0.0 || cos_r <= 0.0) {
         return 0.0;
     }
-    return 1.0 / (1.0 + sb_smith_lambda(wi, slope) + sb_smith_lambda(wr, slope));
+    return 1.0 / (1.0 + sb_smith_lambda(wi, slope) + lambda_r);
 }
 
 // The diffuse base's share of the light arriving at cos_i
