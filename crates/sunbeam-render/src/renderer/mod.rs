@@ -76,6 +76,7 @@ macro_rules! player_shader {
         )
     };
 }
+// By path, for baselines.rs (`super::player_shader!`).
 #[cfg(feature = "baselines")]
 use player_shader;
 
