@@ -20,6 +20,7 @@ pub mod export;
 pub mod gpu;
 pub mod renderer;
 pub mod response;
+#[cfg(feature = "baselines")]
 pub mod table;
 pub mod window;
 

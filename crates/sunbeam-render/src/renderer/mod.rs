@@ -1,19 +1,29 @@
 //! The diffraction renderer: buffers for meshes and packs, the pipeline of
-//! shaders/diffraction.wgsl, drawing into any colour target, and headless frames.
+//! the [`Mode`]'s technique, drawing into any colour target, and headless
+//! frames.
 //!
-//! One pipeline and one material uniform serve every [`Mode`] (the WGSL
-//! branches on the mode); what each technique uploads is its own module:
+//! Each technique is a shader of its own: the shared shading
+//! (shaders/diffraction.wgsl: the `Globals` and `Material` uniforms, the
+//! vertex stage, `shade`) composed with the technique's file, which gives a
+//! point light's diffraction term and the fragment entry point, and, where
+//! it needs them, its own uniform and bind group:
 //!
-//! - [`response_map`]: the default mode's point-light response map;
-//! - [`environment`]: sky and map lighting (the default mode's extended-light maps);
-//! - [`baselines`]: the modes the default is measured against (table,
-//!   direct, thesis, Lambert);
+//! - the default mode: [`SHADER`], shaders/default.wgsl's `fs_main`, the
+//!   response map ([`response_map`]) and the environment ([`environment`]:
+//!   sky and map lighting, the extended-light maps). The Lambert mode is
+//!   this pipeline with no pack bound (the base colour alone).
+//! - the baselines (table, direct, thesis; behind the `baselines` feature,
+//!   on by default): `baselines::BASELINE_SHADER`, shaders/baselines.wgsl's
+//!   `fs_baseline` specialised per mode by a pipeline constant, with their
+//!   own uniform (`Baseline`: series, crop, kernel, term and response
+//!   tables) in bind group 3, which the default pipeline does not have.
 //!
-//! and the shared parts: [`uniforms`] (the uniform structs, checked against
-//! the WGSL), [`pipeline`] (layouts, buffers, the render pipeline),
-//! [`targets`] (depth, colour and offscreen targets, readback).
+//! The shared parts: [`uniforms`] (the uniform structs, checked against the
+//! WGSL), [`pipeline`] (layouts, buffers, the render pipeline), [`targets`]
+//! (depth, colour and offscreen targets, readback).
 
 pub mod background;
+#[cfg(feature = "baselines")]
 pub mod baselines;
 pub mod environment;
 pub mod pipeline;
@@ -21,41 +31,58 @@ pub mod response_map;
 pub mod targets;
 pub mod uniforms;
 
+#[cfg(feature = "baselines")]
+pub use baselines::term_table;
 pub use targets::{
     colour_view, depth_view, depth_view_ms, subpixel_jitter, Offscreen, OFFSCREEN_FORMAT,
 };
-pub use uniforms::term_table;
 
 use crate::gpu::Gpu;
 use pipeline::{
     bind_group_layouts, dummy_texture, mesh_buffers, render_pipeline, rgba8_texture, scale_wraps,
+    Technique,
 };
 use std::sync::Arc;
 use sunbeam_common::{Error, Result};
 use sunbeam_frame::Prepared;
 use sunbeam_optics::colour::{self, ToneCurve, ToneMap};
 use sunbeam_scene::{camera, Background, Camera, Light};
-use uniforms::{pack_uniforms, spectral_samples, spectrum_table, Globals, MaterialU};
+use uniforms::{spectral_samples, spectrum_table, Globals, MaterialU};
 use wgpu::util::DeviceExt;
 
-/// The WGSL source: the skin's material functions (shaders/material.wgsl:
-/// Fresnel, G, masking, the diffuse base's share, the frame), the response-map
-/// material (shaders/response_map.wgsl; both also what `--export-shader`
-/// translates), the scale maps' frame (shaders/scales.wgsl), the player's
-/// shading (shaders/diffraction.wgsl) and the environment's estimators
-/// (shaders/environment.wgsl; shaders/env_cells.wgsl: the cells, shared with
-/// the export; shaders/env_hotspots.wgsl: a map's hot spots as lights).
-pub const SHADER: &str = concat!(
-    include_str!("../../../../shaders/material.wgsl"),
-    include_str!("../../../../shaders/scales.wgsl"),
-    include_str!("../../../../shaders/display.wgsl"),
-    include_str!("../../../../shaders/env_table.wgsl"),
-    include_str!("../../../../shaders/response_map.wgsl"),
-    include_str!("../../../../shaders/diffraction.wgsl"),
-    include_str!("../../../../shaders/environment.wgsl"),
-    include_str!("../../../../shaders/env_cells.wgsl"),
-    include_str!("../../../../shaders/env_hotspots.wgsl")
-);
+/// The WGSL of a technique (`$technique`: its file, relative to this
+/// folder, defining `point_xyz` and its fragment entry point): the skin's
+/// material functions (shaders/material.wgsl: Fresnel, G, masking, the
+/// diffuse base's share, the frame), the response-map material
+/// (shaders/response_map.wgsl; both also what `--export-shader` translates),
+/// the scale maps' frame (shaders/scales.wgsl), the shared shading
+/// (shaders/diffraction.wgsl), the technique's file, and the environment's
+/// estimators (shaders/environment.wgsl; shaders/env_cells.wgsl: the cells,
+/// shared with the export; shaders/env_hotspots.wgsl: a map's hot spots as
+/// lights).
+macro_rules! player_shader {
+    ($technique:literal) => {
+        concat!(
+            include_str!("../../../../shaders/material.wgsl"),
+            include_str!("../../../../shaders/scales.wgsl"),
+            include_str!("../../../../shaders/display.wgsl"),
+            include_str!("../../../../shaders/env_table.wgsl"),
+            include_str!("../../../../shaders/response_map.wgsl"),
+            include_str!("../../../../shaders/diffraction.wgsl"),
+            include_str!($technique),
+            include_str!("../../../../shaders/environment.wgsl"),
+            include_str!("../../../../shaders/env_cells.wgsl"),
+            include_str!("../../../../shaders/env_hotspots.wgsl")
+        )
+    };
+}
+// By path, for baselines.rs (`super::player_shader!`).
+#[cfg(feature = "baselines")]
+use player_shader;
+
+/// The default technique's WGSL: the shared shading with shaders/default.wgsl
+/// (the response map; `fs_main`).
+pub const SHADER: &str = player_shader!("../../../../shaders/default.wgsl");
 
 /// shaders/material.wgsl alone: the skin's functions every shader calls
 /// (`sb_fresnel`, `sb_gain`, `sb_masking`, `sb_base_transmission`, `sb_frame`);
@@ -74,7 +101,8 @@ pub const TERM_TABLE: usize = 256;
 /// Term count of the thesis mode.
 pub const THESIS_TERMS: u32 = 39;
 
-/// Which shading the pipeline does.
+/// Which shading the pipeline does (table, direct and thesis: the
+/// `baselines` feature).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Mode {
     /// PHYSICS.md 2 through the pack's response map (sunbeam-response: built by
@@ -97,6 +125,9 @@ impl std::str::FromStr for Mode {
     fn from_str(s: &str) -> Result<Self> {
         match s {
             "default" | "response" => Ok(Mode::Default),
+            "table" | "direct" | "thesis" if !cfg!(feature = "baselines") => {
+                Err(Error::usage(no_baselines(s)))
+            }
             "table" => Ok(Mode::Table),
             "direct" => Ok(Mode::Direct),
             "thesis" => Ok(Mode::Thesis),
@@ -106,6 +137,21 @@ impl std::str::FromStr for Mode {
             ))),
         }
     }
+}
+
+impl Mode {
+    /// True for the modes the `baselines` feature builds (table, direct, thesis).
+    pub fn is_baseline(self) -> bool {
+        matches!(self, Mode::Table | Mode::Direct | Mode::Thesis)
+    }
+}
+
+/// Why a baseline mode is refused by a build without the `baselines` feature.
+fn no_baselines(mode: &str) -> String {
+    format!(
+        "mode '{mode}' is a baseline, and this build of sunbeam-render has no `baselines` \
+         feature (build with it: it is on by default)"
+    )
 }
 
 /// Renderer settings.
@@ -119,6 +165,7 @@ pub struct Settings {
     /// tolerance or series bound, whichever is larger).
     pub term_tolerance: Option<f64>,
     /// Response table resolution of the table mode.
+    #[cfg(feature = "baselines")]
     pub table: crate::table::Dims,
     /// How the default mode builds a response map when none is beside the pack.
     pub response: sunbeam_response::Options,
@@ -149,6 +196,7 @@ impl Default for Settings {
             lambda_samples: DEFAULT_LAMBDA_SAMPLES,
             curve: ToneCurve::default(),
             term_tolerance: None,
+            #[cfg(feature = "baselines")]
             table: Default::default(),
             response: Default::default(),
             msaa: 4,
@@ -203,6 +251,16 @@ pub struct Renderer {
     pub notes: Vec<String>,
 }
 
+/// The default mode's shader (and the Lambert mode's): `fs_main` of [`SHADER`].
+fn default_technique() -> Technique {
+    Technique {
+        label: "diffraction.wgsl",
+        source: SHADER,
+        entry: "fs_main",
+        constants: Vec::new(),
+    }
+}
+
 /// Depth format of every pass.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
@@ -214,6 +272,8 @@ struct GpuMesh {
     bind: wgpu::BindGroup,
     /// Bind group 2: the environment (this mesh's pack's maps, or stand-ins).
     env_bind: wgpu::BindGroup,
+    /// Bind group 3 of the baselines' pipelines (none in the default's).
+    technique_bind: Option<wgpu::BindGroup>,
 }
 
 impl Renderer {
@@ -225,13 +285,22 @@ impl Renderer {
     ) -> Result<Renderer> {
         let device = &gpu.device;
         let mut warnings = Vec::new();
+        // The technique's shader and, for a baseline, its own bind group.
+        #[cfg(feature = "baselines")]
+        let (technique, mut baselines) = match baselines::technique(settings.mode) {
+            Some(t) => (t, Some(baselines::Baselines::new(device))),
+            None => (default_technique(), None),
+        };
+        #[cfg(not(feature = "baselines"))]
+        let technique = if settings.mode.is_baseline() {
+            return Err(Error::usage(no_baselines(
+                &format!("{:?}", settings.mode).to_lowercase(),
+            )));
+        } else {
+            default_technique()
+        };
         let samples = spectral_samples(settings);
         let spec = spectrum_table(&samples);
-        let lambda_min = samples
-            .0
-            .iter()
-            .map(|s| s.lambda_m)
-            .fold(f64::INFINITY, f64::min);
         let spectrum = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("spectrum"),
             contents: bytemuck::cast_slice(&spec),
@@ -299,8 +368,6 @@ impl Renderer {
             ],
         });
 
-        // Packs: one terms buffer per distinct pack.
-        let mut pack_bufs: baselines::TermBuffers = Vec::new();
         let mut meshes = Vec::new();
         for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
             let scales = mat.scales.as_deref();
@@ -312,8 +379,6 @@ impl Renderer {
                     mat.base_color[2] as f32,
                     mat.diffuse_weight as f32,
                 ],
-                n_table: 1,
-                table_dt: 1.0,
                 mask_sx: mat.masking.rms_slope()[0] as f32,
                 mask_sy: mat.masking.rms_slope()[1] as f32,
                 ior: mat.skin.ior as f32,
@@ -322,9 +387,9 @@ impl Renderer {
                 scales_wrap: scales.map_or(0, scale_wraps),
                 ..Default::default()
             };
-            let mut response: Option<Vec<[f32; 4]>> = None;
             let mut resp_map: Option<Arc<sunbeam_response::Response>> = None;
-            let (terms_buf, table): (Arc<wgpu::Buffer>, Vec<u32>) = match &mat.pack {
+            #[cfg_attr(not(feature = "baselines"), allow(unused_variables))]
+            let mesh_pack = match &mat.pack {
                 Some(pack) if settings.mode != Mode::Lambert => {
                     let m = &pack.manifest;
                     if m.kernel.taps > MAX_TAPS {
@@ -340,15 +405,7 @@ impl Renderer {
                             m.terms
                         ));
                     }
-                    let buf = baselines::terms_buffer(
-                        device,
-                        pack,
-                        used,
-                        settings.mode,
-                        mi,
-                        &mut pack_bufs,
-                    )?;
-                    let (table, dt) = pack_uniforms(&mut mu, pack, used, settings, lambda_min);
+                    mu.has_pack = 1;
                     // The point map serves point lights only: an environment scene
                     // without any needs just the environment's maps (built below).
                     let point_lit = environment.is_none() || !p.scene.lights.is_empty();
@@ -379,39 +436,27 @@ impl Renderer {
                         let masked = mat.masking != sunbeam_optics::masking::Masking::Off;
                         mu.energy = info.bound(mat.skin, masked).columns();
                     }
-                    if settings.mode == Mode::Table {
-                        response = Some(baselines::response_table(
-                            pack, &samples, settings, &table, dt, mi, device, &mut mu,
-                        )?);
-                    }
-                    (buf, table)
+                    Some((pack, used))
                 }
-                _ => (
-                    Arc::new(
-                        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                            label: Some("no terms"),
-                            contents: bytemuck::cast_slice(&[0.0f32; 4]),
-                            usage: wgpu::BufferUsages::STORAGE,
-                        }),
-                    ),
-                    vec![1u32],
-                ),
+                _ => None,
             };
+            #[cfg(feature = "baselines")]
+            let technique_bind = match baselines.as_mut() {
+                Some(b) => Some(b.bind(
+                    device,
+                    mesh_pack.map(|(pack, used)| baselines::MeshPack { pack, used }),
+                    settings,
+                    &samples,
+                    mi,
+                )?),
+                None => None,
+            };
+            #[cfg(not(feature = "baselines"))]
+            let technique_bind = None;
             let mbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("material"),
                 contents: bytemuck::bytes_of(&mu),
                 usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let tbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("term table"),
-                contents: bytemuck::cast_slice(&table),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
-            let rdata = response.unwrap_or_else(|| vec![[0.0f32; 4]]);
-            let rbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("response table"),
-                contents: bytemuck::cast_slice(&rdata),
-                usage: wgpu::BufferUsages::STORAGE,
             });
             let resp_view = match &resp_map {
                 Some(r) => resp_views
@@ -448,18 +493,6 @@ impl Renderer {
                     wgpu::BindGroupEntry {
                         binding: 0,
                         resource: mbuf.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: terms_buf.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: tbuf.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: rbuf.as_entire_binding(),
                     },
                     wgpu::BindGroupEntry {
                         binding: 4,
@@ -500,15 +533,17 @@ impl Renderer {
                 count: mesh.indices.len() as u32,
                 bind,
                 env_bind,
+                technique_bind,
             });
         }
 
-        let pipeline = render_pipeline(
-            device,
-            [&gl0, &gl1, &env_scene.layout],
-            format,
-            settings.msaa,
-        )?;
+        #[cfg_attr(not(feature = "baselines"), allow(unused_mut))]
+        let mut layouts = vec![&gl0, &gl1, &env_scene.layout];
+        #[cfg(feature = "baselines")]
+        if let Some(b) = &baselines {
+            layouts.push(&b.layout);
+        }
+        let pipeline = render_pipeline(device, &layouts, format, settings.msaa, &technique)?;
         // `"background": "environment"`: the lighting's table and sun (or,
         // in the Lambert mode, which lights without them, the same built here).
         let background = match (&p.scene.background, &p.environment) {
@@ -624,12 +659,7 @@ impl Renderer {
                 [b[0] as f32, b[1] as f32, b[2] as f32, 1.0]
             },
             n_lights: n as u32,
-            mode: match self.settings.mode {
-                Mode::Default | Mode::Table => 0,
-                Mode::Thesis => 1,
-                Mode::Lambert => 2,
-                Mode::Direct => 3,
-            },
+            _g1: 0,
             curve: match self.settings.curve {
                 ToneCurve::Clamp => 0,
                 ToneCurve::Reinhard => 1,
@@ -740,6 +770,9 @@ impl Renderer {
             }
             rp.set_bind_group(1, &m.bind, &[]);
             rp.set_bind_group(2, &m.env_bind, &[]);
+            if let Some(b) = &m.technique_bind {
+                rp.set_bind_group(3, b, &[]);
+            }
             rp.set_vertex_buffer(0, m.vbuf.slice(..));
             rp.set_index_buffer(m.ibuf.slice(..), wgpu::IndexFormat::Uint32);
             rp.draw_indexed(0..m.count, 0, 0..1);

@@ -1,29 +1,20 @@
-//! The pipeline of the player's shaders ([`super::SHADER`]): the bind group
-//! layouts, a mesh's vertex and index buffers, the render pipeline, the
-//! stand-in texture of materials without a response map.
+//! The pipeline of a technique's shader ([`Technique`]: [`super::SHADER`]
+//! or the baselines'): the bind group layouts every technique shares, a
+//! mesh's vertex and index buffers, the render pipeline, the stand-in
+//! texture of materials without a response map.
 
 use super::uniforms::Vertex;
-use super::{DEPTH_FORMAT, SHADER};
+use super::DEPTH_FORMAT;
 use crate::gpu::Gpu;
 use bytemuck::Zeroable;
 use sunbeam_common::{Error, Result};
 use wgpu::util::DeviceExt;
 
-/// Bind group layouts: 0 = globals and spectrum, 1 = one material (uniforms,
-/// terms, term table, response table, response map and its sampler, the
-/// scale maps).
+/// Bind group layouts: 0 = globals and spectrum, 1 = one material (uniform,
+/// response map and its sampler, the scale maps). Group 2 is the
+/// environment's ([`crate::env::EnvScene`]); the baselines add group 3.
 pub(super) fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 2] {
     let storage_entry = crate::gpu::fragment_storage_entry;
-    let uniform_entry = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
     let gl0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("globals"),
         entries: &[uniform_entry(0), storage_entry(1)],
@@ -32,9 +23,6 @@ pub(super) fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayou
         label: Some("material"),
         entries: &[
             uniform_entry(0),
-            storage_entry(1),
-            storage_entry(2),
-            storage_entry(3),
             wgpu::BindGroupLayoutEntry {
                 binding: 4,
                 visibility: wgpu::ShaderStages::FRAGMENT,
@@ -56,6 +44,20 @@ pub(super) fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayou
         ],
     });
     [gl0, gl1]
+}
+
+/// A uniform buffer both stages read.
+pub(super) fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
 }
 
 /// A 2D texture read by `textureLoad` (the scale maps).
@@ -117,35 +119,53 @@ pub(super) fn mesh_buffers(
     (vbuf, ibuf)
 }
 
-/// The pipeline of shaders/diffraction.wgsl for a colour format and sample count.
+/// A technique's shader: the composed WGSL, its fragment entry point and the
+/// values of its pipeline constants.
+pub(super) struct Technique {
+    pub(super) label: &'static str,
+    pub(super) source: &'static str,
+    pub(super) entry: &'static str,
+    pub(super) constants: Vec<(&'static str, f64)>,
+}
+
+/// The pipeline of `technique` for a colour format and sample count, with
+/// bind groups `layouts` (0, 1, 2 shared; more for the technique's own).
 pub(super) fn render_pipeline(
     device: &wgpu::Device,
-    layouts: [&wgpu::BindGroupLayout; 3],
+    layouts: &[&wgpu::BindGroupLayout],
     format: wgpu::TextureFormat,
     msaa: u32,
+    technique: &Technique,
 ) -> Result<wgpu::RenderPipeline> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("diffraction.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        label: Some(technique.label),
+        source: wgpu::ShaderSource::Wgsl(technique.source.into()),
     });
+    let bind_group_layouts: Vec<_> = layouts.iter().map(|l| Some(*l)).collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("diffraction"),
-        bind_group_layouts: &[Some(layouts[0]), Some(layouts[1]), Some(layouts[2])],
+        label: Some(technique.label),
+        bind_group_layouts: &bind_group_layouts,
         immediate_size: 0,
     });
+    // Every stage gets the constants: wgpu resolves all of a module's
+    // overrides for each stage.
+    let options = || wgpu::PipelineCompilationOptions {
+        constants: &technique.constants,
+        ..Default::default()
+    };
     let vlayout = wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<Vertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x2, 4 => Float32x4],
     };
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("diffraction"),
+        label: Some(technique.label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
             module: &module,
             entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
+            compilation_options: options(),
             buffers: &[Some(vlayout)],
         },
         primitive: wgpu::PrimitiveState {
@@ -166,8 +186,8 @@ pub(super) fn render_pipeline(
         },
         fragment: Some(wgpu::FragmentState {
             module: &module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
+            entry_point: Some(technique.entry),
+            compilation_options: options(),
             targets: &[Some(wgpu::ColorTargetState {
                 format,
                 blend: None,

@@ -2,7 +2,7 @@
 //! sunbeam-response): the point-light map of a pack, loaded from beside the
 //! pack or built ([`crate::response`]), and its grid in the material's
 //! uniforms. Its shading is shaders/response_map.wgsl's (through
-//! shaders/diffraction.wgsl's mode 0).
+//! shaders/default.wgsl, composed with shaders/diffraction.wgsl).
 
 use super::uniforms::MaterialU;
 use super::Settings;

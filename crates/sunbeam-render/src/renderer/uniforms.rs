@@ -1,14 +1,14 @@
 //! The uniforms the shaders read (shaders/diffraction.wgsl's `Globals` and
-//! `Material`, mirrored by hand and checked against the WGSL by naga's
-//! reflection in the tests below), the vertex layout, and what fills the
-//! pack's part of the material: the series, crop and kernel, the per-|t| term
-//! table, the spectrum buffer. One `Material` serves every mode (the WGSL
-//! branches on `Globals::mode`); each technique's module fills its fields.
+//! `Material`; shaders/baselines.wgsl's `Baseline`), mirrored by hand and
+//! checked against the WGSL by naga's reflection in the tests below, the
+//! vertex layout, and the spectrum buffer. `Material` holds what the default
+//! technique (the response map, the environment) and every mesh read; the
+//! baselines' series, crop, kernel and tables are their own uniform, bound
+//! by their pipelines only.
 
-use super::{Mode, Settings, MAX_LIGHTS, MAX_TERMS, TERM_TABLE, THESIS_TERMS};
+use super::{Mode, Settings, MAX_LIGHTS};
 use sunbeam_frame::spectral::Samples;
 use sunbeam_optics::cie;
-use sunbeam_pack::{Basis, Model, Pack};
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -33,7 +33,7 @@ pub(super) struct Globals {
     pub(super) xyz_to_rgb: [[f32; 4]; 3],
     pub(super) background: [f32; 4],
     pub(super) n_lights: u32,
-    pub(super) mode: u32,
+    pub(super) _g1: u32,
     pub(super) curve: u32,
     pub(super) output: u32,
     pub(super) exposure_scale: f32,
@@ -47,7 +47,39 @@ pub(super) struct Globals {
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
 pub(super) struct MaterialU {
     pub(super) base: [f32; 4],
+    /// 1 when the mesh diffracts (it has a pack; 0 in the Lambert mode).
     pub(super) has_pack: u32,
+    /// 1 when the mesh's scale maps are bound (shaders/scales.wgsl).
+    pub(super) scales_on: u32,
+    pub(super) mask_sx: f32,
+    pub(super) mask_sy: f32,
+    /// The skin's refractive index (scene `meshes[].ior`).
+    pub(super) ior: f32,
+    /// What G is divided by: `sunbeam_optics::gain::Material::norm` (1
+    /// absolute, F(0) relative).
+    pub(super) norm: f32,
+    pub(super) resp_on: u32,
+    pub(super) resp_n_theta: f32,
+    pub(super) resp_n_rho: f32,
+    pub(super) resp_n_s: f32,
+    pub(super) resp_r0: f32,
+    pub(super) resp_rho_scale: f32,
+    pub(super) resp_footprint: u32,
+    /// The scale maps' wraps: bits 0-1 the normal map's REPEAT along s and
+    /// t, bits 2-3 the orientation map's.
+    pub(super) scales_wrap: u32,
+    pub(super) _s: [f32; 2],
+    /// The energy bound's table (`sunbeam_optics::energy::EnergyBound::columns`).
+    pub(super) energy: [[f32; 4]; 4],
+}
+
+/// shaders/baselines.wgsl's `Baseline`: the pack's series, crop, kernel and
+/// per-|t| term table (docs/PACK_FORMAT.md "Evaluation") for the per-fragment
+/// baselines, and the table baseline's grid.
+#[cfg(feature = "baselines")]
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
+pub(super) struct BaselineU {
     pub(super) basis: u32,
     pub(super) model: u32,
     pub(super) taps: u32,
@@ -58,8 +90,6 @@ pub(super) struct MaterialU {
     pub(super) terms: u32,
     pub(super) fixed_terms: u32,
     pub(super) n_table: u32,
-    /// 1 when the mesh's scale maps are bound (shaders/scales.wgsl).
-    pub(super) scales_on: u32,
     pub(super) bin_scale_um: [f32; 2],
     pub(super) half_range_um: f32,
     pub(super) beta: f32,
@@ -69,119 +99,14 @@ pub(super) struct MaterialU {
     pub(super) tab_nu: u32,
     pub(super) tab_nv: u32,
     pub(super) tab_nw: u32,
-    pub(super) tab_on: u32,
     pub(super) tab_u0: f32,
     pub(super) tab_du: f32,
     pub(super) tab_dv: f32,
     pub(super) tab_w0: f32,
     pub(super) tab_dw: f32,
-    pub(super) mask_sx: f32,
-    pub(super) mask_sy: f32,
-    /// The skin's refractive index (scene `meshes[].ior`).
-    pub(super) ior: f32,
-    pub(super) resp_on: u32,
-    pub(super) resp_n_theta: f32,
-    pub(super) resp_n_rho: f32,
-    pub(super) resp_n_s: f32,
-    pub(super) resp_r0: f32,
-    pub(super) resp_rho_scale: f32,
-    pub(super) resp_footprint: u32,
-    /// What G is divided by: `sunbeam_optics::gain::Material::norm` (1
-    /// absolute, F(0) relative).
-    pub(super) norm: f32,
     /// The window's sigma in um (window model: R_U in the direct mode), 0 = R.
     pub(super) window_sigma_um: f32,
-    /// The scale maps' wraps: bits 0-1 the normal map's REPEAT along s and
-    /// t, bits 2-3 the orientation map's.
-    pub(super) scales_wrap: u32,
-    pub(super) _s: [f32; 2],
-    /// The energy bound's table (`sunbeam_optics::energy::EnergyBound::columns`).
-    pub(super) energy: [[f32; 4]; 4],
-}
-
-/// Smallest term count whose truncation bound stays below `tol` for every |t| up to `t`.
-fn terms_for(basis: Basis, t: f64, tol: f64, start: usize, cap: usize) -> usize {
-    let mut n = start.max(1);
-    while n < cap && sunbeam_pack::series::tail_bound_upto(basis, t, n) >= tol {
-        n += 1;
-    }
-    n
-}
-
-/// The per-|t| term table of a pack: entry i covers |t| <= (i + 1) dt.
-pub fn term_table(pack: &Pack, t_max: f64, tol: f64) -> (Vec<u32>, f64) {
-    let m = &pack.manifest;
-    let cap = m.terms.min(MAX_TERMS);
-    let dt = (t_max / TERM_TABLE as f64).max(1e-6);
-    let mut out = Vec::with_capacity(TERM_TABLE);
-    let mut n = 1;
-    for i in 0..TERM_TABLE {
-        n = terms_for(m.basis, (i + 1) as f64 * dt, tol, n, cap);
-        out.push(n as u32);
-    }
-    (out, dt)
-}
-
-/// The pack's part of a material's uniforms (series, crop, kernel, per-|t| term
-/// table; docs/PACK_FORMAT.md "Evaluation"): the term table and its |t| step.
-pub(super) fn pack_uniforms(
-    mu: &mut MaterialU,
-    pack: &Pack,
-    used: usize,
-    settings: &Settings,
-    lambda_min: f64,
-) -> (Vec<u32>, f64) {
-    let m = &pack.manifest;
-    let h = m.height_half_range_m;
-    let t_max = 4.0 * std::f64::consts::PI * h / lambda_min;
-    let tol = settings
-        .term_tolerance
-        .unwrap_or_else(|| m.error.tolerance.unwrap_or(0.0).max(m.error.series_bound))
-        .max(1e-12);
-    let (table, dt) = term_table(pack, t_max, tol);
-    let w = m.kernel.taps as f64;
-    mu.has_pack = 1;
-    mu.basis = match m.basis {
-        Basis::Chebyshev => 0,
-        Basis::Taylor => 1,
-    };
-    mu.model = match m.model {
-        Model::Window => 0,
-        Model::Tiled => 1,
-    };
-    mu.taps = m.kernel.taps as u32;
-    mu.crop_w = m.crop.width as u32;
-    mu.crop_h = m.crop.height as u32;
-    mu.kx = m.crop.kx as i32;
-    mu.ky = m.crop.ky as i32;
-    mu.terms = used as u32;
-    mu.fixed_terms = if settings.mode == Mode::Thesis {
-        THESIS_TERMS
-    } else {
-        0
-    };
-    mu.n_table = table.len() as u32;
-    mu.bin_scale_um = [
-        (m.bin_scale_m[0] * 1e6) as f32,
-        (m.bin_scale_m[1] * 1e6) as f32,
-    ];
-    mu.half_range_um = (h * 1e6) as f32;
-    mu.beta = m.kernel.beta as f32;
-    mu.sigma_bins = [m.kernel.sigma_bins[0] as f32, m.kernel.sigma_bins[1] as f32];
-    mu.kb_norm = if m.kernel.beta > 0.0 {
-        (m.kernel.beta / (w * m.kernel.beta.sinh())) as f32
-    } else {
-        0.0
-    };
-    mu.table_dt = dt as f32;
-    // PHYSICS.md 2b's exact grazing term (Pack::shading_reflectance) in the
-    // direct mode; the thesis mode keeps the thesis' R.
-    mu.window_sigma_um = if m.model == Model::Window && settings.mode == Mode::Direct {
-        (m.window_sigma_m * 1e6) as f32
-    } else {
-        0.0
-    };
-    (table, dt)
+    pub(super) _b: u32,
 }
 
 /// Wavelength samples of a mode: the thesis' 5 nm steps, else `lambda_samples` midpoints.
@@ -276,7 +201,6 @@ mod layout_tests {
                 xyz_to_rgb,
                 background,
                 n_lights,
-                mode,
                 curve,
                 output,
                 exposure_scale,
@@ -297,6 +221,37 @@ mod layout_tests {
             &f!(
                 base,
                 has_pack,
+                scales_on,
+                mask_sx,
+                mask_sy,
+                ior,
+                norm,
+                resp_on,
+                resp_n_theta,
+                resp_n_rho,
+                resp_n_s,
+                resp_r0,
+                resp_rho_scale,
+                resp_footprint,
+                scales_wrap,
+                energy
+            ),
+        );
+    }
+
+    #[cfg(feature = "baselines")]
+    #[test]
+    fn baseline_matches_the_wgsl() {
+        use super::super::baselines::BASELINE_SHADER;
+        use super::BaselineU;
+        macro_rules! f {
+            ($($n:ident),*) => { [$((stringify!($n), offset_of!(BaselineU, $n))),*] };
+        }
+        check_in(
+            BASELINE_SHADER,
+            "Baseline",
+            size_of::<BaselineU>(),
+            &f!(
                 basis,
                 model,
                 taps,
@@ -307,7 +262,6 @@ mod layout_tests {
                 terms,
                 fixed_terms,
                 n_table,
-                scales_on,
                 bin_scale_um,
                 half_range_um,
                 beta,
@@ -317,26 +271,12 @@ mod layout_tests {
                 tab_nu,
                 tab_nv,
                 tab_nw,
-                tab_on,
                 tab_u0,
                 tab_du,
                 tab_dv,
                 tab_w0,
                 tab_dw,
-                mask_sx,
-                mask_sy,
-                ior,
-                resp_on,
-                resp_n_theta,
-                resp_n_rho,
-                resp_n_s,
-                resp_r0,
-                resp_rho_scale,
-                resp_footprint,
-                norm,
-                window_sigma_um,
-                scales_wrap,
-                energy
+                window_sigma_um
             ),
         );
     }
