@@ -30,8 +30,8 @@ pub(crate) struct Cli {
     #[arg(short, long)]
     pub(crate) output: Option<PathBuf>,
     /// Multisample anti-aliasing of silhouettes: 1 (off) or 4. Default 4, except for
-    /// a headless frame of an environment scene (1: the frames' sub-pixel jitter is
-    /// its anti-aliasing, an exact box filter; MSAA on top widens it).
+    /// a headless environment scene accumulated over --frames > 1 (1: the frames'
+    /// sub-pixel jitter is its anti-aliasing, an exact box filter; MSAA on top widens it).
     #[arg(long)]
     pub(crate) msaa: Option<u32>,
     /// Headless: render K x K times the size and box-filter in linear light.

@@ -51,12 +51,17 @@ fn load_scene(cli: &Cli) -> Result<Scene> {
 }
 
 /// `--msaa`, or its default: 1 for a headless frame accumulated under an
-/// environment (the settled frame averages frames jittered over the pixel, a
-/// box filter of one pixel; each frame's 4 samples at +-0.375 px would widen it
-/// to 1.75 px, which blurred the snake's silhouettes against the reference:
-/// CIEDE2000 p99 19.6 against 9.3 at 256 frames), else 4.
+/// environment over more than one frame (the settled frame averages frames
+/// jittered over the pixel, a box filter of one pixel; each frame's 4 samples
+/// at +-0.375 px would widen it to 1.75 px, which blurred the snake's
+/// silhouettes against the reference: CIEDE2000 p99 19.6 against 9.3 at 256
+/// frames), else 4: a single frame (the first-frame estimator's) has no
+/// jitter to anti-alias it, and without MSAA its silhouettes are one sample
+/// per pixel (the sky-lit sphere's edge pixels at p99 34.9 against 13.9 with
+/// MSAA, docs/bench/play.md "The first frame with the energy bound").
 fn msaa_for(cli: &Cli, scene: &Scene) -> u32 {
-    let accumulating = scene.environment.is_some() && cli.headless && !cli.bench;
+    let accumulating =
+        scene.environment.is_some() && cli.headless && !cli.bench && cli.frames.unwrap_or(1) > 1;
     cli.msaa.unwrap_or(if accumulating { 1 } else { 4 })
 }
 
