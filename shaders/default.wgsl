@@ -32,3 +32,29 @@ fn point_xyz(wi: vec3<f32>, wr: vec3<f32>, uvw: vec3<f32>, dx: vec3<f32>, dy: ve
 fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f32> {
     return shade(in, covered);
 }
+
+// The cells' pre-pass (g.cells_rate > 1; shaders/environment.wgsl
+// env_cells_shared): on the coarse grid, the cells' XYZ at the pixel centre
+// (w: 1 where this mesh diffracts under the environment and the view is above
+// ENV_GRAZING_COS, else 0: the full-rate pass walks those itself), the
+// frame's normal and the distance to the eye, and its tangent.
+struct CellsOut {
+    @location(0) xyz: vec4<f32>,
+    @location(1) nd: vec4<f32>,
+    @location(2) t: vec4<f32>,
+};
+
+@fragment
+fn fs_cells(in: VsOut) -> CellsOut {
+    let fr = frame_at(in.normal, in.tangent, in.uv, in.uv_tangent);
+    let wr = normalize(g.eye.xyz - in.world);
+    let wr_l = vec3<f32>(dot(wr, fr[0]), dot(wr, fr[1]), dot(wr, fr[2]));
+    var o: CellsOut;
+    o.xyz = vec4<f32>(0.0);
+    if (envg.on == 1u && envp.on == 1u && mat.has_pack == 1u && mat.base.w < 1.0 && wr_l.z > ENV_GRAZING_COS) {
+        o.xyz = vec4<f32>(env_cells(fr[0], fr[1], fr[2], wr_l), 1.0);
+    }
+    o.nd = vec4<f32>(fr[2], length(g.eye.xyz - in.world));
+    o.t = vec4<f32>(fr[0], 0.0);
+    return o;
+}

@@ -40,7 +40,9 @@ struct Globals {
     n_lambda: u32,
     // samples per pixel of the colour target (1 or 4)
     msaa: u32,
-    _g0: u32,
+    // the cells' rate (shaders/environment.wgsl env_cells_shared): K > 1 when
+    // the pre-pass shaded them on a grid of K x K pixels (cells_* below), else 0
+    cells_rate: u32,
 };
 
 struct Material {
@@ -77,6 +79,13 @@ struct Material {
 };
 
 @group(0) @binding(0) var<uniform> g: Globals;
+// The cells' pre-pass at 1/K of the pixels (fs_cells, shaders/default.wgsl;
+// read by env_cells_shared): the cells' XYZ (w: 1 where shaded), the frame's
+// normal with the distance to the eye, its tangent (1 x 1 stand-ins when
+// g.cells_rate is 0).
+@group(0) @binding(2) var cells_xyz: texture_2d<f32>;
+@group(0) @binding(3) var cells_nd: texture_2d<f32>;
+@group(0) @binding(4) var cells_t: texture_2d<f32>;
 // xyz: colour weight of the sample, w: 1 / lambda in 1/um (the per-fragment
 // baselines' wavelengths)
 @group(0) @binding(1) var<storage, read> spectrum: array<vec4<f32>>;
@@ -361,7 +370,7 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
         let fc = frame_at(normal_c, tangent_c, uv_c, uv_tangent_c);
         let wr_c = normalize(g.eye.xyz - world_c);
         let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
-        rgb = rgb + env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, vec2<u32>(in.clip.xy));
+        rgb = rgb + env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, length(g.eye.xyz - world_c));
     }
     return display(rgb);
 }

@@ -517,15 +517,82 @@ fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
     return textureSampleLevel(env_irr_plain, env_smp, uv, 0.0).xyz;
 }
 
+// ---------------------------------------------------------------- cells at a lower rate
+// A pre-pass (fs_cells, shaders/default.wgsl) shades the cells at every K-th
+// pixel corner (K = g.cells_rate: grid point (i, j) at the frame's pixel
+// coordinates (i K, j K)); a pixel in the block [i K, (i + 1) K) takes the
+// bilinear mix of the block's four corners when they saw one smooth patch
+// of surface: all shaded (a diffracting mesh, views above ENV_GRAZING_COS),
+// their normals and tangents within ENV_LOWRES_CONE (2 degrees) of their mean, their
+// distances to the eye within ENV_LOWRES_DEPTH of each other, and the pixel
+// on that patch (its normal within ENV_LOWRES_OWN (10 degrees), its distance within
+// ENV_LOWRES_DEPTH). Elsewhere (silhouettes, limbs, scale borders, where the
+// surface turns faster than the cone across a block) the pixel walks the
+// cells itself. The test is on the block's corners, so a block's pixels
+// decide alike (a SIMD group that mixed both would pay for the walk). The
+// cells' term is a smooth function of the frame and the view on the scale
+// of a cell's spread, a few degrees (the sun and the hot spots have their
+// own exact paths at every pixel), so its error is second order in the
+// cone (docs/LIGHTING.md "Cells at a lower rate").
+const ENV_LOWRES_CONE: f32 = 0.99939;
+const ENV_LOWRES_OWN: f32 = 0.985;
+const ENV_LOWRES_DEPTH: f32 = 0.02;
+
+fn env_cells_shared(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec3<f32> {
+    let k = g.cells_rate;
+    if (k > 1u && wr.z > ENV_GRAZING_COS) {
+        let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
+        let q = clip / f32(k);
+        let q0 = floor(q);
+        let f = q - q0;
+        var acc = vec3<f32>(0.0);
+        var ns = vec3<f32>(0.0);
+        var ts = vec3<f32>(0.0);
+        var d_lo = 3.4e38;
+        var d_hi = 0.0;
+        var shaded = true;
+        var nn: array<vec3<f32>, 4>;
+        var tt: array<vec3<f32>, 4>;
+        for (var j = 0; j < 4; j = j + 1) {
+            let o = vec2<i32>(j & 1, j >> 1u);
+            let c = clamp(vec2<i32>(q0) + o, vec2<i32>(0), last);
+            let x = textureLoad(cells_xyz, c, 0);
+            let nd = textureLoad(cells_nd, c, 0);
+            let tc = textureLoad(cells_t, c, 0);
+            shaded = shaded && x.w > 0.5;
+            nn[j] = nd.xyz;
+            tt[j] = tc.xyz;
+            ns = ns + nd.xyz;
+            ts = ts + tc.xyz;
+            d_lo = min(d_lo, nd.w);
+            d_hi = max(d_hi, nd.w);
+            let wx = select(1.0 - f.x, f.x, o.x == 1);
+            let wy = select(1.0 - f.y, f.y, o.y == 1);
+            acc = acc + (wx * wy) * x.xyz;
+        }
+        let nm = ns / max(length(ns), 1e-12);
+        let tm = ts / max(length(ts), 1e-12);
+        var one_patch = shaded && d_hi - d_lo <= ENV_LOWRES_DEPTH * d_lo;
+        for (var j = 0; j < 4; j = j + 1) {
+            one_patch = one_patch && dot(nn[j], nm) >= ENV_LOWRES_CONE && dot(tt[j], tm) >= ENV_LOWRES_CONE;
+        }
+        let d_mid = 0.5 * (d_lo + d_hi);
+        if (one_patch && dot(nm, n) >= ENV_LOWRES_OWN && abs(dist - d_mid) <= ENV_LOWRES_DEPTH * d_mid) {
+            return acc;
+        }
+    }
+    return env_cells(t, b, n, wr);
+}
+
 // ---------------------------------------------------------------- the estimator
 // Linear sRGB leaving the surface towards the viewer under the environment (both
 // parts, dw applied): frame (t, b, n), local view wr, base colour, diffuse weight
 // dw, diffract: the mesh has a pack's maps.
-fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, px: vec2<u32>) -> vec3<f32> {
+fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32) -> vec3<f32> {
     if (envg.on == 0u || wr.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    env_seed_at(px, envg.frame);
+    env_seed_at(vec2<u32>(clip), envg.frame);
     var rgb = vec3<f32>(0.0);
     // Diffuse: one cosine-weighted direction (pdf cos / pi) plus the sun's
     // disc, each times the share the skin transmits at its incidence.
@@ -562,7 +629,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     let gr = env_grid();
     var xyz = vec3<f32>(0.0);
     if (envg.estimator == 0u) {
-        xyz = env_cells(t, b, n, wr) + env_hotspots(t, b, n, wr);
+        xyz = env_cells_shared(t, b, n, wr, clip, dist) + env_hotspots(t, b, n, wr);
     } else {
     // The first frame after a reset (every frame while the view moves) is the
     // preview: one direction uniform over the hemisphere, no descent (the

@@ -84,6 +84,11 @@ pub(crate) struct Cli {
     /// frame"). The engines' export does not carry them yet.
     #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_HOT_SPOTS as u64, value_parser = clap::value_parser!(u64).range(0..=256))]
     pub(crate) env_hot_spots: u64,
+    /// Environment scenes, `--env-estimator cells`: shade the cells on a grid
+    /// of one pixel in K x K and interpolate them where the surface is smooth
+    /// (1..=16; 1: at every pixel; docs/LIGHTING.md "Cells at a lower rate").
+    #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_CELLS_RATE, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub(crate) env_cells_rate: u32,
     /// Wavelength samples of the default mode.
     #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES)]
     pub(crate) lambda_samples: usize,

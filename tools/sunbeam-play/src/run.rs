@@ -110,6 +110,7 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
         msaa,
         footprint: !cli.no_footprint,
         env_hot_spots: cli.env_hot_spots as usize,
+        env_cells_rate: cli.env_cells_rate,
         env_cells: (cli.env_cells as usize, sunbeam_render::env::ENV_CELLS_DEPTH),
         ..Default::default()
     })

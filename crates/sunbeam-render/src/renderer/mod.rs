@@ -20,11 +20,14 @@
 //!
 //! The shared parts: [`uniforms`] (the uniform structs, checked against the
 //! WGSL), [`pipeline`] (layouts, buffers, the render pipeline), [`targets`]
-//! (depth, colour and offscreen targets, readback).
+//! (depth, colour and offscreen targets, readback), `cells_rate` (the
+//! first-frame cells shaded on a coarser grid by a pre-pass, bind group 0's
+//! bindings 2-4).
 
 pub mod background;
 #[cfg(feature = "baselines")]
 pub mod baselines;
+mod cells_rate;
 pub mod environment;
 pub mod pipeline;
 pub mod response_map;
@@ -33,6 +36,7 @@ pub mod uniforms;
 
 #[cfg(feature = "baselines")]
 pub use baselines::term_table;
+pub use cells_rate::DEFAULT_CELLS_RATE;
 pub use targets::{
     colour_view, depth_view, depth_view_ms, subpixel_jitter, Offscreen, OFFSCREEN_FORMAT,
 };
@@ -184,6 +188,10 @@ pub struct Settings {
     /// Environment, cells estimator: the map's hot spots pulled out as at most
     /// this many lights (sunbeam_light::hotspots; 0: none).
     pub env_hot_spots: usize,
+    /// Environment, cells estimator: shade the cells on a grid of one pixel
+    /// in K x K and interpolate where the surface is smooth (1: every pixel;
+    /// docs/LIGHTING.md "Cells at a lower rate").
+    pub env_cells_rate: u32,
 }
 
 /// Default wavelength sample count (docs/PLAY.md: chosen by measurement).
@@ -208,6 +216,7 @@ impl Default for Settings {
                 sunbeam_response::cells::DEFAULT_DEPTH,
             ),
             env_hot_spots: crate::env::DEFAULT_ENV_HOT_SPOTS,
+            env_cells_rate: DEFAULT_CELLS_RATE,
         }
     }
 }
@@ -236,7 +245,13 @@ impl FrameState {
 pub struct Renderer {
     pipeline: wgpu::RenderPipeline,
     globals: wgpu::Buffer,
+    spectrum: wgpu::Buffer,
+    /// Bind group 0's layout and the group with stand-ins for the cells' grid.
+    global_layout: wgpu::BindGroupLayout,
     global_bind: wgpu::BindGroup,
+    /// The cells' pre-pass at a lower rate (environment scenes with the
+    /// cells estimator and `env_cells_rate` > 1).
+    cells: Option<cells_rate::CellsRate>,
     meshes: Vec<GpuMesh>,
     settings: Settings,
     n_lambda: u32,
@@ -353,20 +368,13 @@ impl Renderer {
         let mut scale_views: Vec<(Arc<sunbeam_frame::MeshScales>, ScaleViews)> = Vec::new();
         let mut resp_views: Vec<(Arc<sunbeam_response::Response>, Arc<wgpu::TextureView>)> =
             Vec::new();
-        let global_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("globals"),
-            layout: &gl0,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: globals.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: spectrum.as_entire_binding(),
-                },
-            ],
-        });
+        let global_bind = cells_rate::global_bind(
+            device,
+            &gl0,
+            &globals,
+            &spectrum,
+            [&dummy_2d, &dummy_2d, &dummy_2d],
+        );
 
         let mut meshes = Vec::new();
         for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
@@ -543,7 +551,24 @@ impl Renderer {
         if let Some(b) = &baselines {
             layouts.push(&b.layout);
         }
-        let pipeline = render_pipeline(device, &layouts, format, settings.msaa, &technique)?;
+        let pipeline = render_pipeline(device, &layouts, &[format], settings.msaa, &technique)?;
+        let cells = if settings.mode == Mode::Default
+            && env_scene.env.is_some()
+            && settings.env_estimator == crate::env::EnvEstimator::Cells
+            && settings.env_cells_rate > 1
+            && p.meshes.iter().any(|(_, m)| m.pack.is_some())
+        {
+            Some(cells_rate::CellsRate::new(
+                device,
+                &layouts,
+                settings.env_cells_rate,
+                &globals,
+                &spectrum,
+                &dummy_2d,
+            )?)
+        } else {
+            None
+        };
         // `"background": "environment"`: the lighting's table and sun (or,
         // in the Lambert mode, which lights without them, the same built here).
         let background = match (&p.scene.background, &p.environment) {
@@ -575,7 +600,10 @@ impl Renderer {
             pipeline,
             background,
             globals,
+            spectrum,
+            global_layout: gl0,
             global_bind,
+            cells,
             meshes,
             settings: settings.clone(),
             n_lambda: spec.len() as u32,
@@ -672,8 +700,18 @@ impl Renderer {
             exposure_scale: state.exposure.exp2() as f32,
             n_lambda: self.n_lambda,
             msaa: self.msaa(),
-            _g0: 0,
+            cells_rate: self.cells.as_ref().map_or(0, |c| c.rate()),
         };
+        if let Some(c) = &self.cells {
+            c.prepare(
+                gpu,
+                &self.global_layout,
+                &self.globals,
+                &self.spectrum,
+                w,
+                h,
+            );
+        }
         gpu.queue
             .write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
         if let Some(bg) = &self.background {
@@ -739,6 +777,44 @@ impl Renderer {
         depth: &wgpu::TextureView,
         state: &FrameState,
     ) {
+        match &self.cells {
+            Some(c) => c.encode(
+                enc,
+                &self.global_bind,
+                |rp| self.draw_meshes(rp),
+                |enc, g0| self.encode_frame(enc, g0, colour, resolve, depth, state),
+            ),
+            None => self.encode_frame(enc, &self.global_bind, colour, resolve, depth, state),
+        }
+    }
+
+    /// Groups 1-3 and the draw of each mesh.
+    fn draw_meshes(&self, rp: &mut wgpu::RenderPass<'_>) {
+        for m in &self.meshes {
+            if m.count == 0 {
+                continue;
+            }
+            rp.set_bind_group(1, &m.bind, &[]);
+            rp.set_bind_group(2, &m.env_bind, &[]);
+            if let Some(b) = &m.technique_bind {
+                rp.set_bind_group(3, b, &[]);
+            }
+            rp.set_vertex_buffer(0, m.vbuf.slice(..));
+            rp.set_index_buffer(m.ibuf.slice(..), wgpu::IndexFormat::Uint32);
+            rp.draw_indexed(0..m.count, 0, 0..1);
+        }
+    }
+
+    /// The frame's pass, with bind group `g0`.
+    fn encode_frame(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        g0: &wgpu::BindGroup,
+        colour: &wgpu::TextureView,
+        resolve: Option<&wgpu::TextureView>,
+        depth: &wgpu::TextureView,
+        state: &FrameState,
+    ) {
         let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("frame"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -763,20 +839,8 @@ impl Renderer {
             multiview_mask: None,
         });
         rp.set_pipeline(&self.pipeline);
-        rp.set_bind_group(0, &self.global_bind, &[]);
-        for m in &self.meshes {
-            if m.count == 0 {
-                continue;
-            }
-            rp.set_bind_group(1, &m.bind, &[]);
-            rp.set_bind_group(2, &m.env_bind, &[]);
-            if let Some(b) = &m.technique_bind {
-                rp.set_bind_group(3, b, &[]);
-            }
-            rp.set_vertex_buffer(0, m.vbuf.slice(..));
-            rp.set_index_buffer(m.ibuf.slice(..), wgpu::IndexFormat::Uint32);
-            rp.draw_indexed(0..m.count, 0, 0..1);
-        }
+        rp.set_bind_group(0, g0, &[]);
+        self.draw_meshes(&mut rp);
         if let Some(bg) = &self.background {
             bg.draw(&mut rp);
         }

@@ -10,14 +10,21 @@ use bytemuck::Zeroable;
 use sunbeam_common::{Error, Result};
 use wgpu::util::DeviceExt;
 
-/// Bind group layouts: 0 = globals and spectrum, 1 = one material (uniform,
+/// Bind group layouts: 0 = globals, spectrum and the cells' pre-pass grid
+/// ([`super::cells_rate`]), 1 = one material (uniform,
 /// response map and its sampler, the scale maps). Group 2 is the
 /// environment's ([`crate::env::EnvScene`]); the baselines add group 3.
 pub(super) fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayout; 2] {
     let storage_entry = crate::gpu::fragment_storage_entry;
     let gl0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("globals"),
-        entries: &[uniform_entry(0), storage_entry(1)],
+        entries: &[
+            uniform_entry(0),
+            storage_entry(1),
+            texture_2d_unfiltered_entry(2),
+            texture_2d_unfiltered_entry(3),
+            texture_2d_unfiltered_entry(4),
+        ],
     });
     let gl1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("material"),
@@ -74,6 +81,18 @@ fn texture_2d_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
+/// A 2D float texture read by `textureLoad` that need not be filterable
+/// (the cells' grid: 32-bit floats).
+fn texture_2d_unfiltered_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    let mut e = texture_2d_entry(binding);
+    e.ty = wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+        view_dimension: wgpu::TextureViewDimension::D2,
+        multisampled: false,
+    };
+    e
+}
+
 /// Vertex and index buffers of a mesh (one dummy element when empty); with
 /// `scales`, the vertices carry TEXCOORD_0 and the maps' TANGENT too.
 pub(super) fn mesh_buffers(
@@ -128,12 +147,13 @@ pub(super) struct Technique {
     pub(super) constants: Vec<(&'static str, f64)>,
 }
 
-/// The pipeline of `technique` for a colour format and sample count, with
-/// bind groups `layouts` (0, 1, 2 shared; more for the technique's own).
+/// The pipeline of `technique` for colour formats (one per target of its
+/// entry point) and a sample count, with bind groups `layouts` (0, 1, 2
+/// shared; more for the technique's own).
 pub(super) fn render_pipeline(
     device: &wgpu::Device,
     layouts: &[&wgpu::BindGroupLayout],
-    format: wgpu::TextureFormat,
+    formats: &[wgpu::TextureFormat],
     msaa: u32,
     technique: &Technique,
 ) -> Result<wgpu::RenderPipeline> {
@@ -188,11 +208,16 @@ pub(super) fn render_pipeline(
             module: &module,
             entry_point: Some(technique.entry),
             compilation_options: options(),
-            targets: &[Some(wgpu::ColorTargetState {
-                format,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
+            targets: &formats
+                .iter()
+                .map(|&format| {
+                    Some(wgpu::ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })
+                })
+                .collect::<Vec<_>>(),
         }),
         multiview_mask: None,
         cache: None,

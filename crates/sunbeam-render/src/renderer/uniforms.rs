@@ -40,7 +40,9 @@ pub(super) struct Globals {
     pub(super) n_lambda: u32,
     /// Samples per pixel of the colour target (the shader tells covered pixels from silhouettes).
     pub(super) msaa: u32,
-    pub(super) _g0: u32,
+    /// K > 1: the cells were shaded on a grid of K x K pixels by the
+    /// pre-pass ([`super::cells_rate`]); 0: every pixel walks them.
+    pub(super) cells_rate: u32,
 }
 
 #[repr(C)]
@@ -205,7 +207,8 @@ mod layout_tests {
                 output,
                 exposure_scale,
                 n_lambda,
-                msaa
+                msaa,
+                cells_rate
             ),
         );
     }
