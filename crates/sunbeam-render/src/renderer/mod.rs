@@ -552,10 +552,18 @@ impl Renderer {
             layouts.push(&b.layout);
         }
         let pipeline = render_pipeline(device, &layouts, &[format], settings.msaa, &technique)?;
+        // The cells at a lower rate need a smooth term: the sky (its sun has
+        // its own path) or a map whose hot spots are lights; a map's
+        // softboxes seen by the cells themselves (`env_hot_spots` 0) are
+        // sharp at the cells' scale (CIEDE2000 p99 8.3 against every pixel on
+        // tests/threejs_render.rs' studio scene, 0.45 with its hot spots).
+        let smooth_term =
+            settings.env_hot_spots > 0 || env_scene.env.as_ref().is_some_and(|e| e.sun().is_some());
         let cells = if settings.mode == Mode::Default
             && env_scene.env.is_some()
             && settings.env_estimator == crate::env::EnvEstimator::Cells
             && settings.env_cells_rate > 1
+            && smooth_term
             && p.meshes.iter().any(|(_, m)| m.pack.is_some())
         {
             Some(cells_rate::CellsRate::new(
