@@ -12,7 +12,7 @@
 //! "Cost"); the sun, the hot spots and the diffuse part stay at every pixel.
 
 use super::pipeline::{render_pipeline, Technique};
-use super::{DEPTH_FORMAT, SHADER};
+use super::SHADER;
 use crate::gpu::Gpu;
 use std::sync::Mutex;
 use sunbeam_common::Result;
@@ -180,7 +180,7 @@ impl CellsRate {
         let xyz = target(gpu, gw, gh, XYZ_FORMAT);
         let nd = target(gpu, gw, gh, FRAME_FORMAT);
         let t = target(gpu, gw, gh, FRAME_FORMAT);
-        let depth = target(gpu, gw, gh, DEPTH_FORMAT);
+        let depth = super::depth_view(gpu, gw, gh);
         let bind = global_bind(&gpu.device, layout, globals, spectrum, [&xyz, &nd, &t]);
         *grid = Some(Grid {
             full: [w, h],
