@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Write a Ninja file for the demo pipeline: the same graph, commands and outputs
-# as examples/Makefile (byte for byte; tested by tests/ninja.rs), for Ninja users.
+# as examples/Makefile (byte for byte; tested by tests/pipeline.rs), for Ninja users.
 #
 #   examples/ninja.sh [VAR=value ...]           writes $OUT/build.ninja (OUT default: out)
 #   ninja -C examples -f out/build.ninja [-j2] [fields|packs|pictures|frames|sheet|web|turntable|all]

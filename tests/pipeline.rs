@@ -1,7 +1,8 @@
-//! The examples/ Makefile as artists run it: incremental rebuilds from the
-//! tools' depfiles, byte-identical outputs under -j1 and -j2, and an
-//! interrupted build (the make process group SIGKILLed while a pack is being
-//! written) that leaves no half-written target and is redone by the next run.
+//! The examples/ Makefile as artists run it, and its Ninja file
+//! (`examples/ninja.sh`, docs/PIPELINE.md): incremental rebuilds from the
+//! tools' depfiles, byte-identical outputs under make -j1, make -j2 and Ninja,
+//! and an interrupted build (the make process group SIGKILLed while a pack is
+//! being written) that leaves no half-written target and is redone by the next run.
 //!
 //! Small inputs and sizes (make variables) keep it fast. The player's frames
 //! are built only where a GPU stack is present (skipped otherwise, failing under
@@ -9,82 +10,63 @@
 
 mod common;
 use common::*;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 use sunbeam::{scratch, workspace_root};
 use sunbeam_common::testdata;
 
-#[test]
-fn parallel_builds_are_byte_identical() {
-    let d = scratch("pipeline-parallel");
-    let g = goals(&d);
-    let bin = bin_dir();
-    let (a, b) = (d.join("j1"), d.join("j2"));
-    let mut va = small_vars(&bin, &a);
-    let mut vb = small_vars(&bin, &b);
-    va.push("SHARED=".into());
-    vb.push("SHARED=".into());
-    make(1, &va, &g);
-    make(2, &vb, &g);
-    let (ca, cb) = (contents(&a), contents(&b));
-    assert_eq!(ca.keys().collect::<Vec<_>>(), cb.keys().collect::<Vec<_>>());
-    for name in [
-        "elaphe.exr",
-        "xeno.ktx2",
-        "elaphe-brdf.png",
-        "xeno-grating.png",
-        "elaphe-height.png",
-    ] {
-        assert!(ca.contains_key(name), "{name} not built: {:?}", ca.keys());
-    }
-    for (name, bytes) in &ca {
-        assert!(bytes == &cb[name], "{name} differs between -j1 and -j2");
-    }
-    // Nothing left to do after a full build (make -q: exit 0 when up to date).
-    let q = Command::new("make")
+/// `ninja -C examples -f OUT/build.ninja ARGS` (paths in the file are relative
+/// to examples/, as make sees them); its stdout. Panics when it fails.
+fn ninja(build_file: &Path, args: &[&str]) -> String {
+    let o = Command::new("ninja")
+        .arg("-C")
+        .arg(workspace_root().join("examples"))
+        .arg("-f")
+        .arg(build_file)
+        .args(args)
+        .output()
+        .expect("run ninja");
+    let said = format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "ninja {args:?} failed:\n{said}");
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The steps `ninja -n` would run: the descriptions after `[i/n] `.
+fn planned(build_file: &Path, goals: &[&str]) -> BTreeSet<String> {
+    let mut args = vec!["-n"];
+    args.extend_from_slice(goals);
+    ninja(build_file, &args)
+        .lines()
+        .filter_map(|l| l.split_once("] ").map(|(_, d)| d.to_string()))
+        .collect()
+}
+
+/// `make -q`: exit 0 when everything is up to date.
+fn make_up_to_date(vars: &[String], goals: &[String]) -> bool {
+    Command::new("make")
         .arg("-C")
         .arg(workspace_root().join("examples"))
         .arg("-q")
-        .args(&vb)
-        .args(&g)
+        .args(vars)
+        .args(goals)
         .status()
-        .unwrap();
-    assert!(q.success(), "a second make would rebuild something");
+        .unwrap()
+        .success()
 }
 
-/// Touch the Elaphe patch: its height field, pack and pictures (and frame)
-/// rebuild (with the snake baked with its pack); Xenopeltis' do not.
-#[test]
-fn touching_a_scan_rebuilds_only_its_dependents() {
-    let (Some(elaphe), Some(xeno)) = (
-        testdata::shared_file("snake/Elaph100x100.png"),
-        testdata::shared_file("snake/Xeno100x100.png"),
-    ) else {
-        return;
-    };
-    let d = scratch("pipeline-incremental");
-    // A private copy of the inputs, so touching one does not disturb anyone.
-    let shared = d.join("shared");
-    std::fs::create_dir_all(shared.join("snake")).unwrap();
-    std::fs::copy(&elaphe, shared.join("snake/Elaph100x100.png")).unwrap();
-    std::fs::copy(&xeno, shared.join("snake/Xeno100x100.png")).unwrap();
-    let out = d.join("out");
-    let g = goals(&d);
-    let mut vars = small_vars(&bin_dir(), &out);
-    vars.push(format!("SHARED={}", shared.display()));
-    vars.push("MATERIALS=elaphe xeno".into());
-    make(2, &vars, &g);
-    let before = mtimes(&out);
-    std::thread::sleep(Duration::from_millis(1100)); // coarse mtime file systems
-    let f = std::fs::File::options()
-        .append(true)
-        .open(shared.join("snake/Elaph100x100.png"))
-        .unwrap();
-    f.set_modified(SystemTime::now()).unwrap();
-    drop(f);
-    make(2, &vars, &g);
-    let after = mtimes(&out);
+/// Outputs whose mtime changed between two snapshots must be exactly Elaphe's
+/// (not its scene files), its snake and the sheet.
+fn only_elaphe_rebuilt(
+    before: &BTreeMap<String, SystemTime>,
+    after: &BTreeMap<String, SystemTime>,
+    who: &str,
+) {
     let changed: Vec<&String> = after
         .keys()
         .filter(|k| before.get(*k) != after.get(*k))
@@ -96,11 +78,211 @@ fn touching_a_scan_rebuilds_only_its_dependents() {
         assert_eq!(
             before.get(k) != after.get(k),
             should,
-            "{k}: rebuilt = {}, expected {should}; rebuilt: {changed:?}",
+            "{who}: {k}: rebuilt = {}, expected {should}; rebuilt: {changed:?}",
             before.get(k) != after.get(k)
         );
     }
     assert!(changed.iter().any(|k| *k == "elaphe.ktx2"), "{changed:?}");
+}
+
+/// The demo from private copies of the two snake scans, built three ways:
+/// `make -j1`, `make -j2` and the Ninja file (`examples/ninja.sh`, `ninja -j2`).
+/// Every file is byte-identical across the three (depfiles too, kept with
+/// `-d keepdepfile`); `make -q` and `ninja -n` find nothing to do; Ninja
+/// recorded the depfiles (`deps = gcc`: `ninja -t deps`). Then the Elaphe scan
+/// is touched: make rebuilds exactly its dependents, `ninja -n` plans exactly
+/// them, and Ninja's rebuild touches nothing else. One set of builds serves
+/// the three properties (each full build is about a minute on 2 cores).
+///
+/// Needs `ninja` (Debian ninja-build, scripts/ensure-deps.sh) and ../shared/data
+/// (skipped without them, failing under SUNBEAM_REQUIRE_ALL=1).
+#[test]
+fn make_and_ninja_build_the_same_bytes_and_rebuild_only_dependents() {
+    if !testdata::have_command("ninja", &["--version"]) {
+        return;
+    }
+    let (Some(elaphe), Some(xeno)) = (
+        testdata::shared_file("snake/Elaph100x100.png"),
+        testdata::shared_file("snake/Xeno100x100.png"),
+    ) else {
+        return;
+    };
+    let d = scratch("pipeline-builds");
+    // A private copy of the inputs, so touching one does not disturb anyone.
+    let shared = d.join("shared");
+    std::fs::create_dir_all(shared.join("snake")).unwrap();
+    let scan = shared.join("snake/Elaph100x100.png");
+    std::fs::copy(&elaphe, &scan).unwrap();
+    std::fs::copy(&xeno, shared.join("snake/Xeno100x100.png")).unwrap();
+    let goals = goals(&d);
+    let goal_refs: Vec<&str> = goals.iter().map(String::as_str).collect();
+    let vars = |out: &Path| {
+        let mut v = small_vars(&bin_dir(), out);
+        v.push(format!("SHARED={}", shared.display()));
+        v.push("MATERIALS=elaphe xeno".into());
+        v
+    };
+    let (j1, j2, by_ninja) = (d.join("j1"), d.join("j2"), d.join("ninja"));
+    make(1, &vars(&j1), &goals);
+    make(2, &vars(&j2), &goals);
+
+    // The Ninja file, generated with the same variables, and its build.
+    let g = Command::new(workspace_root().join("examples/ninja.sh"))
+        .args(vars(&by_ninja))
+        .output()
+        .expect("run examples/ninja.sh");
+    assert!(
+        g.status.success(),
+        "ninja.sh failed: {}",
+        String::from_utf8_lossy(&g.stderr)
+    );
+    let build_file = by_ninja.join("build.ninja");
+    let mut args = vec!["-j2", "-d", "keepdepfile"];
+    args.extend_from_slice(&goal_refs);
+    ninja(&build_file, &args);
+
+    // Same files, same bytes (depfiles with their folder's name made generic).
+    let (a, b, mut n) = (contents(&j1), contents(&j2), contents(&by_ninja));
+    n.remove("build.ninja");
+    for name in [
+        "elaphe.exr",
+        "xeno.ktx2",
+        "elaphe-brdf.png",
+        "xeno-grating.png",
+        "elaphe-height.png",
+    ] {
+        assert!(a.contains_key(name), "{name} not built: {:?}", a.keys());
+    }
+    for (other, by) in [(&b, "make -j2"), (&n, "ninja -j2")] {
+        assert_eq!(
+            a.keys().collect::<Vec<_>>(),
+            other.keys().collect::<Vec<_>>(),
+            "make -j1 and {by} built different files"
+        );
+        for (name, bytes) in &a {
+            assert!(
+                bytes == &other[name],
+                "{name}: {by}'s differs from make -j1's"
+            );
+        }
+    }
+    assert!(
+        make_up_to_date(&vars(&j2), &goals),
+        "a second make would rebuild something"
+    );
+
+    // deps = gcc: Ninja read the depfiles into its log (the scan, for the import).
+    let deps = ninja(&build_file, &["-t", "deps"]);
+    let import_deps = deps
+        .split("\n\n")
+        .find(|b| b.contains("elaphe.exr") && b.contains("#deps"))
+        .unwrap_or_else(|| panic!("no deps recorded for elaphe.exr:\n{deps}"));
+    assert!(
+        import_deps.contains("(VALID)") && import_deps.contains("Elaph100x100.png"),
+        "{import_deps}"
+    );
+    assert!(
+        deps.contains("elaphe.ktx2")
+            && deps.contains("elaphe-frame.png") == goals.iter().any(|g| g == "frames"),
+        "{deps}"
+    );
+    assert!(
+        planned(&build_file, &goal_refs).is_empty(),
+        "ninja -n wants to redo work after a build"
+    );
+
+    // Touch the Elaphe scan: make rebuilds its import, pack, pictures (frames,
+    // sheet) and nothing of Xenopeltis or the other snake.
+    let (before_make, before_ninja) = (mtimes(&j2), mtimes(&by_ninja));
+    std::thread::sleep(Duration::from_millis(1100)); // coarse mtime file systems
+    let f = std::fs::File::options().append(true).open(&scan).unwrap();
+    f.set_modified(SystemTime::now()).unwrap();
+    drop(f);
+    make(2, &vars(&j2), &goals);
+    only_elaphe_rebuilt(&before_make, &mtimes(&j2), "make");
+
+    // `ninja -n` plans just that, and its rebuild does just that.
+    let plan = planned(&build_file, &goal_refs);
+    let o = by_ninja.display().to_string();
+    let mut want: BTreeSet<String> = [
+        "import elaphe".to_string(),
+        format!("pack {o}/elaphe.ktx2"),
+        format!("brdf {o}/elaphe-brdf.png"),
+        format!("grating {o}/elaphe-grating.png"),
+    ]
+    .into();
+    if goals.iter().any(|g| g == "frames") {
+        want.insert(format!("play {o}/elaphe-frame.png"));
+        want.insert(format!("sky {o}/elaphe-sky.png"));
+        want.insert(format!("play_sky {o}/elaphe-play-sky.png"));
+        want.insert(format!("play_first {o}/elaphe-play-first.png"));
+        // the frames show the snake with Elaphe's scales, baked with its pack
+        want.insert(format!("bake {o}/snake-elaphe.glb"));
+    }
+    if goals.iter().any(|g| g == "sheet") {
+        want.insert(format!("sheet {o}/contact-sheet.png"));
+    }
+    assert_eq!(plan, want, "ninja -n after touching the Elaphe scan");
+    ninja(&build_file, &args);
+    only_elaphe_rebuilt(&before_ninja, &mtimes(&by_ninja), "ninja");
+    assert!(planned(&build_file, &goal_refs).is_empty());
+}
+
+/// The viewer's environments (examples/Makefile ENVS, docs/PIPELINE.md): make
+/// and the Ninja file plan the same exports for `web`, the studio one only
+/// with an HDR image (HDRI), and the sky alone without it. Plans only (`-n`),
+/// nothing is built.
+#[test]
+fn ninja_and_make_plan_the_same_environments() {
+    if !testdata::have_command("ninja", &["--version"]) {
+        return;
+    }
+    let d = scratch("ninja-envs");
+    let hdri = d.join("studio.exr");
+    std::fs::write(&hdri, b"not read: plans only").unwrap();
+    for (with_map, want) in [(true, ["sky", "studio"].as_slice()), (false, &["sky"])] {
+        let out = d.join(format!("out-{with_map}"));
+        let mut vars = small_vars(&bin_dir(), &out);
+        vars.push("SHARED=".into());
+        vars.push(format!(
+            "HDRI={}",
+            if with_map {
+                hdri.display().to_string()
+            } else {
+                String::new()
+            }
+        ));
+        let g = Command::new(workspace_root().join("examples/ninja.sh"))
+            .args(&vars)
+            .output()
+            .expect("run examples/ninja.sh");
+        assert!(g.status.success(), "{}", String::from_utf8_lossy(&g.stderr));
+        let ninja_plan: BTreeSet<String> = planned(&out.join("build.ninja"), &["web"])
+            .into_iter()
+            .filter_map(|s| s.strip_prefix("export_environment ").map(String::from))
+            .collect();
+        let o = Command::new("make")
+            .arg("-C")
+            .arg(workspace_root().join("examples"))
+            .arg("-n")
+            .args(&vars)
+            .arg("web")
+            .output()
+            .expect("run make -n");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let make_plan: BTreeSet<String> = String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .filter_map(|l| l.split_once("--export-environment "))
+            .map(|(_, r)| r.split_whitespace().next().unwrap().to_string())
+            .collect();
+        let o = out.display();
+        let expected: BTreeSet<String> = want
+            .iter()
+            .flat_map(|e| ["elaphe", "xeno"].map(|m| format!("{o}/env-{e}-{m}")))
+            .collect();
+        assert_eq!(make_plan, expected, "make -n web");
+        assert_eq!(ninja_plan, expected, "ninja -n web");
+    }
 }
 
 /// Process group of a process, from /proc (Linux).

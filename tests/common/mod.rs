@@ -1,4 +1,4 @@
-//! Helpers shared by the pipeline tests (tests/pipeline.rs, tests/ninja.rs):
+//! Helpers shared by the pipeline tests (tests/pipeline.rs):
 //! small make variables, what this machine can build, folder contents; the
 //! three.js tests' in [`threejs`].
 #![allow(dead_code)]

@@ -15,7 +15,7 @@ use sunbeam_light::{sky::Sky, EnvMap, Environment};
 use sunbeam_optics::truth::{Params, Truth};
 use sunbeam_optics::{cie, colour, gain};
 use sunbeam_pack::{build::BuildOptions, FieldRef, Model, Pack};
-use sunbeam_raster::environment::{EnvEstimator, EnvShader, Frame, Uniforms};
+use sunbeam_raster::environment::{EnvEstimator, EnvShader, Frame};
 use sunbeam_raster::{compare_linear, fixtures, render_prepared_linear, LinearImage, Options};
 
 /// A ridge field like snake skin, scaled down: sinusoidal ridges of `period`
@@ -47,20 +47,7 @@ fn pack_of(n: usize, dx: f64, data: &[f64], model: Model) -> Arc<Pack> {
 /// The estimator's mean XYZ over `m` samples at one shading point (frame `f`,
 /// view `wr`), wavelengths stratified, no diffuse part.
 fn estimate_xyz(es: &EnvShader, f: Frame, wr: [f64; 3], m: u64, seed: u64) -> [f64; 3] {
-    let mut mc = [0.0; 3];
-    for k in 0..m {
-        let mut rng = EnvShader::rng(seed, 0, k);
-        let lu = (k as f64 + rng.unit()) / m as f64;
-        let u = Uniforms {
-            lambda: lu,
-            ..Uniforms::random(&mut rng)
-        };
-        let xyz = colour::linear_srgb_to_xyz(es.sample(0, f, wr, [0.0; 3], 0.0, &u));
-        for i in 0..3 {
-            mc[i] += xyz[i] / m as f64;
-        }
-    }
-    mc
+    common::estimator_xyz_sum(es, f, wr, seed, 0..m, m)
 }
 
 fn mean_y(img: &LinearImage, x0: u32, x1: u32) -> f64 {

@@ -139,14 +139,21 @@ fn p99(report: &serde_json::Value) -> f64 {
 }
 
 /// A sky-lit sphere with the ridge pack, filling the frame: the settled frame
-/// (256 frames) against the reference at 256 samples per pixel, CIEDE2000
-/// p99 over the lit pixels in linear light, and over 4 x 4 blocks (a bias);
-/// unmasked (PHYSICS.md's model) and with the pack's Smith masking.
+/// (256 frames) against the reference at 64 samples per pixel (two seeds
+/// agree to p99 0.54; 256 samples took 2.4x as long and moved no figure below
+/// by more than 0.05), CIEDE2000 p99 over the lit pixels in linear light, and
+/// over 4 x 4 blocks (a bias). Unmasked (PHYSICS.md's model) here, with the pack's Smith masking in
+/// [`sky_lit_sphere_with_masking_settles_to_the_reference`] (two tests, so the
+/// harness runs them side by side).
 #[test]
 fn sky_lit_sphere_settles_to_the_reference() {
-    for masking in ["off", "smith"] {
-        sky_lit_sphere(masking);
-    }
+    sky_lit_sphere("off");
+}
+
+/// [`sky_lit_sphere_settles_to_the_reference`] with the pack's Smith masking.
+#[test]
+fn sky_lit_sphere_with_masking_settles_to_the_reference() {
+    sky_lit_sphere("smith");
 }
 
 fn sky_lit_sphere(masking: &str) {
@@ -175,7 +182,7 @@ fn sky_lit_sphere(masking: &str) {
     eprintln!("masking {masking}:");
     let t = std::time::Instant::now();
     let refp = dir.join("ref.exr");
-    reference(&scene, 256, &[1], &refp);
+    reference(&scene, 64, &[1], &refp);
     eprintln!("reference: {:.1} s", t.elapsed().as_secs_f64());
     let t = std::time::Instant::now();
     let r = play(&scene, 256, &dir.join("f.exr"), &refp);
@@ -201,33 +208,35 @@ fn sky_lit_sphere(masking: &str) {
         sunbeam_frame::compare_linear(&frame.downsample(4), &reference.downsample(4)).unwrap();
     eprintln!("4 x 4 blocks: {blocks}");
     assert!(blocks.p99 < BLOCKS_P99, "{blocks}");
-    // The first-frame estimator (--env-estimator cells): its frames only
-    // anti-alias (16 sub-pixel positions), no noise to average. Unmasked
-    // only (52 s on lavapipe per run).
+    // The first-frame estimator (--env-estimator cells): its first frame (no
+    // accumulation; MSAA 4 by default for one headless frame). Unmasked only.
     if masking != "off" {
         return;
     }
     let t = std::time::Instant::now();
     let c = play_with(
         &scene,
-        16,
+        1,
         &dir.join("c.exr"),
         &refp,
         &["--env-estimator", "cells"],
     );
     eprintln!(
-        "player, cells, 16 frames: {:.1} s, {c}",
+        "player, cells, first frame: {:.1} s, {c}",
         t.elapsed().as_secs_f64()
     );
+    assert_eq!(c["accumulated_frames"].as_u64(), Some(1));
     let dc = p99(&c);
     // Measured on lavapipe: see CELLS_P99.
     assert!(dc < CELLS_P99, "cells: CIEDE2000 p99 {dc} (report {c})");
 }
 
-/// Bound of the cells' 16 frames in [`sky_lit_sphere_settles_to_the_reference`]
-/// (docs/LIGHTING.md "The first frame"): measured p99 2.16 (mean 0.72, max
-/// 6.2) against the Monte Carlo's 6.15 at 256 frames, plus 25 %.
-const CELLS_P99: f64 = 2.7;
+/// Bound of the cells' first frame in [`sky_lit_sphere_settles_to_the_reference`]
+/// (docs/LIGHTING.md "The first frame"): measured p99 3.04 (mean 1.05, max
+/// 6.2; one sample per pixel inside the silhouette, where the reference
+/// averages the pixel's area: 16 jittered frames give 2.15) against the
+/// Monte Carlo's 6.15 at 256 frames, plus 25 %.
+const CELLS_P99: f64 = 3.8;
 
 /// Bound of [`sky_lit_sphere_settles_to_the_reference`]'s 4 x 4 blocks:
 /// measured 2.27 unmasked and 2.16 masked at 256 frames (2026-11-25; mostly
@@ -531,7 +540,10 @@ const ROTATION_BOUNDS: (f64, f64) = (0.1, 1.0);
 /// 4 pixels and interpolated, against every pixel walking them
 /// (`--env-cells-rate 1`). They differ (the grid is in use: a rate that
 /// reached no pixel would give the same image) by little: bilinear
-/// interpolation of a term smooth over a few degrees.
+/// interpolation of a term smooth over a few degrees. The frame is a 128 x
+/// 128 window onto the 256 x 256 view of the sphere (half the field of view,
+/// aimed at the right limb): the same degrees per pixel, interior and
+/// silhouette, at a quarter of the cost.
 #[test]
 fn cells_at_a_lower_rate_match_every_pixel() {
     let dir = tmp("cells-rate");
@@ -539,12 +551,12 @@ fn cells_at_a_lower_rate_match_every_pixel() {
     let scene = write(
         &dir,
         "sky.json",
-        r#"{ "camera": { "eye": [0, 0, 2.4], "target": [0, 0, 0], "fov_y_deg": 26 },
+        r#"{ "camera": { "eye": [0, 0, 2.4], "target": [0.3, 0.1, 0], "fov_y_deg": 13 },
   "meshes": [ { "mesh": "builtin:sphere", "pack": "ridge.ktx2", "masking": "smith" } ],
   "lights": [],
   "environment": { "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 60 } },
   "exposure": 4.64,
-  "size": [256, 256] }"#,
+  "size": [128, 128] }"#,
     );
     if !have_gpu() {
         return;
@@ -569,6 +581,7 @@ fn cells_at_a_lower_rate_match_every_pixel() {
     assert!(d.p99 < LOWER_RATE_P99, "{d}");
 }
 
-/// Bound of [`cells_at_a_lower_rate_match_every_pixel`]: measured p99 0.250
-/// (mean 0.050, max 1.08; lavapipe, 2026-11-27), plus 25 %.
-const LOWER_RATE_P99: f64 = 0.32;
+/// Bound of [`cells_at_a_lower_rate_match_every_pixel`]: measured p99 0.179
+/// (mean 0.046, max 0.35; lavapipe, 2026-11-27; the whole sphere at 256 x 256
+/// gave p99 0.250 in 7x the time), plus 25 %.
+const LOWER_RATE_P99: f64 = 0.23;

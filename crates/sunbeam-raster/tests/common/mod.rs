@@ -138,3 +138,33 @@ pub fn narrow_flat_pack(model: sunbeam_pack::Model) -> std::sync::Arc<sunbeam_pa
     };
     std::sync::Arc::new(sunbeam_pack::build(f, &opts, &mut |_, _| {}).unwrap())
 }
+
+/// Sum over samples `ks` of the reference estimator's XYZ at one shading
+/// point (frame `f`, world view `wr`; no diffuse part), each divided by `m`:
+/// sample k draws from its own stream `EnvShader::rng(seed, 0, k)` and takes
+/// wavelength stratum k of `m`, so a range of a larger sum is a part of it.
+pub fn estimator_xyz_sum(
+    es: &sunbeam_raster::environment::EnvShader,
+    f: sunbeam_raster::environment::Frame,
+    wr: [f64; 3],
+    seed: u64,
+    ks: std::ops::Range<u64>,
+    m: u64,
+) -> [f64; 3] {
+    use sunbeam_raster::environment::{EnvShader, Uniforms};
+    let mut mc = [0.0; 3];
+    for k in ks {
+        let mut rng = EnvShader::rng(seed, 0, k);
+        let lu = (k as f64 + rng.unit()) / m as f64;
+        let u = Uniforms {
+            lambda: lu,
+            ..Uniforms::random(&mut rng)
+        };
+        let xyz =
+            sunbeam_optics::colour::linear_srgb_to_xyz(es.sample(0, f, wr, [0.0; 3], 0.0, &u));
+        for i in 0..3 {
+            mc[i] += xyz[i] / m as f64;
+        }
+    }
+    mc
+}
