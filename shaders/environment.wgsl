@@ -103,6 +103,28 @@ struct EnvProposal {
 @group(2) @binding(11) var env_irr_plain: texture_2d<f32>;
 // the maps' cells (sunbeam_response::cells::Cells::gpu_data)
 @group(2) @binding(12) var<storage, read> cells: array<f32>;
+// the hot spots' taps (shaders/env_hotspots.wgsl), two vec4 per tap:
+// (world direction, 0) and (the light's basis power times the tap's weight, 0)
+@group(2) @binding(13) var<storage, read> env_lights: array<vec4<f32>>;
+
+// shaders/env_hotspots.wgsl's data access
+fn env_hot_count() -> u32 {
+    return arrayLength(&env_lights) / 2u;
+}
+
+fn env_hot_dir(i: u32) -> vec3<f32> {
+    return env_lights[2u * i].xyz;
+}
+
+fn env_hot_power(i: u32) -> vec3<f32> {
+    return env_lights[2u * i + 1u].xyz;
+}
+
+fn env_hot_maps(p: vec3<f32>, uvw: vec3<f32>) -> vec3<f32> {
+    let gr = env_grid();
+    let rc = sb_resp_coords(uvw, gr);
+    return p.x * env_map(env_e0, rc, gr) + p.y * env_map(env_e1, rc, gr) + p.z * env_map(env_e2, rc, gr);
+}
 
 // ---------------------------------------------------------------- random numbers
 fn pcg(v: u32) -> u32 {

@@ -16,7 +16,13 @@
 //   8 sunbeam_env: the numbers (environment.json);
 //   9 env_sun_map: the sky's sun, Omega_sun E_sun over directions: a
 //     response map of the sun's spectrum (sun-I.ktx2, read like the material's
-//     map, with its sampler 2), for sunbeam_shade_sun.
+//     map, with its sampler 2), for sunbeam_shade_sun;
+//   12 env_lights_tex: a map's hot spots as lights (shaders/env_hotspots.wgsl),
+//     2D RGBA32F, one row, two texels per tap: (2 i, 0) the tap's world
+//     direction, (2 i + 1, 0) its basis power (environment.json hot_spots);
+//   13, 14, 15 env_basis0..2: the mesh's extended-light maps E_k, one per
+//     basis function of the environment (basis-I-K.ktx2, response maps read
+//     like the sun's, with sampler 2), for the hot spots.
 
 struct SunbeamEnvironment {
     // the mesh's cells: x the top cut (meshes[].n_top; 0: none), y the maps'
@@ -32,6 +38,10 @@ struct SunbeamEnvironment {
     sun_rgb: vec4<f32>,
     // the sun map's grid: n_theta, n_rho, n_s, r0 (meshes[].sun_grid)
     sun_grid: vec4<f32>,
+    // x: the hot spots' taps (hot_spots.length; 0: none); yzw unused
+    hot: vec4<f32>,
+    // the basis maps' grid: n_theta, n_rho, n_s, r0 (meshes[].basis_grid)
+    basis_grid: vec4<f32>,
 };
 
 @group(0) @binding(3) var env_chain: texture_2d<f32>;
@@ -41,6 +51,33 @@ struct SunbeamEnvironment {
 @group(0) @binding(7) var env_cells_tex: texture_2d<u32>;
 @group(0) @binding(8) var<uniform> sunbeam_env: SunbeamEnvironment;
 @group(0) @binding(9) var env_sun_map: texture_3d<f32>;
+@group(0) @binding(12) var env_lights_tex: texture_2d<f32>;
+@group(0) @binding(13) var env_basis0: texture_3d<f32>;
+@group(0) @binding(14) var env_basis1: texture_3d<f32>;
+@group(0) @binding(15) var env_basis2: texture_3d<f32>;
+
+// shaders/env_hotspots.wgsl's data access
+fn env_hot_count() -> u32 {
+    return u32(sunbeam_env.hot.x);
+}
+
+fn env_hot_dir(i: u32) -> vec3<f32> {
+    return textureLoad(env_lights_tex, vec2<i32>(i32(2u * i), 0), 0).xyz;
+}
+
+fn env_hot_power(i: u32) -> vec3<f32> {
+    return textureLoad(env_lights_tex, vec2<i32>(i32(2u * i + 1u), 0), 0).xyz;
+}
+
+fn env_hot_maps(p: vec3<f32>, uvw: vec3<f32>) -> vec3<f32> {
+    let r0 = sunbeam_env.basis_grid.w;
+    let gr = SbGrid(sunbeam_env.basis_grid.xyz, r0, asinh(2.0 / r0));
+    let c = sb_resp_coords(uvw, gr);
+    let at = (vec3<f32>(c.x, clamp(c.y, 0.0, gr.n.y - 1.0), clamp(c.z, 0.0, gr.n.z - 1.0)) + 0.5) / gr.n;
+    return p.x * textureSampleLevel(env_basis0, resp_smp, at, 0.0).xyz
+        + p.y * textureSampleLevel(env_basis1, resp_smp, at, 0.0).xyz
+        + p.z * textureSampleLevel(env_basis2, resp_smp, at, 0.0).xyz;
+}
 
 fn env_cell_u32(i: u32) -> u32 {
     let w = u32(textureDimensions(env_cells_tex, 0).x);
@@ -107,7 +144,8 @@ fn sunbeam_shade_environment(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<
     if (dw >= 1.0 || env_cells_top() == 0u) {
         return base;
     }
-    return base + (1.0 - dw) * sb_xyz_to_linear_srgb(env_cells(t, b, n, wr_l));
+    let xyz = env_cells(t, b, n, wr_l) + env_hotspots(t, b, n, wr_l);
+    return base + (1.0 - dw) * sb_xyz_to_linear_srgb(xyz);
 }
 
 

@@ -40,9 +40,12 @@ window.sunbeamRender = async (job) => {
       for (const [file, url] of Object.entries(envJob.cells)) cells[file] = await get(url);
       const suns = {};
       for (const [file, url] of Object.entries(envJob.suns)) suns[file] = await get(url);
+      const basis = {};
+      for (const [file, url] of Object.entries(envJob.basis ?? {})) basis[file] = await get(url);
       environment = parseEnvironment({
         json: envJob.json, chain: await get(envJob.chain), irradianceSkin: await get(envJob.irradianceSkin),
-        irradiance: await get(envJob.irradiance), cells, suns,
+        irradiance: await get(envJob.irradiance), cells, suns, basis,
+        table: envJob.table ? await get(envJob.table) : null,
       });
     }
     let meshIndex = 0;

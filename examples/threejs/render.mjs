@@ -194,12 +194,15 @@ if (scene.environment) {
   const json = JSON.parse(readFileSync(join(envDir, 'environment.json'), 'utf8'));
   const cells = {};
   const suns = {};
+  const basis = {};
   for (const m of json.meshes) {
     cells[m.file] = serve(join(envDir, m.file));
     if (m.sun) suns[m.sun] = serve(join(envDir, m.sun));
+    for (const f of m.basis ?? []) basis[f] = serve(join(envDir, f));
   }
   env = {
-    json, cells, suns, chain: serve(join(envDir, json.chain.file)),
+    json, cells, suns, basis, chain: serve(join(envDir, json.chain.file)),
+    table: json.table ? serve(join(envDir, json.table)) : null,
     irradianceSkin: serve(join(envDir, json.irradiance.skin)), irradiance: serve(join(envDir, json.irradiance.plain)),
   };
 }

@@ -81,12 +81,16 @@ function equirectTexture(levels) {
  * The environment for sunbeamMaterial from the files of `sunbeam-play
  * SCENE.json --export-environment DIR`: `json` (environment.json, parsed),
  * `chain` (chain.ktx2), `irradianceSkin` (irradiance-skin.ktx2),
- * `irradiance` (irradiance.ktx2), `cells` and `suns` (objects: file name
- * -> ArrayBuffer, of every meshes[].file and meshes[].sun). Returns { json,
- * chain, irrSkin, irrPlain, cells: {file -> texture}, basisToRgb, sun };
- * `forMesh(i)` the cells (and sun map) of scene mesh i.
+ * `irradiance` (irradiance.ktx2), `cells`, `suns` and `basis` (objects: file
+ * name -> ArrayBuffer, of every meshes[].file, meshes[].sun and
+ * meshes[].basis[k]), and `table` (table.ktx2, when environment.json names
+ * one: the whole map, the chain being the rest of it after the hot spots).
+ * Returns { json, chain, table (the whole map for a background: table.ktx2,
+ * else the chain), irrSkin, irrPlain, cells: {file -> texture}, basisToRgb,
+ * sun, hotSpots: the taps' texture (null without hot spots) }; `forMesh(i)`
+ * the cells (and sun map, basis maps) of scene mesh i.
  */
-export function parseEnvironment({ json, chain, irradianceSkin, irradiance, cells, suns = {} }) {
+export function parseEnvironment({ json, chain, irradianceSkin, irradiance, cells, suns = {}, basis = {}, table = null }) {
   if (json.format !== 'sunbeam-environment' || json.version !== 1) throw new Error('environment.json: not a sunbeam-environment version 1');
   const levels = ktxLevels(chain, 'chain.ktx2', 97);
   if (levels.length !== json.chain.levels) throw new Error(`chain.ktx2: ${levels.length} levels, environment.json says ${json.chain.levels}`);
@@ -113,7 +117,26 @@ export function parseEnvironment({ json, chain, irradianceSkin, irradiance, cell
     cells: {},
     basisToRgb: json.basis_to_rgb,
     sun: json.sun,
+    hotSpots: null,
   };
+  if (json.table && !table) throw new Error(`environment: ${json.table} not given`);
+  out.table = table ? equirectTexture(ktxLevels(table, 'table.ktx2', 97).slice(0, 1)) : out.chain;
+  // The hot spots' taps (shaders/export_env.wgsl binding 12): one row of
+  // RGBA32F, (2 i, 0) the direction, (2 i + 1, 0) the basis power.
+  const taps = json.hot_spots ?? [];
+  if (taps.length > 0) {
+    const data = new Float32Array(8 * taps.length);
+    taps.forEach((t, i) => {
+      if (t.length !== 6) throw new Error(`environment.json: hot_spots[${i}] has ${t.length} numbers, not 6`);
+      data.set([t[0], t[1], t[2], 0, t[3], t[4], t[5], 0], 8 * i);
+    });
+    const tex = new THREE.DataTexture(data, 2 * taps.length, 1, THREE.RGBAFormat, THREE.FloatType);
+    tex.minFilter = THREE.NearestFilter;
+    tex.magFilter = THREE.NearestFilter;
+    tex.generateMipmaps = false;
+    tex.needsUpdate = true;
+    out.hotSpots = tex;
+  }
   for (const [file, buf] of Object.entries(cells)) {
     const [l] = ktxLevels(buf, file, 98);
     const tex = new THREE.DataTexture(new Uint32Array(l.bytes), l.width, l.height, THREE.RedIntegerFormat, THREE.UnsignedIntType);
@@ -125,14 +148,21 @@ export function parseEnvironment({ json, chain, irradianceSkin, irradiance, cell
     tex.needsUpdate = true;
     out.cells[file] = tex;
   }
-  const sunMaps = {};
-  for (const [file, buf] of Object.entries(suns)) sunMaps[file] = parseResponseMap(buf);
+  const maps = {};
+  for (const [file, buf] of [...Object.entries(suns), ...Object.entries(basis)]) maps[file] = parseResponseMap(buf);
   out.forMesh = (i) => {
     const m = json.meshes.find((e) => e.mesh === i);
     if (!m) return null;
-    const sun = m.sun ? sunMaps[m.sun] : null;
+    const sun = m.sun ? maps[m.sun] : null;
     if (m.sun && !sun) throw new Error(`environment: ${m.sun} not given`);
-    return { texture: out.cells[m.file], nTop: m.n_top, nS: m.n_s, nodes: m.nodes, sun, sunGrid: m.sun_grid };
+    const basisMaps = (m.basis ?? []).map((f) => {
+      if (!maps[f]) throw new Error(`environment: ${f} not given`);
+      return maps[f];
+    });
+    return {
+      texture: out.cells[m.file], nTop: m.n_top, nS: m.n_s, nodes: m.nodes, sun, sunGrid: m.sun_grid,
+      basis: basisMaps.length === 3 ? basisMaps : null, basisGrid: m.basis_grid,
+    };
   };
   return out;
 }
@@ -354,6 +384,12 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
     throw new Error(`environment: the transmitted irradiance is for index ${env.json.irradiance.ior}, the mesh's is ${ior}`);
   }
   const sun = env?.sun;
+  // A map's hot spots as lights: the taps and this mesh's basis maps.
+  const hot = Boolean(env?.hotSpots && envCells?.basis);
+  const noTaps = new THREE.DataTexture(new Float32Array(4), 1, 1, THREE.RGBAFormat, THREE.FloatType);
+  noTaps.minFilter = THREE.NearestFilter; // float textures filter only with an extension
+  noTaps.magFilter = THREE.NearestFilter;
+  noTaps.needsUpdate = true;
   const m = new THREE.RawShaderMaterial({
     glslVersion: THREE.GLSL3,
     vertexShader: VERTEX,
@@ -377,6 +413,10 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
       _group_0_binding_5_fs: { value: env ? env.irrPlain : flat },
       _group_0_binding_7_fs: { value: envCells ? envCells.texture : noCells },
       _group_0_binding_9_fs: { value: envCells?.sun ? envCells.sun.texture : placeholder },
+      _group_0_binding_12_fs: { value: hot ? env.hotSpots : noTaps },
+      _group_0_binding_13_fs: { value: hot ? envCells.basis[0].texture : placeholder },
+      _group_0_binding_14_fs: { value: hot ? envCells.basis[1].texture : placeholder },
+      _group_0_binding_15_fs: { value: hot ? envCells.basis[2].texture : placeholder },
       _group_0_binding_8_fs: {
         value: {
           cells: new THREE.Vector4(envCells ? envCells.nTop : 0, envCells ? envCells.nS : 2, envCells ? envCells.nodes : 0, 0),
@@ -385,6 +425,9 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
           sun_rgb: sun ? new THREE.Vector4(...sun.rgb, 0) : new THREE.Vector4(),
           // a mesh without its sun map: n_theta 0 (no diffraction from the sun)
           sun_grid: envCells?.sun ? new THREE.Vector4(...envCells.sunGrid) : new THREE.Vector4(0, 2, 2, 1),
+          // the hot spots' taps (0: none), read through the mesh's basis maps
+          hot: new THREE.Vector4(hot ? env.json.hot_spots.length : 0, 0, 0, 0),
+          basis_grid: hot ? new THREE.Vector4(...envCells.basisGrid) : new THREE.Vector4(1, 2, 2, 1),
         },
       },
       _group_0_binding_0_fs: {
@@ -604,7 +647,8 @@ export function sceneCamera(scene, aspect) {
  * `"background": "environment"` (docs/SCENE.md): a full-screen triangle,
  * drawn first, showing the environment along each pixel's view ray as the
  * player's background pass does: the exported sb_env_texel (the texel of the
- * coefficient table holding the direction; here level 0 of the chain) times
+ * coefficient table holding the direction: table.ktx2, or level 0 of the
+ * chain when there are no hot spots) times
  * basis_to_rgb, times 2^exposure. `camera` is the scene camera (a moving
  * camera: update the uniforms sbInvViewProj and sbEye per frame). `display`:
  * clip and sRGB-encode, as sunbeamMaterial's (drawing to a canvas).
@@ -647,7 +691,7 @@ void main() {
       sbTable: { value: new THREE.Vector2(environment.json.chain.width, environment.json.chain.height) },
       sbExposure: { value: Math.pow(2, exposure) },
       sbDisplay: { value: display ? 1 : 0 },
-      sbChain: { value: environment.chain },
+      sbChain: { value: environment.table },
     },
     depthTest: false,
     depthWrite: false,

@@ -134,6 +134,54 @@ fn orthonormal(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     (t, b)
 }
 
+/// A coefficient table's hot spots as lights (sunbeam_light::hotspots) and
+/// the residual the prefiltered chain is built from: what the player's
+/// first-frame cells and the engines' export (`--export-environment`) both use.
+pub(crate) struct HotSpots {
+    /// Every light's taps (sunbeam_response::hotspots::taps, made once: they
+    /// do not depend on the view), as shaders/env_hotspots.wgsl reads them:
+    /// (world direction, 0) and (the light's basis power times the tap's
+    /// weight, 0).
+    pub taps: Vec<[[f32; 4]; 2]>,
+    /// The table without the lights (RGBA f32, the table's layout).
+    pub residual: Vec<f32>,
+}
+
+impl HotSpots {
+    /// At most `max_lights` lights (0: none, the residual is the table).
+    pub fn split(w: usize, h: usize, table: &[f32], max_lights: usize) -> HotSpots {
+        let split = sunbeam_light::hotspots::split(
+            w,
+            h,
+            table,
+            sunbeam_light::hotspots::SplitOptions {
+                max_lights,
+                ..Default::default()
+            },
+        );
+        if !split.lights.is_empty() {
+            log::info!(
+                "{} hot spots as lights ({:.1} % of the environment's energy)",
+                split.lights.len(),
+                100.0 * split.share
+            );
+        }
+        let taps = split
+            .lights
+            .iter()
+            .flat_map(|l| {
+                sunbeam_response::hotspots::taps(l)
+                    .into_iter()
+                    .map(|(d, w)| [v4(d, 0.0), v4(l.power.map(|p| p * w), 0.0)])
+            })
+            .collect();
+        HotSpots {
+            taps,
+            residual: split.residual,
+        }
+    }
+}
+
 fn v4(v: [f64; 3], w: f64) -> [f32; 4] {
     [v[0] as f32, v[1] as f32, v[2] as f32, w as f32]
 }
@@ -205,33 +253,11 @@ impl EnvScene {
         // (the residual) prefiltered for the cells.
         let mut light_data = vec![[0.0f32; 4]; 2];
         let chain_levels = if cells {
-            let split = sunbeam_light::hotspots::split(
-                tw,
-                th,
-                &tdata,
-                sunbeam_light::hotspots::SplitOptions {
-                    max_lights: hot_spots,
-                    ..Default::default()
-                },
-            );
-            if !split.lights.is_empty() {
-                log::info!(
-                    "{} hot spots as lights ({:.1} % of the environment's energy)",
-                    split.lights.len(),
-                    100.0 * split.share
-                );
-                // the taps once, here: they do not depend on the view
-                light_data = split
-                    .lights
-                    .iter()
-                    .flat_map(|l| {
-                        sunbeam_response::hotspots::taps(l)
-                            .into_iter()
-                            .flat_map(|(d, w)| [v4(d, 0.0), v4(l.power.map(|p| p * w), 0.0)])
-                    })
-                    .collect();
+            let hot = HotSpots::split(tw, th, &tdata, hot_spots);
+            if !hot.taps.is_empty() {
+                light_data = hot.taps.concat();
             }
-            sunbeam_light::prefilter::Prefiltered::new(tw, th, split.residual).levels
+            sunbeam_light::prefilter::Prefiltered::new(tw, th, hot.residual).levels
         } else {
             vec![(1, 1, vec![0.0f32; 4])]
         };

@@ -14,6 +14,13 @@
 //!   others naming the same file): Cells::gpu_data as 2D R32_UINT (the floats'
 //!   bits), [`CELLS_WIDTH`] wide; with the sky's sun up, `sun-I.ktx2`: the
 //!   pack's `Omega_sun E_sun` map (a response map, RGBA16F 3D);
+//! - a map's hot spots as lights (sunbeam_light::hotspots, as the player's
+//!   `--env-hot-spots`): their taps in `environment.json` (`hot_spots`), the
+//!   chain then made from the rest of the map, and for each mesh I the pack's
+//!   extended-light maps they are read through, `basis-I-K.ktx2` (K = 0, 1,
+//!   2; response maps, RGBA16F 3D);
+//! - with hot spots, `table.ktx2`: the whole coefficient table (level 0 of
+//!   the chain without them), for a background;
 //! - `environment.json`: what the uniforms need (docs/ENGINES.md).
 //!
 //! f16, as the player uploads them, so an engine reads the player's numbers.
@@ -47,11 +54,14 @@ fn f16_levels(levels: &[(usize, usize, Vec<f32>)]) -> Vec<(usize, usize, Vec<u16
 
 /// Write the environment's files for `p` into `dir` (created if missing);
 /// `cells`: the top cut's cells and the levels below it (as the player's
-/// `--env-cells`). Returns the files written and notes (maps built).
+/// `--env-cells`); `hot_spots`: at most this many of a map's hot spots as
+/// lights (as the player's `--env-hot-spots`; the chain is then the rest).
+/// Returns the files written and notes (maps built).
 pub fn export(
     p: &Prepared,
     opts: &sunbeam_response::Options,
     cells: (usize, usize),
+    hot_spots: usize,
     dir: &Path,
 ) -> Result<(Vec<PathBuf>, Vec<String>)> {
     let env = p.environment.clone().ok_or_else(|| {
@@ -67,7 +77,23 @@ pub fn export(
         Ok(name.to_string())
     };
     let (tw, th, table) = env.coefficient_table(crate::env::SKY_TABLE_HEIGHT);
-    let chain = sunbeam_light::prefilter::Prefiltered::new(tw, th, table).levels;
+    let hot = crate::env::HotSpots::split(tw, th, &table, hot_spots);
+    // With hot spots the chain is the rest of the map: the whole map (for a
+    // background) is then a file of its own.
+    let table_file = if hot.taps.is_empty() {
+        None
+    } else {
+        let json = serde_json::json!({"width": tw, "height": th});
+        Some(put(
+            "table.ktx2",
+            encode_2d(
+                KEY,
+                &json.to_string(),
+                &Texture2d::Rgba16f(&f16_levels(&[(tw, th, table)])),
+            ),
+        )?)
+    };
+    let chain = sunbeam_light::prefilter::Prefiltered::new(tw, th, hot.residual).levels;
     let chain_json = serde_json::json!({"width": tw, "height": th, "levels": chain.len()});
     let chain_file = put(
         "chain.ktx2",
@@ -143,6 +169,19 @@ pub fn export(
             .into();
             v["sun_grid"] = serde_json::json!([g.n_theta, g.n_rho, g.n_s, g.r0]);
         }
+        // The basis maps E_k, which the hot spots are read through.
+        if !hot.taps.is_empty() {
+            let g = &er.basis[0].info.grid;
+            let mut names = Vec::new();
+            for (k, m) in er.basis.iter().enumerate() {
+                names.push(put(
+                    &format!("basis-{mi}-{k}.ktx2"),
+                    sunbeam_response::ktx2::encode(m),
+                )?);
+            }
+            v["basis"] = names.into();
+            v["basis_grid"] = serde_json::json!([g.n_theta, g.n_rho, g.n_s, g.r0]);
+        }
         done.push((key, v.clone()));
         v["mesh"] = mi.into();
         meshes.push(v);
@@ -165,6 +204,8 @@ pub fn export(
         "irradiance": {"skin": skin_file, "plain": plain_file, "ior": ior},
         "basis_to_rgb": m,
         "sun": sun,
+        "table": table_file,
+        "hot_spots": hot.taps.iter().map(|[d, p]| [d[0], d[1], d[2], p[0], p[1], p[2]]).collect::<Vec<_>>(),
         "meshes": meshes,
     });
     let text = serde_json::to_string_pretty(&json).expect("JSON serialises") + "\n";

@@ -4,8 +4,9 @@
 //! and the frame; shaders/response_map.wgsl; plus the engine interface in
 //! shaders/export.wgsl: one uniform block, the map, its sampler,
 //! `sunbeam_shade(t, b, n, wi, wr)`; the environment: shaders/env_cells.wgsl,
-//! the player's first-frame cells, with shaders/export_env.wgsl reading their
-//! data from textures, `sunbeam_shade_environment(t, b, n, wr)`; the scale
+//! the player's first-frame cells, and shaders/env_hotspots.wgsl, a map's hot
+//! spots as lights, with shaders/export_env.wgsl reading their data from
+//! textures, `sunbeam_shade_environment(t, b, n, wr)`; the scale
 //! maps: shaders/scales.wgsl, the player's frame function, with
 //! shaders/export_scales.wgsl binding the two textures,
 //! `sunbeam_scale_frame`).
@@ -24,7 +25,8 @@ pub const SOURCE: &str = concat!(
     include_str!("../../../shaders/export_scales.wgsl"),
     include_str!("../../../shaders/env_table.wgsl"),
     include_str!("../../../shaders/export_env.wgsl"),
-    include_str!("../../../shaders/env_cells.wgsl")
+    include_str!("../../../shaders/env_cells.wgsl"),
+    include_str!("../../../shaders/env_hotspots.wgsl")
 );
 
 /// The fragment entry point that shows the call (the function engines use is

@@ -81,7 +81,7 @@ pub(crate) struct Cli {
     /// Environment scenes, `--env-estimator cells`: the map's hot spots (its
     /// lamps, softboxes) as at most this many small lights through the maps,
     /// the rest for the cells (0..=256; 0: none; docs/LIGHTING.md "The first
-    /// frame"). The engines' export does not carry them yet.
+    /// frame"); `--export-environment` writes them for the engines too.
     #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_HOT_SPOTS as u64, value_parser = clap::value_parser!(u64).range(0..=256))]
     pub(crate) env_hot_spots: u64,
     /// Environment scenes, `--env-estimator cells`: shade the cells on a grid

@@ -352,8 +352,13 @@ fn export_environment(
             eprintln!("sunbeam-play: warning: {line}");
         }
     }
-    let (files, notes) =
-        sunbeam_render::env_export::export(&prepared, &st.response, st.env_cells, dir)?;
+    let (files, notes) = sunbeam_render::env_export::export(
+        &prepared,
+        &st.response,
+        st.env_cells,
+        st.env_hot_spots,
+        dir,
+    )?;
     if !quiet {
         for n in &notes {
             eprintln!("sunbeam-play: {n}");

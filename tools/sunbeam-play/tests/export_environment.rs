@@ -157,3 +157,150 @@ fn a_scene_without_an_environment_is_refused() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("environment"));
     assert!(!d.join("out").exists());
 }
+
+/// A map's hot spots (docs/ENGINES.md "Environment"): a white map of
+/// radiance 1 with a 2 x 2 texel lamp of radiance 200 on the horizon. The
+/// export carries the lamp as lights: every tap points at the lamp (within its
+/// size) and the taps' power, through basis_to_rgb, is the lamp's energy
+/// above the threshold of 8 times the map's mean (between 90 % and all of
+/// 200 x its solid angle; both from docs/SCENE.md's equirectangular
+/// convention, not from the code), read through the pack's three basis maps,
+/// which are written for it; `--env-hot-spots 0` writes neither.
+#[test]
+fn a_maps_hot_spots_are_exported_as_lights() {
+    use std::f64::consts::PI;
+    let d = tmp("hot");
+    pack(&d, "ridge", "xenopeltis");
+    let (w, h) = (64u32, 32u32);
+    let lamp = |i: u32, j: u32| (16..18).contains(&i) && (15..17).contains(&j);
+    let rgb = (0..w * h)
+        .map(|t| {
+            if lamp(t % w, t / w) {
+                [200.0; 3]
+            } else {
+                [1.0; 3]
+            }
+        })
+        .collect();
+    sunbeam_frame::LinearImage {
+        width: w,
+        height: h,
+        rgb,
+    }
+    .write_exr(&d.join("lamp.exr"))
+    .unwrap();
+    let scene = d.join("lamp.json");
+    std::fs::write(
+        &scene,
+        r#"{ "camera": { "eye": [0, 0, 2], "target": [0, 0, 0] },
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "ridge.ktx2" } ],
+  "environment": { "map": "lamp.exr" } }"#,
+    )
+    .unwrap();
+    let run = |out: &Path, hot: &str| {
+        let o = Command::new(BIN)
+            .arg(&scene)
+            .args(["--env-cells", "32", "--env-hot-spots", hot, "-q"])
+            .arg("--export-environment")
+            .arg(out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice::<serde_json::Value>(
+            &std::fs::read(out.join("environment.json")).unwrap(),
+        )
+        .unwrap()
+    };
+    let json = run(&d.join("on"), "32");
+    // The lamp: columns 16-17 (phi 2 pi [16, 18) / 64), rows 15-16 (theta
+    // pi [15, 17) / 32 from +y).
+    let phi = 2.0 * PI * 17.0 / 64.0;
+    let centre = [phi.cos(), 0.0, phi.sin()];
+    let omega: f64 = (15..17)
+        .map(|j| {
+            let j = f64::from(j);
+            ((PI * j / 32.0).cos() - (PI * (j + 1.0) / 32.0).cos()) * 2.0 * PI / 64.0
+        })
+        .sum::<f64>()
+        * 2.0;
+    let m: Vec<Vec<f64>> = serde_json::from_value(json["basis_to_rgb"].clone()).unwrap();
+    let taps = json["hot_spots"].as_array().unwrap();
+    assert!(!taps.is_empty(), "no hot spots: {json}");
+    let mut power = [0.0f64; 3];
+    for t in taps {
+        let t: Vec<f64> = serde_json::from_value(t.clone()).unwrap();
+        let cos = t[0] * centre[0] + t[1] * centre[1] + t[2] * centre[2];
+        assert!(
+            cos > 8f64.to_radians().cos(),
+            "a tap {:.1} deg from the lamp: {t:?}",
+            cos.min(1.0).acos().to_degrees()
+        );
+        for (r, row) in m.iter().enumerate() {
+            power[r] += row[0] * t[3] + row[1] * t[4] + row[2] * t[5];
+        }
+    }
+    eprintln!(
+        "{} taps, power {power:?} against the lamp's 200 x {omega:.5} sr",
+        taps.len()
+    );
+    for (c, p) in power.iter().enumerate() {
+        let ratio = p / (200.0 * omega);
+        assert!(
+            (0.9..=1.0).contains(&ratio),
+            "channel {c}: the taps carry {ratio:.3} of the lamp's 200 x {omega:.5} sr"
+        );
+    }
+    let basis: Vec<String> = serde_json::from_value(json["meshes"][0]["basis"].clone()).unwrap();
+    assert_eq!(
+        basis,
+        ["basis-0-0.ktx2", "basis-0-1.ktx2", "basis-0-2.ktx2"]
+    );
+    for f in &basis {
+        let (fmt, w, _, _) = ktx2_head(&std::fs::read(d.join("on").join(f)).unwrap());
+        assert_eq!(fmt, 97, "{f}: RGBA16F");
+        assert_eq!(json["meshes"][0]["basis_grid"][0], w, "{f}");
+    }
+    // The whole map for a background, the chain being the rest: the lamp's
+    // texel is in the table at full radiance, not in level 0 of the chain.
+    assert_eq!(json["table"], "table.ktx2");
+    let level0 = |f: &str| {
+        let b = std::fs::read(d.join("on").join(f)).unwrap();
+        let (_, tw, _, levels) = ktx2_head(&b);
+        let (off, _) = levels[0];
+        // k = tw / 64 table texels per map texel (a map's table is its own
+        // size, k = 1): table texel (16 k, 15 k) lies in the lamp's texel
+        // (16, 15); channel 1
+        let k = tw as usize / 64;
+        let o = off + 8 * (15 * k * tw as usize + 16 * k) + 2;
+        f16_to_f32(u16::from_le_bytes([b[o], b[o + 1]]))
+    };
+    let (in_table, in_chain) = (level0("table.ktx2"), level0("chain.ktx2"));
+    eprintln!("the lamp's texel: {in_table} in the table, {in_chain} in the chain");
+    assert!(in_table > 100.0 && in_chain < 20.0, "{in_table} {in_chain}");
+    // Without hot spots: no taps, no basis maps, no separate table.
+    let json = run(&d.join("off"), "0");
+    assert_eq!(
+        json["hot_spots"].as_array().map(Vec::len),
+        Some(0),
+        "{json}"
+    );
+    assert!(json["meshes"][0].get("basis").is_none(), "{json}");
+    assert!(json["table"].is_null(), "{json}");
+    assert!(!d.join("off/basis-0-0.ktx2").exists());
+    assert!(!d.join("off/table.ktx2").exists());
+}
+
+/// An IEEE half float's value (normal and subnormal; no crate for one line).
+fn f16_to_f32(h: u16) -> f32 {
+    let (sign, exp, frac) = (h >> 15, (h >> 10) & 0x1f, f32::from(h & 0x3ff));
+    let v = match exp {
+        0 => frac * 2f32.powi(-24),
+        31 => f32::INFINITY,
+        e => (1.0 + frac / 1024.0) * 2f32.powi(i32::from(e) - 15),
+    };
+    if sign == 1 {
+        -v
+    } else {
+        v
+    }
+}
