@@ -176,9 +176,7 @@ fn env_grid() -> SbGrid {
 
 // Trilinear read of one map at texel coordinates c (as sb_resp_sample).
 fn env_map(tex: texture_3d<f32>, c: vec3<f32>, gr: SbGrid) -> vec3<f32> {
-    let n = gr.n;
-    let cc = vec3<f32>(c.x, clamp(c.y, 0.0, n.y - 1.0), clamp(c.z, 0.0, n.z - 1.0));
-    return textureSampleLevel(tex, env_smp, (cc + 0.5) / n, 0.0).xyz;
+    return textureSampleLevel(tex, env_smp, sb_resp_uvw(c, gr), 0.0).xyz;
 }
 
 // Coefficients c_k of the radiance from world direction d: the texel that

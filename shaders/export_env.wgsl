@@ -56,6 +56,12 @@ struct SunbeamEnvironment {
 @group(0) @binding(14) var env_basis1: texture_3d<f32>;
 @group(0) @binding(15) var env_basis2: texture_3d<f32>;
 
+// The grid of an environment's response map from its uniform
+// (n_theta, n_rho, n_s, r0), as the material's (rho_scale = asinh(2 / r0)).
+fn env_map_grid(g: vec4<f32>) -> SbGrid {
+    return SbGrid(g.xyz, g.w, asinh(2.0 / g.w));
+}
+
 // shaders/env_hotspots.wgsl's data access
 fn env_hot_count() -> u32 {
     return u32(sunbeam_env.hot.x);
@@ -70,10 +76,8 @@ fn env_hot_power(i: u32) -> vec3<f32> {
 }
 
 fn env_hot_maps(p: vec3<f32>, uvw: vec3<f32>) -> vec3<f32> {
-    let r0 = sunbeam_env.basis_grid.w;
-    let gr = SbGrid(sunbeam_env.basis_grid.xyz, r0, asinh(2.0 / r0));
-    let c = sb_resp_coords(uvw, gr);
-    let at = (vec3<f32>(c.x, clamp(c.y, 0.0, gr.n.y - 1.0), clamp(c.z, 0.0, gr.n.z - 1.0)) + 0.5) / gr.n;
+    let gr = env_map_grid(sunbeam_env.basis_grid);
+    let at = sb_resp_uvw(sb_resp_coords(uvw, gr), gr);
     return p.x * textureSampleLevel(env_basis0, resp_smp, at, 0.0).xyz
         + p.y * textureSampleLevel(env_basis1, resp_smp, at, 0.0).xyz
         + p.z * textureSampleLevel(env_basis2, resp_smp, at, 0.0).xyz;
@@ -165,11 +169,9 @@ fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr
     let dw = sunbeam.warp.z;
     var diff = vec3<f32>(0.0);
     if (wi_l.z > 0.0 && wr_l.z > 0.0 && sunbeam_env.sun_grid.x > 0.0) {
-        let r0 = sunbeam_env.sun_grid.w;
-        let gr = SbGrid(sunbeam_env.sun_grid.xyz, r0, asinh(2.0 / r0));
-        let c = sb_resp_coords(-wi_l - wr_l, gr);
-        let cc = vec3<f32>(c.x, clamp(c.y, 0.0, gr.n.y - 1.0), clamp(c.z, 0.0, gr.n.z - 1.0));
-        let e = textureSampleLevel(env_sun_map, resp_smp, (cc + 0.5) / gr.n, 0.0).xyz;
+        let gr = env_map_grid(sunbeam_env.sun_grid);
+        let at = sb_resp_uvw(sb_resp_coords(-wi_l - wr_l, gr), gr);
+        let e = textureSampleLevel(env_sun_map, resp_smp, at, 0.0).xyz;
         diff = sb_xyz_to_linear_srgb(e * sb_gain(wi_l, wr_l, skin) * sb_masking(wi_l, wr_l, skin.slope));
     }
     let cos_i = max(wi_l.z, 0.0);

@@ -44,11 +44,19 @@ fn sb_resp_dtheta(uv: vec2<f32>, duv: vec2<f32>, gr: SbGrid) -> f32 {
     return (uv.x * duv.y - uv.y * duv.x) / r2 * gr.n.x / SB_TAU;
 }
 
-// Trilinear read of the map at texel coordinates c.
-fn sb_resp_sample(c: vec3<f32>, gr: SbGrid) -> vec3<f32> {
+// Normalised texture coordinates of texel coordinates c in a map of grid gr
+// (the angle wraps by the sampler's repeat; rho and s clamped to the grid):
+// every reader of a response map (the material's, the environment's maps)
+// samples there, trilinear at level 0.
+fn sb_resp_uvw(c: vec3<f32>, gr: SbGrid) -> vec3<f32> {
     let n = gr.n;
     let cc = vec3<f32>(c.x, clamp(c.y, 0.0, n.y - 1.0), clamp(c.z, 0.0, n.z - 1.0));
-    return textureSampleLevel(resp_tex, resp_smp, (cc + 0.5) / n, 0.0).xyz;
+    return (cc + 0.5) / n;
+}
+
+// Trilinear read of the map at texel coordinates c.
+fn sb_resp_sample(c: vec3<f32>, gr: SbGrid) -> vec3<f32> {
+    return textureSampleLevel(resp_tex, resp_smp, sb_resp_uvw(c, gr), 0.0).xyz;
 }
 
 // G T at one direction pair (XYZ, without the masking; D65 white at Y = F(0)
