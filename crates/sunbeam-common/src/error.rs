@@ -83,6 +83,22 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+/// The exit status when stdout's reader has gone (`tool | head`): a shell's
+/// for a process killed by SIGPIPE.
+pub const BROKEN_PIPE_EXIT: i32 = 141;
+
+/// Whether a panic is `print!` failing on a closed pipe (its message names
+/// stdout and the OS error; std offers no typed payload for it).
+fn is_broken_pipe(info: &std::panic::PanicHookInfo<'_>) -> bool {
+    let msg = info
+        .payload()
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| info.payload().downcast_ref::<&str>().copied())
+        .unwrap_or("");
+    msg.starts_with("failed printing to stdout") && msg.contains("os error 32")
+}
+
 /// Run a tool's main body: print the error to stderr as `TOOL: error: ...` and
 /// exit with its code. A panic (a bug) exits 4 through the default hook's code
 /// path being replaced here. This is the one exit path of every tool; tools call
@@ -90,6 +106,12 @@ impl std::error::Error for Error {}
 pub fn run_main(tool: &str, body: impl FnOnce() -> Result<()>) -> ! {
     let tool_name = tool.to_string();
     std::panic::set_hook(Box::new(move |info| {
+        if is_broken_pipe(info) {
+            // `tool | head`: the reader left. Rust ignores SIGPIPE, so
+            // `println!` panics; end as a process killed by SIGPIPE would
+            // (128 + 13), without a message, as other Unix tools do.
+            std::process::exit(BROKEN_PIPE_EXIT);
+        }
         eprintln!("{tool_name}: internal error (a bug, please report): {info}");
     }));
     let code = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(body)) {
@@ -99,6 +121,11 @@ pub fn run_main(tool: &str, body: impl FnOnce() -> Result<()>) -> ! {
             let _ = std::io::stdout().flush();
             eprintln!("{tool}: {e}");
             e.exit_code()
+        }
+        // A tool that writes stdout itself reports the closed pipe as an
+        // error `stdout: ...` (tools/sunbeam-eval probe, sunbeam-bake).
+        Ok(Err(e)) if e.message.starts_with("stdout: ") && e.message.contains("os error 32") => {
+            BROKEN_PIPE_EXIT
         }
         Ok(Err(e)) => {
             eprintln!("{tool}: error: {e}");

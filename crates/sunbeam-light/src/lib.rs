@@ -244,7 +244,7 @@ impl EnvMap {
 
     /// Texel indices seen from world direction `d` (unit).
     fn texel(&self, d: [f64; 3]) -> (usize, usize) {
-        let l = rot_y(d, -self.rotation_deg);
+        let l = self.local(d);
         let theta = l[1].clamp(-1.0, 1.0).acos();
         let mut phi = l[2].atan2(l[0]);
         if phi < 0.0 {
@@ -253,6 +253,24 @@ impl EnvMap {
         let i = ((phi / (2.0 * PI) * self.width as f64) as usize).min(self.width - 1);
         let j = ((theta / PI * self.height as f64) as usize).min(self.height - 1);
         (i, j)
+    }
+
+    /// The map's direction for world direction `d`: `d` turned by
+    /// `-rotation_deg` (what [`EnvMap::lookup`] reads, and where
+    /// [`EnvMap::prefiltered`]'s chain is read).
+    pub fn local(&self, d: [f64; 3]) -> [f64; 3] {
+        rot_y(d, -self.rotation_deg)
+    }
+
+    /// The map's texels (intensity applied, rotation not), row-major from
+    /// the top: what [`EnvMap::lookup`] reads at [`EnvMap::local`] directions.
+    pub fn texels(&self) -> &[[f32; 3]] {
+        &self.rgb
+    }
+
+    /// World direction of map direction `l` (the inverse of [`EnvMap::local`]).
+    pub fn world(&self, l: [f64; 3]) -> [f64; 3] {
+        rot_y(l, self.rotation_deg)
     }
 
     /// Radiance arriving from world direction `d` (unit vector).

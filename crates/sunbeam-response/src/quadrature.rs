@@ -31,6 +31,13 @@
 //! The sun (a disc of 0.5 degrees, outside the basis) is a point of its disc
 //! per call, with `Omega E_sun` interpolated trilinearly, as in the player.
 //!
+//! A map is split texel by texel ([`LAMP_THRESHOLD`]): its lamps, the part of
+//! each texel above 8x the map's mean, are point lights through the same
+//! trilinear lookup of the three basis maps, one per map texel; the residual
+//! is read averaged over each sum texel's footprint of directions (a mip
+//! chain, `sunbeam_light::prefilter`), not at its centre (docs/LIGHTING.md
+//! "Lamps in a map").
+//!
 //! Cost: only texels that matter are visited. Texels are ranked by their
 //! largest `|E|` times area over the layers, and the smallest, together at
 //! most [`SKIP_SHARE`] of the total, are left out. The rest can be split into
@@ -43,6 +50,7 @@
 use crate::build::{self, Options};
 use crate::env::env_weights;
 use crate::grid::Grid;
+use sunbeam_light::prefilter::Prefiltered;
 use sunbeam_light::Environment;
 use sunbeam_optics::gain;
 use sunbeam_optics::masking::Masking;
@@ -94,6 +102,13 @@ pub struct EnvQuadrature {
     /// A white furnace's map ([`EnvQuadrature::from_xyz`]): the
     /// coefficients are `(1, 0, 0)` without asking the environment.
     white: bool,
+    /// A map's residual (its texels capped at [`LAMP_THRESHOLD`] times its
+    /// mean) prefiltered by solid angle: each texel of the sum reads it
+    /// averaged over its own footprint of directions.
+    chain: Option<Prefiltered>,
+    /// A map's lamps: each texel's part above the cap as a point light at
+    /// its centre (world direction, `int c_k d(omega)` over the texel).
+    lamps: Vec<Lamp>,
 }
 
 impl EnvQuadrature {
@@ -115,8 +130,13 @@ impl EnvQuadrature {
             &sets.iter().take(3).map(Vec::as_slice).collect::<Vec<_>>(),
         );
         let mut q = Self::from_parts(g, basis, sun);
-        if let Environment::Sky(_) = env {
-            q.table = Some(OctTable::new(env, OCT_SIDE));
+        match env {
+            Environment::Sky(_) => q.table = Some(OctTable::new(env, OCT_SIDE)),
+            Environment::Map(m) => {
+                let (chain, lamps) = split_map(m);
+                q.chain = Some(chain);
+                q.lamps = lamps;
+            }
         }
         q
     }
@@ -193,6 +213,8 @@ impl EnvQuadrature {
             rows,
             table: None,
             white: false,
+            chain: None,
+            lamps: Vec::new(),
         }
     }
 
@@ -308,7 +330,52 @@ impl EnvQuadrature {
                 }
             }
         }
+        // A map's lamps: every `kl`-th of them (in raster order, so each
+        // class spans every lamp's extent) times `kl`.
+        let kl = lamp_parts(self.lamps.len(), part.1.max(1));
+        for (dir, power) in self.lamps.iter().skip(part.0 % kl).step_by(kl) {
+            for ((qy, v), o) in queries.iter().zip(&views).zip(out.iter_mut()) {
+                if v.is_some() {
+                    let s = self.point_light(qy, *dir, *power);
+                    for a in 0..3 {
+                        o[a] += kl as f64 * s[a];
+                    }
+                }
+            }
+        }
         out
+    }
+
+    /// A point light of basis power `power` from world direction `dir`:
+    /// `G sum_k P_k E_k(-wi - wr)` (`d(u, v) = cos(theta_i) d(omega)`
+    /// cancels `1 / cos`, as for the sun).
+    fn point_light(&self, q: &Query, dir: [f64; 3], power: [f64; 3]) -> [f64; 3] {
+        let (t, b, n) = q.frame;
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let wi = [dot(dir, t), dot(dir, b), dot(dir, n)];
+        if wi[2] <= 0.0 {
+            return [0.0; 3];
+        }
+        let wr = q.wr;
+        let gain = q.masking.gain(wi, wr, q.skin);
+        if gain <= 0.0 || !gain.is_finite() {
+            return [0.0; 3];
+        }
+        let g = &self.grid;
+        let Some(c) = g.coords(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]) else {
+            return [0.0; 3];
+        };
+        let ns = g.n_s;
+        let e = g.trilinear(c, |i, j, k| {
+            let o = (j * g.n_theta + i) * ns * 9 + k * 9;
+            let l = &self.basis[o..o + 9];
+            [0, 1, 2].map(|a| {
+                (0..3)
+                    .map(|kk| power[kk] * f64::from(l[3 * kk + a]))
+                    .sum::<f64>()
+            })
+        });
+        e.map(|x| gain * x)
     }
 
     /// The sun's part at a point of its disc (`d(u, v) = cos(theta_i) dw`
@@ -345,6 +412,72 @@ impl EnvQuadrature {
             [0, 1, 2].map(|a| f64::from(self.sun[o + a]))
         })
     }
+}
+
+/// A map texel brighter than this many times the map's mean brightness (the
+/// sum of its coefficients, over the sphere) is a lamp: its part above the
+/// cap is summed as a point light per texel, not through the maps' texels.
+/// Why: a lamp smaller than the maps' texel spacing lands in a few texels of
+/// one interleaved class, so one sub-pixel sample of 16 carried it (two seeds
+/// of a 40 x 40 frame under ../shared/data/hdri/studio.exr differed by
+/// CIEDE2000 p99 31; with the residual prefiltered per texel footprint but
+/// no lamps, 16); every class sees a lamp through its own share of the
+/// lamp's texels.
+pub const LAMP_THRESHOLD: f64 = 8.0;
+
+/// Interleaved classes of the lamps for `parts` classes of the maps' texels:
+/// the largest power of four dividing `parts` that leaves each class
+/// [`LAMPS_PER_CLASS`] lamps or more (1 for a few lamps: every sample sums
+/// them all).
+fn lamp_parts(lamps: usize, parts: usize) -> usize {
+    let mut k = 1;
+    while parts.is_multiple_of(4 * k) && lamps / (4 * k) >= LAMPS_PER_CLASS {
+        k *= 4;
+    }
+    k
+}
+
+/// A lamp texel: world direction and basis power.
+type Lamp = ([f64; 3], [f64; 3]);
+
+/// Fewest lamp texels one class sums.
+const LAMPS_PER_CLASS: usize = 64;
+
+/// A map split into its residual's prefiltered chain and its lamps
+/// ([`LAMP_THRESHOLD`]): texel by texel, residual plus lamp is the map.
+fn split_map(m: &sunbeam_light::EnvMap) -> (Prefiltered, Vec<Lamp>) {
+    use std::f64::consts::{PI, TAU};
+    let (w, h) = (m.width(), m.height());
+    let texels = m.texels();
+    let omega = |j: usize| {
+        ((PI * j as f64 / h as f64).cos() - (PI * (j + 1) as f64 / h as f64).cos()) * TAU / w as f64
+    };
+    let y = |c: [f32; 3]| f64::from(c[0]) + f64::from(c[1]) + f64::from(c[2]);
+    let total: f64 = texels
+        .iter()
+        .enumerate()
+        .map(|(t, c)| y(*c) * omega(t / w))
+        .sum();
+    let cap = LAMP_THRESHOLD * total / (4.0 * PI);
+    let mut lamps = Vec::new();
+    let mut rgba = Vec::with_capacity(w * h * 4);
+    for (t, c) in texels.iter().enumerate() {
+        let yt = y(*c);
+        if cap > 0.0 && yt > cap {
+            let (i, j) = (t % w, t / w);
+            let keep = cap / yt;
+            let theta = (j as f64 + 0.5) / h as f64 * PI;
+            let phi = (i as f64 + 0.5) / w as f64 * TAU;
+            let dir = m.world(sunbeam_light::direction(theta.cos(), phi));
+            let p = c.map(|v| f64::from(v) * (1.0 - keep) * omega(j));
+            lamps.push((dir, p));
+            rgba.extend(c.map(|v| (f64::from(v) * keep) as f32));
+        } else {
+            rgba.extend(*c);
+        }
+        rgba.push(0.0);
+    }
+    (Prefiltered::new(w, h, rgba), lamps)
 }
 
 /// 3-point Gauss-Legendre nodes and weights on [-1, 1].
@@ -467,6 +600,22 @@ pub struct Query {
     pub skin: gain::Material,
 }
 
+/// A texel's footprint of incoming directions: its `(u, v)` area over
+/// `cos(theta_i)` steradians (`d(u, v) = cos(theta_i) d(omega)`), the cosine
+/// floored at the texel's reach from the horizon (`sqrt(2 extent)`: the
+/// cosine at `|wi_xy| = 1 - extent`).
+#[derive(Debug, Clone, Copy)]
+struct Footprint {
+    area: f64,
+    min_cos: f64,
+}
+
+impl Footprint {
+    fn solid_angle(self, ci: f64) -> f64 {
+        self.area / ci.max(self.min_cos)
+    }
+}
+
 /// A query prepared for the sum.
 struct View<'a> {
     frame: Frame,
@@ -477,6 +626,7 @@ struct View<'a> {
     phi_v: f64,
     table: Option<&'a OctTable>,
     white: bool,
+    chain: Option<&'a Prefiltered>,
     env: &'a Environment,
 }
 
@@ -495,6 +645,7 @@ impl<'a> View<'a> {
             phi_v: wr[1].atan2(wr[0]),
             table: quad.table.as_ref(),
             white: quad.white,
+            chain: quad.chain.as_ref(),
             env,
         })
     }
@@ -523,15 +674,22 @@ impl<'a> View<'a> {
         }
     }
 
-    fn coefficients(&self, d: [f64; 3]) -> [f64; 3] {
+    /// The coefficients from local direction `d`, averaged over `omega`
+    /// steradians around it where the environment is a map: a texel of the
+    /// sum stands for its footprint of directions, and a point lookup there
+    /// aliases a lamp smaller than the texels' spacing (under
+    /// ../shared/data/hdri/studio.exr two seeds of a 40 x 40 frame differed
+    /// by CIEDE2000 p99 31 with point lookups).
+    fn coefficients(&self, d: [f64; 3], omega: f64) -> [f64; 3] {
         if self.white {
             return [1.0, 0.0, 0.0];
         }
         let (t, b, n) = self.frame;
         let w = [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
-        match self.table {
-            Some(tab) => tab.at(w),
-            None => self.env.coefficients(w),
+        match (self.table, self.chain, self.env) {
+            (Some(tab), _, _) => tab.at(w),
+            (None, Some(chain), Environment::Map(m)) => chain.lookup(m.local(w), omega),
+            _ => self.env.coefficients(w),
         }
     }
 
@@ -558,8 +716,12 @@ impl<'a> View<'a> {
             return;
         }
         let d = d2.sqrt();
+        let foot = Footprint {
+            area: row.area,
+            min_cos: (2.0 * row.extent).sqrt(),
+        };
         if (1.0 - d).abs() > BAND * row.extent {
-            self.plain(quad, -x, -y, row.r, area, e, xyz);
+            self.plain(quad, -x, -y, row.r, area, foot, e, xyz);
             return;
         }
         // Near the horizon: the texel's radial and angular half extents
@@ -575,6 +737,7 @@ impl<'a> View<'a> {
             hr.max(1e-9),
             ha.max(1e-9),
             area,
+            foot,
             e,
             xyz,
         );
@@ -620,6 +783,7 @@ impl<'a> View<'a> {
         y: f64,
         r: f64,
         area: f64,
+        foot: Footprint,
         e: &[f32],
         xyz: &mut [f64; 3],
     ) {
@@ -631,7 +795,7 @@ impl<'a> View<'a> {
         let wi = [x, y, ci];
         let gain = self.masking.gain(wi, self.wr, self.skin) / ci;
         if gain > 0.0 && gain.is_finite() {
-            let c = self.coefficients([x, y, ci]);
+            let c = self.coefficients([x, y, ci], foot.solid_angle(ci));
             self.add(quad, ci, r, area * gain, c, e, xyz);
         }
     }
@@ -654,6 +818,7 @@ impl<'a> View<'a> {
         hr: f64,
         ha: f64,
         area: f64,
+        foot: Footprint,
         e: &[f32],
         xyz: &mut [f64; 3],
     ) {
@@ -666,7 +831,7 @@ impl<'a> View<'a> {
         let (w0, w1) = (hr.min(ha), hr.max(ha));
         let dc = d.min(1.0 - 1e-9);
         let cc = (1.0 - dc * dc).sqrt();
-        let c = self.coefficients([x * dc / d, y * dc / d, cc]);
+        let c = self.coefficients([x * dc / d, y * dc / d, cc], foot.solid_angle(cc));
         let tau = |d: f64| -1.0 / ((1.0 - d * d).max(0.0).sqrt() + cr);
         // Pieces (start, end, density at start, density at end) of the
         // trapezoid, whose integral is 1.

@@ -153,3 +153,29 @@ fn probe_bad_points_exit_2() {
     assert_eq!(o.status.code(), Some(1));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `sunbeam-eval probe ... | head`: when stdout's reader leaves, the tool
+/// ends quietly with the shell's status for SIGPIPE (141), not as an
+/// internal error. 20000 points print about 400 KB, more than a pipe holds,
+/// so the write fails whatever the timing.
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    let dir = tmpdir("probe-pipe");
+    let field = dir.join("f.txt");
+    write_ascii(&field, 2, 2, &[0.0, 1e-7, 2e-7, 0.0]);
+    let pts = dir.join("p.csv");
+    std::fs::write(&pts, "0,0,-1,5e-7\n".repeat(20_000)).unwrap();
+    let o = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(r#""$0" probe "$1" --points "$2" --pixel-size 50nm | true; echo "${PIPESTATUS[0]}""#)
+        .args([bin(), field.to_str().unwrap(), pts.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert_eq!(out.trim(), "141", "status; stderr: {err}");
+    assert!(err.is_empty(), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
