@@ -505,8 +505,8 @@ fn threejs_renders_an_hdr_image_and_its_background() {
 
 /// Bounds of [`threejs_renders_an_hdr_image_and_its_background`], measured
 /// plus 25 % (docs/ENGINES.md "Environment", 2026-11-27): under studio.exr,
-/// the map's hot spots as lights in both, three.js p99 4.27 (mean 0.94; the
-/// player's first frame 4.72, mean 1.02; without the hot spots the player's
+/// the map's hot spots as lights in both, three.js p99 4.32 (mean 0.92; the
+/// player's first frame 4.81, mean 0.99; without the hot spots the player's
 /// mean is 7.16); the reference's own two seeds differ by p99 2.34 at 16
 /// samples. The background p99 17.5 (the player's own background pass 13.9:
 /// the map's sharp edges sampled by 16 rays per pixel in each).

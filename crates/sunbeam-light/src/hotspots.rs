@@ -58,6 +58,12 @@ pub struct HotSpot {
     pub solid_angle: f64,
     /// Power-weighted rms angle of its texels from `dir` (radians).
     pub spread: f64,
+    /// Its extent along its two principal axes: tangent vectors at `dir`
+    /// (world), each `sqrt(2 lambda)` long for the eigenvalue `lambda` of the
+    /// power-weighted covariance of its texels' directions projected on the
+    /// tangent plane, so that four taps at `dir +- axes[i]` with weight 1/4
+    /// have the light's second moments. Zero for a single texel.
+    pub axes: [[f64; 3]; 2],
 }
 
 /// A coefficient table split into lights and a residual table.
@@ -228,11 +234,18 @@ pub fn split(w: usize, h: usize, rgba: &[f32], opts: SplitOptions) -> Split {
             s2 += c.acos().powi(2) * (y(t) - tau) * omega[t / w];
         }
         taken += e;
+        let axes = principal_axes(
+            dir,
+            members
+                .iter()
+                .map(|&t| (texel_dir(w, h, t % w, t / w), (y(t) - tau) * omega[t / w])),
+        );
         lights.push(HotSpot {
             dir,
             power,
             solid_angle,
             spread: (s2 / e).sqrt(),
+            axes,
         });
     }
     Split {
@@ -240,6 +253,55 @@ pub fn split(w: usize, h: usize, rgba: &[f32], opts: SplitOptions) -> Split {
         residual,
         share: taken / total,
     }
+}
+
+/// A tangent basis at unit `d` (any: the axes below do not depend on it).
+pub fn tangent_basis(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let a = if d[1].abs() < 0.9 {
+        [0.0, 1.0, 0.0]
+    } else {
+        [1.0, 0.0, 0.0]
+    };
+    let c = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let e1 = c(a, d);
+    let l = (e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]).sqrt();
+    let e1 = e1.map(|x| x / l);
+    (e1, c(d, e1))
+}
+
+/// [`HotSpot::axes`] of weighted directions `pts` about unit `dir`.
+fn principal_axes(dir: [f64; 3], pts: impl Iterator<Item = ([f64; 3], f64)>) -> [[f64; 3]; 2] {
+    let (e1, e2) = tangent_basis(dir);
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (mut sw, mut m) = (0.0, [0.0f64; 3]);
+    for (d, wt) in pts {
+        let (x, y) = (dot(d, e1), dot(d, e2));
+        sw += wt;
+        m[0] += wt * x * x;
+        m[1] += wt * x * y;
+        m[2] += wt * y * y;
+    }
+    if sw <= 0.0 {
+        return [[0.0; 3]; 2];
+    }
+    let (a, b, c) = (m[0] / sw, m[1] / sw, m[2] / sw);
+    let half = 0.5 * (a - c);
+    let r = (half * half + b * b).sqrt();
+    let l1 = (0.5 * (a + c) + r).max(0.0);
+    let l2 = (0.5 * (a + c) - r).max(0.0);
+    // eigenvector of l1: (cos t, sin t) with tan 2t = 2b / (a - c)
+    let t = 0.5 * (2.0 * b).atan2(a - c);
+    let (s, co) = t.sin_cos();
+    let v1 = [0, 1, 2].map(|k| co * e1[k] + s * e2[k]);
+    let v2 = [0, 1, 2].map(|k| -s * e1[k] + co * e2[k]);
+    let (s1, s2) = ((2.0 * l1).sqrt(), (2.0 * l2).sqrt());
+    [v1.map(|x| x * s1), v2.map(|x| x * s2)]
 }
 
 #[cfg(test)]
@@ -315,5 +377,45 @@ mod tests {
         assert!(s.share > 0.5 && s.share < 1.0, "{}", s.share);
         let sphere: f64 = (0..h).map(|j| texel_solid_angle(w, h, j)).sum::<f64>() * w as f64;
         assert!((sphere / (4.0 * PI) - 1.0).abs() < 1e-12);
+    }
+
+    /// A strip of nine equal texels along the equator is one light long in
+    /// azimuth and without extent in polar angle: its first axis is
+    /// horizontal, `sqrt(2 mean(sin^2 delta))` long for the texels' azimuth
+    /// offsets `delta` from its centre (their tangent-plane offsets), its
+    /// second nearly zero (the row's curvature: second order in `delta`).
+    #[test]
+    fn a_strips_axes_follow_its_length() {
+        let (w, h) = (256, 128);
+        let mut t = vec![0.0f32; w * h * 4];
+        for p in 0..w * h {
+            t[4 * p..4 * p + 3].copy_from_slice(&[0.01; 3]);
+        }
+        // rows 63 and 64 straddle the equator: take row 64's centre
+        for i in 100..109 {
+            let p = 64 * w + i;
+            t[4 * p..4 * p + 3].copy_from_slice(&[100.0; 3]);
+        }
+        // one light (more would cut the strip into pieces)
+        let one = SplitOptions {
+            max_lights: 1,
+            ..SplitOptions::default()
+        };
+        let s = split(w, h, &t, one);
+        assert_eq!(s.lights.len(), 1);
+        let [a1, a2] = s.lights[0].axes;
+        let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let dphi = TAU / w as f64;
+        let theta = 64.5 / h as f64 * PI;
+        // the tangent-plane offset of a texel delta away in azimuth at polar
+        // angle theta, from the light's direction (on the same row)
+        let ms: f64 = (-4..=4)
+            .map(|k| (theta.sin() * (k as f64 * dphi).sin()).powi(2))
+            .sum::<f64>()
+            / 9.0;
+        let want = (2.0 * ms).sqrt();
+        assert!((len(a1) / want - 1.0).abs() < 0.01, "{} vs {want}", len(a1));
+        assert!(a1[1].abs() < 1e-9 * len(a1), "horizontal: {a1:?}");
+        assert!(len(a2) < 0.01 * len(a1), "little polar extent: {a2:?}");
     }
 }

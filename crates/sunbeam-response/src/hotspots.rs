@@ -5,7 +5,8 @@
 //! A light of basis power `P_k = int c_k d(omega)` over a small solid angle
 //! adds `G(wi, wr) sum_k P_k E_k(-wi - wr)`: the maps integrate over `(u,
 //! v)`, and `d(u, v) = cos(theta_i) d(omega)` cancels their `1 / cos`. Its
-//! extent is four taps at its spread around its direction (one without).
+//! extent is four taps on its principal axes (`HotSpot::axes`: they have the
+//! light's second moments; one tap for a single texel).
 
 use crate::cells::Frame;
 use crate::Response;
@@ -15,14 +16,6 @@ use sunbeam_optics::masking::Masking;
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn unit(v: [f64; 3]) -> [f64; 3] {
@@ -35,16 +28,10 @@ pub fn taps(l: &HotSpot) -> Vec<([f64; 3], f64)> {
     if l.spread.is_nan() || l.spread <= 0.0 {
         return vec![(l.dir, 1.0)];
     }
-    let a = if l.dir[1].abs() < 0.9 {
-        [0.0, 1.0, 0.0]
-    } else {
-        [1.0, 0.0, 0.0]
-    };
-    let e1 = unit(cross(a, l.dir));
-    let e2 = cross(l.dir, e1);
+    let [a1, a2] = l.axes;
     [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)]
         .map(|(p, q)| {
-            let d = [0, 1, 2].map(|k| l.dir[k] + l.spread * (p * e1[k] + q * e2[k]));
+            let d = [0, 1, 2].map(|k| l.dir[k] + p * a1[k] + q * a2[k]);
             (unit(d), 0.25)
         })
         .to_vec()
