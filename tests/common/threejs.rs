@@ -86,11 +86,21 @@ pub fn threejs_frame(render: &Path, d: &Path, scene: &Path, name: &str) -> Linea
 /// The reference of the scene file `scene` (`sunbeam-eval render --samples
 /// 16`), written as `out` (EXR).
 pub fn reference_frame(scene: &Path, out: &Path) -> LinearImage {
+    reference_frame_at(scene, out, 16)
+}
+
+/// [`reference_frame`] at `samples` per pixel. Under an environment the
+/// quadrature's cost per pixel hardly grows with the samples (a pixel's
+/// samples share the maps' texels: docs/LIGHTING.md "Quadrature"), and
+/// thin meshes need many: the baked snake under the sky at 96 x 48, two
+/// seeds differ by CIEDE2000 p99 25.9 / 14.2 / 5.4 at 16 / 64 / 256 samples
+/// (10.9 s / 13.0 s / 13.3 s, 2026-11-27).
+pub fn reference_frame_at(scene: &Path, out: &Path, samples: u32) -> LinearImage {
     run_ok(
         Command::new(tool("sunbeam-eval"))
             .arg("render")
             .arg(scene)
-            .args(["--samples", "16", "-q", "-o"])
+            .args(["--samples", &samples.to_string(), "-q", "-o"])
             .arg(out),
     );
     LinearImage::read_exr(out).unwrap()
@@ -100,12 +110,24 @@ pub fn reference_frame(scene: &Path, out: &Path) -> LinearImage {
 /// `ref_scene` (written into `d` as NAME.json and NAME-ref.json): the
 /// difference over lit pixels.
 pub fn measure(render: &Path, d: &Path, scene: &str, ref_scene: &str, name: &str) -> ColourDiff {
+    measure_at(render, d, scene, ref_scene, name, 16)
+}
+
+/// [`measure`] with the reference at `samples` per pixel.
+pub fn measure_at(
+    render: &Path,
+    d: &Path,
+    scene: &str,
+    ref_scene: &str,
+    name: &str,
+    samples: u32,
+) -> ColourDiff {
     let s = d.join(format!("{name}.json"));
     std::fs::write(&s, scene).unwrap();
     let rs = d.join(format!("{name}-ref.json"));
     std::fs::write(&rs, ref_scene).unwrap();
     let a = threejs_frame(render, d, &s, name);
-    let r = reference_frame(&rs, &d.join(format!("{name}-ref.exr")));
+    let r = reference_frame_at(&rs, &d.join(format!("{name}-ref.exr")), samples);
     let c = compare_linear(&a, &r).unwrap();
     eprintln!("three.js {name}: {c}");
     assert!(c.pixels > 200, "{name}: only {} lit pixels", c.pixels);
