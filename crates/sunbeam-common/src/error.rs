@@ -14,6 +14,9 @@ pub enum ExitCode {
     Output = 3,
     Internal = 4,
     CheckFailed = 5,
+    /// stdout's reader left (`tool | head`): a shell's status for a process
+    /// killed by SIGPIPE (128 + 13), ended without a message.
+    BrokenPipe = 141,
 }
 
 /// An error with a message meant for a person and the exit code it maps to.
@@ -46,6 +49,18 @@ impl Error {
         Self {
             code: ExitCode::Output,
             message: msg.into(),
+        }
+    }
+    /// Writing stdout failed: [`ExitCode::BrokenPipe`] when its reader has
+    /// gone, else an output error.
+    pub fn stdout(e: std::io::Error) -> Self {
+        Self {
+            code: if e.kind() == std::io::ErrorKind::BrokenPipe {
+                ExitCode::BrokenPipe
+            } else {
+                ExitCode::Output
+            },
+            message: format!("stdout: {e}"),
         }
     }
     pub fn output_file(path: &Path, msg: impl fmt::Display) -> Self {
@@ -83,10 +98,6 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
-/// The exit status when stdout's reader has gone (`tool | head`): a shell's
-/// for a process killed by SIGPIPE.
-pub const BROKEN_PIPE_EXIT: i32 = 141;
-
 /// Whether a panic is `print!` failing on a closed pipe (its message names
 /// stdout and the OS error; std offers no typed payload for it).
 fn is_broken_pipe(info: &std::panic::PanicHookInfo<'_>) -> bool {
@@ -110,7 +121,7 @@ pub fn run_main(tool: &str, body: impl FnOnce() -> Result<()>) -> ! {
             // `tool | head`: the reader left. Rust ignores SIGPIPE, so
             // `println!` panics; end as a process killed by SIGPIPE would
             // (128 + 13), without a message, as other Unix tools do.
-            std::process::exit(BROKEN_PIPE_EXIT);
+            std::process::exit(ExitCode::BrokenPipe as i32);
         }
         eprintln!("{tool_name}: internal error (a bug, please report): {info}");
     }));
@@ -122,11 +133,8 @@ pub fn run_main(tool: &str, body: impl FnOnce() -> Result<()>) -> ! {
             eprintln!("{tool}: {e}");
             e.exit_code()
         }
-        // A tool that writes stdout itself reports the closed pipe as an
-        // error `stdout: ...` (tools/sunbeam-eval probe, sunbeam-bake).
-        Ok(Err(e)) if e.message.starts_with("stdout: ") && e.message.contains("os error 32") => {
-            BROKEN_PIPE_EXIT
-        }
+        // A tool that writes stdout itself ([`Error::stdout`]).
+        Ok(Err(e)) if e.code == ExitCode::BrokenPipe => e.exit_code(),
         Ok(Err(e)) => {
             eprintln!("{tool}: error: {e}");
             e.exit_code()

@@ -256,7 +256,7 @@ pub fn split(w: usize, h: usize, rgba: &[f32], opts: SplitOptions) -> Split {
 }
 
 /// A tangent basis at unit `d` (any: the axes below do not depend on it).
-pub fn tangent_basis(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+fn tangent_basis(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     let a = if d[1].abs() < 0.9 {
         [0.0, 1.0, 0.0]
     } else {

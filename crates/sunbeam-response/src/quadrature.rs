@@ -449,9 +449,7 @@ fn split_map(m: &sunbeam_light::EnvMap) -> (Prefiltered, Vec<Lamp>) {
     use std::f64::consts::{PI, TAU};
     let (w, h) = (m.width(), m.height());
     let texels = m.texels();
-    let omega = |j: usize| {
-        ((PI * j as f64 / h as f64).cos() - (PI * (j + 1) as f64 / h as f64).cos()) * TAU / w as f64
-    };
+    let omega = |j: usize| sunbeam_light::hotspots::texel_solid_angle(w, h, j);
     let y = |c: [f32; 3]| f64::from(c[0]) + f64::from(c[1]) + f64::from(c[2]);
     let total: f64 = texels
         .iter()

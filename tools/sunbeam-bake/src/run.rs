@@ -137,7 +137,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         std::io::stdout()
             .lock()
             .write_all(&glb)
-            .map_err(|e| Error::output(format!("stdout: {e}")))?;
+            .map_err(Error::stdout)?;
     } else {
         sunbeam_common::output::write_atomic(&cli.output, &glb)?;
         baked.report.output = Some(cli.output.display().to_string());

@@ -17,7 +17,6 @@ pub fn run(src: &Source, points_path: &Path) -> Result<()> {
     }
     let stdout = std::io::stdout();
     let mut lock = stdout.lock();
-    lock.write_all(out.as_bytes())
-        .map_err(|e| Error::output(format!("stdout: {e}")))?;
+    lock.write_all(out.as_bytes()).map_err(Error::stdout)?;
     Ok(())
 }
