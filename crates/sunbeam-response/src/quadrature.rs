@@ -350,17 +350,10 @@ impl EnvQuadrature {
     /// `G sum_k P_k E_k(-wi - wr)` (`d(u, v) = cos(theta_i) d(omega)`
     /// cancels `1 / cos`, as for the sun).
     fn point_light(&self, q: &Query, dir: [f64; 3], power: [f64; 3]) -> [f64; 3] {
-        let (t, b, n) = q.frame;
-        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        let wi = [dot(dir, t), dot(dir, b), dot(dir, n)];
-        if wi[2] <= 0.0 {
+        let Some((wi, gain)) = incoming(q, dir) else {
             return [0.0; 3];
-        }
+        };
         let wr = q.wr;
-        let gain = q.masking.gain(wi, wr, q.skin);
-        if gain <= 0.0 || !gain.is_finite() {
-            return [0.0; 3];
-        }
         let g = &self.grid;
         let Some(c) = g.coords(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]) else {
             return [0.0; 3];
@@ -382,14 +375,10 @@ impl EnvQuadrature {
     /// cancels `1 / cos`).
     fn sun_term(&self, env: &Environment, q: &Query) -> [f64; 3] {
         let mut xyz = [0.0; 3];
-        let (t, b, n) = q.frame;
         if let (Some(sky), false) = (env.sun(), self.sun.is_empty()) {
             if let Some((d, _)) = sky.sample_sun(q.sun_u[0], q.sun_u[1]) {
-                let dot = |a: [f64; 3]| a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
-                let wi = [dot(t), dot(b), dot(n)];
                 let wr = q.wr;
-                if wi[2] > 0.0 {
-                    let gain = q.masking.gain(wi, wr, q.skin);
+                if let Some((wi, gain)) = incoming(q, d) {
                     let e = self.lookup_sun(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
                     for a in 0..3 {
                         xyz[a] += gain * e[a];
@@ -412,6 +401,20 @@ impl EnvQuadrature {
             [0, 1, 2].map(|a| f64::from(self.sun[o + a]))
         })
     }
+}
+
+/// World direction `d` of a point light in `q`'s frame and its gain
+/// (`G` times the masking), or None below the horizon or without gain: what
+/// the sun and a map's lamps share.
+fn incoming(q: &Query, d: [f64; 3]) -> Option<([f64; 3], f64)> {
+    let (t, b, n) = q.frame;
+    let dot = |a: [f64; 3]| a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
+    let wi = [dot(t), dot(b), dot(n)];
+    if wi[2] <= 0.0 {
+        return None;
+    }
+    let gain = q.masking.gain(wi, q.wr, q.skin);
+    (gain > 0.0 && gain.is_finite()).then_some((wi, gain))
 }
 
 /// A map texel brighter than this many times the map's mean brightness (the
