@@ -121,6 +121,11 @@ impl Gpu {
         )
     }
 
+    /// The adapter is a CPU rasteriser (lavapipe, llvmpipe, WARP).
+    pub fn is_cpu(&self) -> bool {
+        self.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+    }
+
     /// Errors wgpu reported since the last call (validation errors are bugs: exit 4).
     pub fn take_errors(&self) -> Result<()> {
         let v: Vec<String> = self

@@ -535,6 +535,8 @@ impl Scene {
             scene.lights.clear();
             scene.environment = Some(Scene::default_sky());
             scene.exposure = Scene::DEFAULT_SKY_EXPOSURE;
+            // The sky is drawn behind the mesh: what is lighting it is in view.
+            scene.background = Background::Environment;
             // The sky reaches every grazing view: without masking a limb pixel
             // does not settle (docs/LIGHTING.md "Grazing views: masking").
             if scene.meshes[0].pack.is_some() {

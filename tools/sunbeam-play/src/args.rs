@@ -68,10 +68,12 @@ pub(crate) struct Cli {
     #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_SAMPLES)]
     pub(crate) env_samples: u32,
     /// Environment scenes: `monte-carlo` (progressive, unbiased, settles over
-    /// thousands of frames) or `cells` (close in the first frame, frames only
-    /// anti-alias; on a CPU rasteriser tens of times a Lambert frame).
+    /// thousands of frames), `cells` (close in the first frame, frames only
+    /// anti-alias; on a CPU rasteriser tens of times a Lambert frame) or `auto`
+    /// (the default: `cells` for a single headless frame, the one written;
+    /// `monte-carlo` in the window, for `--frames` > 1 and for `--bench`).
     /// docs/LIGHTING.md "The first frame".
-    #[arg(long, value_enum, default_value_t = EnvEstimatorArg::MonteCarlo)]
+    #[arg(long, value_enum, default_value_t = EnvEstimatorArg::Auto)]
     pub(crate) env_estimator: EnvEstimatorArg,
     /// Environment scenes, `--env-estimator cells`: cells every view visits
     /// (1..4096; more: closer to the reference, slower; docs/LIGHTING.md
@@ -135,6 +137,7 @@ pub(crate) struct Cli {
 /// `--env-estimator` values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum EnvEstimatorArg {
+    Auto,
     Cells,
     MonteCarlo,
 }

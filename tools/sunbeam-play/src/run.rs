@@ -7,6 +7,7 @@ use std::time::Duration;
 use sunbeam_common::{Error, Result};
 use sunbeam_frame::{Image, LinearImage, Prepared};
 use sunbeam_optics::colour::ToneCurve;
+use sunbeam_render::env::EnvEstimator;
 use sunbeam_render::window::{self, WindowOptions};
 use sunbeam_render::{Backend, Gpu, Mode, Settings};
 use sunbeam_scene::Scene;
@@ -65,6 +66,26 @@ fn msaa_for(cli: &Cli, scene: &Scene) -> u32 {
     cli.msaa.unwrap_or(if accumulating { 1 } else { 4 })
 }
 
+/// `--env-estimator`, `auto` resolved: a single headless frame is the whole
+/// product, so it takes the estimator that is right in one frame (`cells`:
+/// a Monte Carlo frame alone is coloured grain, docs/LIGHTING.md "The first
+/// frame"); the window, `--bench` (the window's frame times) and more than
+/// one `--frames` (the settled frame: the mean of progressive frames) take `monte-carlo`,
+/// whose frames cost a few Lambert frames where the cells' cost tens.
+fn estimator_for(cli: &Cli) -> EnvEstimator {
+    match cli.env_estimator {
+        EnvEstimatorArg::Cells => EnvEstimator::Cells,
+        EnvEstimatorArg::MonteCarlo => EnvEstimator::MonteCarlo,
+        EnvEstimatorArg::Auto => {
+            if cli.headless && !cli.bench && cli.frames.unwrap_or(1) == 1 {
+                EnvEstimator::Cells
+            } else {
+                EnvEstimator::MonteCarlo
+            }
+        }
+    }
+}
+
 fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
     let mut mode: Mode = cli.mode;
     if cli.thesis && cli.lambert {
@@ -97,12 +118,7 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
     }
     Ok(Settings {
         env_samples: cli.env_samples,
-        env_estimator: match cli.env_estimator {
-            crate::args::EnvEstimatorArg::Cells => sunbeam_render::env::EnvEstimator::Cells,
-            crate::args::EnvEstimatorArg::MonteCarlo => {
-                sunbeam_render::env::EnvEstimator::MonteCarlo
-            }
-        },
+        env_estimator: estimator_for(cli),
         mode,
         lambda_samples: cli.lambda_samples,
         curve,
@@ -182,6 +198,13 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         "mode": format!("{:?}", st.mode).to_lowercase(),
         "msaa": st.msaa,
     });
+    if scene.environment.is_some() {
+        report["env_estimator"] = match st.env_estimator {
+            EnvEstimator::Cells => "cells",
+            EnvEstimator::MonteCarlo => "monte-carlo",
+        }
+        .into();
+    }
     if let Some((line, c)) = sunbeam_frame::environment_clamped_warning(&prepared) {
         if !cli.quiet {
             eprintln!("sunbeam-play: warning: {line}");
@@ -203,6 +226,18 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     } else {
         let gpu = Gpu::headless(backend)?;
         report["adapter"] = gpu.describe().into();
+        if st.env_estimator == EnvEstimator::Cells
+            && prepared.environment.is_some()
+            && gpu.is_cpu()
+            && !cli.quiet
+            && !cli.bench
+        {
+            eprintln!(
+                "sunbeam-play: the first frame under an environment (--env-estimator cells) on a \
+                 CPU rasteriser takes tens of seconds at 512 x 512; --env-estimator monte-carlo \
+                 draws a quick, noisy one"
+            );
+        }
         if cli.bench {
             let frames = cli.frames.unwrap_or(10).max(2);
             let (times, img) = sunbeam_render::bench_headless(&gpu, &prepared, &st, size, frames)?;

@@ -349,10 +349,12 @@ fn bad_environments_exit_2() {
     }
 }
 
-/// The default scene of `--mesh --pack` is sky-lit (issue #13): the player
-/// builds the environment's maps and accumulates; `--lighting point` keeps the
-/// point-lit scene (no environment, nothing accumulated); a bad value is a
-/// usage error naming the flag.
+/// The default scene of `--mesh --pack` is sky-lit (issue #13), with the sky
+/// drawn behind the mesh: the player builds the environment's maps and
+/// accumulates over `--frames` 3 with Monte Carlo; one frame (no `--frames`)
+/// takes the first-frame estimator (`--env-estimator auto`: cells);
+/// `--lighting point` keeps the point-lit scene (no environment, nothing
+/// accumulated); a bad value is a usage error naming the flag.
 #[test]
 fn default_scene_is_sky_lit() {
     if !have_gpu() {
@@ -364,21 +366,13 @@ fn default_scene_is_sky_lit() {
         Command::new(BIN)
             .args(["--mesh", "builtin:sphere", "--pack"])
             .arg(dir.join("ridge.ktx2"))
-            .args([
-                "--headless",
-                "--size",
-                "32x32",
-                "--frames",
-                "3",
-                "--json",
-                "-o",
-            ])
-            .arg(dir.join("f.png"))
+            .args(["--headless", "--size", "32x32", "--json"])
             .args(extra)
             .output()
             .unwrap()
     };
-    let o = run(&[]);
+    let f = dir.join("f.png");
+    let o = run(&["--frames", "3", "-o", f.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(
@@ -387,14 +381,35 @@ fn default_scene_is_sky_lit() {
     );
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(r["accumulated_frames"].as_u64(), Some(3), "{r}");
-    let o = run(&["--lighting", "point"]);
+    assert_eq!(r["env_estimator"], "monte-carlo", "{r}");
+    // One frame, the product itself: the estimator that is right in it.
+    let one = dir.join("one.exr");
+    let o = run(&["-o", one.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["accumulated_frames"].as_u64(), Some(1), "{r}");
+    assert_eq!(r["env_estimator"], "cells", "{r}");
+    // The sky behind the sphere: the top corner sees it, lit and blue
+    // (the sky's zenith is bluer than its horizon and the ground grey).
+    let img = LinearImage::read_exr(&one).unwrap();
+    let [cr, _, cb] = img.rgb[0];
+    assert!(cb > 0.0 && cb > cr, "top-left corner {:?}", img.rgb[0]);
+    let o = run(&[
+        "--env-estimator",
+        "monte-carlo",
+        "-o",
+        one.to_str().unwrap(),
+    ]);
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["env_estimator"], "monte-carlo", "{r}");
+    let o = run(&["--lighting", "point", "-o", f.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(
         r["accumulated_frames"].as_u64().unwrap_or(0) == 0,
         "point-lit frames do not accumulate: {r}"
     );
-    let o = run(&["--lighting", "moon"]);
+    let o = run(&["--lighting", "moon", "-o", f.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--lighting"));
 }
