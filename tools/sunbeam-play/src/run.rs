@@ -127,7 +127,15 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
         footprint: !cli.no_footprint,
         env_hot_spots: cli.env_hot_spots as usize,
         env_cells_rate: cli.env_cells_rate,
-        env_cells: (cli.env_cells as usize, sunbeam_render::env::ENV_CELLS_DEPTH),
+        env_cells: (
+            cli.env_cells.unwrap_or_else(|| {
+                scene.environment.as_ref().map_or(
+                    sunbeam_render::env::DEFAULT_ENV_CELLS,
+                    sunbeam_render::env::default_env_cells,
+                )
+            }) as usize,
+            sunbeam_render::env::ENV_CELLS_DEPTH,
+        ),
         ..Default::default()
     })
 }
@@ -204,6 +212,9 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             EnvEstimator::MonteCarlo => "monte-carlo",
         }
         .into();
+        if st.env_estimator == EnvEstimator::Cells {
+            report["env_cells"] = st.env_cells.0.into();
+        }
     }
     if let Some((line, c)) = sunbeam_frame::environment_clamped_warning(&prepared) {
         if !cli.quiet {
