@@ -20,26 +20,14 @@ pub const MAX_LEVELS: usize = 16;
 /// Proposal samples per pixel per frame (the sun and the diffuse part take one each).
 pub const DEFAULT_ENV_SAMPLES: u32 = 1;
 
-/// Cells of the first-frame estimator's top cut (`--env-cells`) under the sky.
-pub const DEFAULT_ENV_CELLS: u64 = sunbeam_response::cells::DEFAULT_TOP as u64;
-/// The same under an HDR image: what its hot spots leave to the cells is
-/// sharper than the sky. On a 64 x 64 sphere (5 um pack, masked; the first
-/// frame 4 x 4 supersampled against two 64-sample reference seeds,
-/// 2026-11-27) the interior's CIEDE2000 p99 at 128 / 256 / 512 cells was
-/// 3.95 / 2.86 / 1.66 under studio.exr and 2.58 / 1.98 / 1.20 under
-/// night.exr, against 2.17 / 1.71 / 1.36 under the sky, at about 0.55 /
-/// 1 / 1.6 times the time (docs/LIGHTING.md "How many cells").
-pub const DEFAULT_ENV_CELLS_MAP: u64 = 512;
-
-/// `--env-cells` when not given: [`DEFAULT_ENV_CELLS_MAP`] under a map,
-/// [`DEFAULT_ENV_CELLS`] under the sky.
-pub fn default_env_cells(env: &sunbeam_scene::Environment) -> u64 {
-    if env.map.is_some() {
-        DEFAULT_ENV_CELLS_MAP
-    } else {
-        DEFAULT_ENV_CELLS
-    }
-}
+/// Cells of the first-frame estimator's top cut (`--env-cells`), twice the
+/// CPU twin's [`sunbeam_response::cells::DEFAULT_TOP`]. On a 64 x 64 sphere
+/// (5 um pack, masked; the first frame 4 x 4 supersampled against two
+/// 64-sample reference seeds, 2026-11-27) the interior's CIEDE2000 p99 at
+/// 128 / 256 / 512 cells was 2.17 / 1.71 / 1.36 under the sky, 3.95 / 2.86 /
+/// 1.66 under studio.exr and 2.58 / 1.98 / 1.20 under night.exr, at about
+/// 0.55 / 1 / 1.6 times the time (docs/LIGHTING.md "How many cells").
+pub const DEFAULT_ENV_CELLS: u64 = 512;
 /// Levels kept below the top cut for views whose horizon a cell reaches.
 pub const ENV_CELLS_DEPTH: usize = sunbeam_response::cells::DEFAULT_DEPTH;
 /// The environment's hot spots as at most this many lights (`--env-hot-spots`).

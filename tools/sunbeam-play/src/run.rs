@@ -127,15 +127,7 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
         footprint: !cli.no_footprint,
         env_hot_spots: cli.env_hot_spots as usize,
         env_cells_rate: cli.env_cells_rate,
-        env_cells: (
-            cli.env_cells.unwrap_or_else(|| {
-                scene.environment.as_ref().map_or(
-                    sunbeam_render::env::DEFAULT_ENV_CELLS,
-                    sunbeam_render::env::default_env_cells,
-                )
-            }) as usize,
-            sunbeam_render::env::ENV_CELLS_DEPTH,
-        ),
+        env_cells: (cli.env_cells as usize, sunbeam_render::env::ENV_CELLS_DEPTH),
         ..Default::default()
     })
 }

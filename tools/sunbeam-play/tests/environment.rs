@@ -389,7 +389,7 @@ fn default_scene_is_sky_lit() {
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(r["accumulated_frames"].as_u64(), Some(1), "{r}");
     assert_eq!(r["env_estimator"], "cells", "{r}");
-    assert_eq!(r["env_cells"], 256, "{r}");
+    assert_eq!(r["env_cells"], 512, "{r}");
     // The sky behind the sphere: the top corner sees it, lit and blue
     // (the sky's zenith is bluer than its horizon and the ground grey).
     let img = LinearImage::read_exr(&one).unwrap();
@@ -528,7 +528,6 @@ fn rotating_the_map_equals_rotating_the_scene_back_in_the_first_frame() {
     let fa = dir.join("a.exr");
     first(&a, &fa, None);
     let rep = first(&b, &dir.join("b.exr"), Some(&fa));
-    // A map's default cell count (the sky's is 256: default_scene_is_sky_lit).
     assert_eq!(rep["env_cells"], 512, "{rep}");
     eprintln!(
         "rotated map vs rotated scene, first frame: {}",
