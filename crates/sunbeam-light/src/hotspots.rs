@@ -255,29 +255,10 @@ pub fn split(w: usize, h: usize, rgba: &[f32], opts: SplitOptions) -> Split {
     }
 }
 
-/// A tangent basis at unit `d` (any: the axes below do not depend on it).
-fn tangent_basis(d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let a = if d[1].abs() < 0.9 {
-        [0.0, 1.0, 0.0]
-    } else {
-        [1.0, 0.0, 0.0]
-    };
-    let c = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let e1 = c(a, d);
-    let l = (e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]).sqrt();
-    let e1 = e1.map(|x| x / l);
-    (e1, c(d, e1))
-}
-
 /// [`HotSpot::axes`] of weighted directions `pts` about unit `dir`.
 fn principal_axes(dir: [f64; 3], pts: impl Iterator<Item = ([f64; 3], f64)>) -> [[f64; 3]; 2] {
-    let (e1, e2) = tangent_basis(dir);
+    // any tangent basis: the axes do not depend on it
+    let (e1, e2) = crate::sky::basis(dir);
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let (mut sw, mut m) = (0.0, [0.0f64; 3]);
     for (d, wt) in pts {

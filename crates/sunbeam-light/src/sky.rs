@@ -425,7 +425,7 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 /// Two unit vectors perpendicular to `n` and each other.
-fn basis(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+pub(crate) fn basis(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     let a = if n[0].abs() < 0.9 {
         [1.0, 0.0, 0.0]
     } else {

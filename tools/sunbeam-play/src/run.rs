@@ -61,9 +61,14 @@ fn load_scene(cli: &Cli) -> Result<Scene> {
 /// per pixel (the sky-lit sphere's edge pixels at p99 34.9 against 13.9 with
 /// MSAA, docs/bench/play.md "The first frame with the energy bound").
 fn msaa_for(cli: &Cli, scene: &Scene) -> u32 {
-    let accumulating =
-        scene.environment.is_some() && cli.headless && !cli.bench && cli.frames.unwrap_or(1) > 1;
+    let accumulating = scene.environment.is_some() && headless_frames(cli).is_some_and(|n| n > 1);
     cli.msaa.unwrap_or(if accumulating { 1 } else { 4 })
+}
+
+/// The frames a headless run writes (their mean, under an environment);
+/// None for the window and `--bench`.
+fn headless_frames(cli: &Cli) -> Option<u32> {
+    (cli.headless && !cli.bench).then(|| cli.frames.unwrap_or(1))
 }
 
 /// `--env-estimator`, `auto` resolved: a single headless frame is the whole
@@ -77,7 +82,7 @@ fn estimator_for(cli: &Cli) -> EnvEstimator {
         EnvEstimatorArg::Cells => EnvEstimator::Cells,
         EnvEstimatorArg::MonteCarlo => EnvEstimator::MonteCarlo,
         EnvEstimatorArg::Auto => {
-            if cli.headless && !cli.bench && cli.frames.unwrap_or(1) == 1 {
+            if headless_frames(cli) == Some(1) {
                 EnvEstimator::Cells
             } else {
                 EnvEstimator::MonteCarlo
