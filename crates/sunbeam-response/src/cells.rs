@@ -34,6 +34,7 @@
 
 use crate::grid::Grid;
 use crate::Response;
+use rayon::prelude::*;
 use std::collections::BinaryHeap;
 use sunbeam_optics::gain;
 use sunbeam_optics::masking::Masking;
@@ -113,20 +114,28 @@ impl Cells {
         assert_eq!(basis.len(), 3, "three basis maps");
         let g = basis[0].info.grid;
         let (nt, nr, ns) = (g.n_theta, g.n_rho, g.n_s);
-        // Texels as the quadrature's: centre, area.
-        let mut texels = Vec::new();
-        let mut areas = vec![0.0; nr];
-        for (j, area) in areas.iter_mut().enumerate() {
-            *area = g.texel_extent(j).2;
-            let r = g.r_at(j);
-            for i in 0..nt {
-                let mut y = 0.0;
+        // Texels as the quadrature's: centre, area. The maps' Y summed over
+        // the layers and maps, in memory order (layer-major), rows in parallel.
+        let areas: Vec<f64> = (0..nr).map(|j| g.texel_extent(j).2).collect();
+        let y_sum: Vec<f64> = (0..nr)
+            .into_par_iter()
+            .flat_map_iter(|j| {
+                let mut row = vec![0.0; nt];
                 for k in 0..ns {
                     for m in basis {
-                        y += m.texel(i, j, k)[1].abs();
+                        for (i, y) in row.iter_mut().enumerate() {
+                            *y += m.texel_channel(i, j, k, 1).abs();
+                        }
                     }
                 }
-                let m = *area * y / ns as f64;
+                row
+            })
+            .collect();
+        let mut texels = Vec::new();
+        for (j, area) in areas.iter().enumerate() {
+            let r = g.r_at(j);
+            for i in 0..nt {
+                let m = *area * y_sum[j * nt + i] / ns as f64;
                 if m > 0.0 {
                     let th = g.theta_at(i);
                     texels.push(Texel {
@@ -144,25 +153,6 @@ impl Cells {
                 n_top: 0,
             };
         }
-        let mass_of = |members: &[u32]| -> Vec<[f64; 9]> {
-            let mut out = vec![[0.0; 9]; ns];
-            for &t in members {
-                let (j, i) = (
-                    texels[t as usize].t as usize / nt,
-                    texels[t as usize].t as usize % nt,
-                );
-                let a = areas[j];
-                for (k, o) in out.iter_mut().enumerate() {
-                    for (b, map) in basis.iter().enumerate() {
-                        let e = map.texel(i, j, k);
-                        for c in 0..3 {
-                            o[3 * b + c] += a * e[c];
-                        }
-                    }
-                }
-            }
-            out
-        };
         let stats = |members: &[u32]| -> ([f64; 2], f64, f64) {
             let (mut m, mut su, mut sv) = (0.0, 0.0, 0.0);
             for &t in members {
@@ -246,6 +236,8 @@ impl Cells {
             queue.push((out.len() - 1, m, 0));
         }
         let n_top = out.len();
+        // The leaves partition the texels: `owner` maps a texel to its leaf.
+        let mut owner = vec![u32::MAX; nt * nr];
         let mut q = 0;
         while q < queue.len() {
             let (id, members, d) = std::mem::take(&mut queue[q]);
@@ -253,9 +245,13 @@ impl Cells {
             let (c, _, var) = stats(&members);
             out[id].uv = c;
             out[id].spread = var.sqrt();
-            out[id].mass = mass_of(&members);
-            if d < depth && var > 0.0 {
-                if let Some((a, b)) = split(&members) {
+            let halves = if d < depth && var > 0.0 {
+                split(&members)
+            } else {
+                None
+            };
+            match halves {
+                Some((a, b)) => {
                     let ia = out.len();
                     out.push(out[id].clone());
                     out.push(out[id].clone());
@@ -263,11 +259,53 @@ impl Cells {
                     queue.push((ia, a, d + 1));
                     queue.push((ia + 1, b, d + 1));
                 }
+                None => {
+                    for &t in &members {
+                        owner[texels[t as usize].t as usize] = id as u32;
+                    }
+                }
             }
         }
-        for c in out.iter_mut() {
-            if c.children.is_none() && c.mass.is_empty() {
-                c.mass = vec![[0.0; 9]; ns];
+        // Masses: each leaf's by one pass over the maps in memory order (a
+        // layer per task), then each parent's as the sum of its children's
+        // (children come after their parent). One pass instead of one per
+        // tree level, and no strided reads: most of the player's start-up
+        // under an environment before (docs/bench/play.md "Start-up").
+        let per_layer: Vec<Vec<[f64; 9]>> = (0..ns)
+            .into_par_iter()
+            .map(|k| {
+                let mut acc = vec![[0.0; 9]; out.len()];
+                for j in 0..nr {
+                    let a = areas[j];
+                    for i in 0..nt {
+                        let leaf = owner[j * nt + i];
+                        if leaf == u32::MAX {
+                            continue;
+                        }
+                        let o = &mut acc[leaf as usize];
+                        for (b, map) in basis.iter().enumerate() {
+                            let e = map.texel(i, j, k);
+                            for c in 0..3 {
+                                o[3 * b + c] += a * e[c];
+                            }
+                        }
+                    }
+                }
+                acc
+            })
+            .collect();
+        for (id, cell) in out.iter_mut().enumerate() {
+            cell.mass = per_layer.iter().map(|l| l[id]).collect();
+        }
+        for id in (0..out.len()).rev() {
+            if let Some([a, b]) = out[id].children {
+                let (ma, mb) = (&out[a as usize].mass, &out[b as usize].mass);
+                let sum: Vec<[f64; 9]> = ma
+                    .iter()
+                    .zip(mb)
+                    .map(|(x, y)| std::array::from_fn(|c| x[c] + y[c]))
+                    .collect();
+                out[id].mass = sum;
             }
         }
         Cells {

@@ -126,6 +126,12 @@ impl Response {
         [0, 1, 2].map(|c| half::f16::from_bits(self.data[o + c]).to_f64())
     }
 
+    /// Channel `c` (0, 1, 2: X, Y, Z) of texel `(i, j, k)`.
+    pub fn texel_channel(&self, i: usize, j: usize, k: usize, c: usize) -> f64 {
+        let g = &self.info.grid;
+        half::f16::from_bits(self.data[4 * ((k * g.n_rho + j) * g.n_theta + i) + c]).to_f64()
+    }
+
     /// `T(u, v, w)` (XYZ without `G`) by trilinear interpolation, angle wrapping,
     /// radius and `s` clamped: what a shader's single texture sample returns.
     pub fn lookup(&self, u: f64, v: f64, w: f64) -> [f64; 3] {
