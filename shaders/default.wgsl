@@ -33,8 +33,8 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
     return shade(in, covered);
 }
 
-// The cells' pre-pass (g.cells_rate > 1; shaders/environment.wgsl
-// env_cells_shared): on the coarse grid, the cells' XYZ at the pixel centre
+// The cells' coarse pre-pass (g.cells_rate > 1; shaders/environment.wgsl
+// env_cells_shared, in the centre pass): on the coarse grid, the cells' XYZ at the pixel centre
 // (w: 1 where this mesh diffracts under the environment and the view is above
 // ENV_GRAZING_COS, else 0: the full-rate pass walks those itself), the
 // frame's normal and the distance to the eye, and its tangent.
@@ -43,6 +43,32 @@ struct CellsOut {
     @location(1) nd: vec4<f32>,
     @location(2) t: vec4<f32>,
 };
+
+// The centre pass (g.cells_rate >= 1): single-sampled at the frame's size,
+// the cells' XYZ at each pixel centre, from the coarse grid where it serves
+// (shaders/environment.wgsl env_cells_shared), else one walk (w: 1 where
+// shaded, as fs_cells), and the frame's normal with the distance to the eye.
+// The frame's pass reads them (env_cells_pixel) instead of walking once per
+// triangle that touches the pixel.
+struct CentreOut {
+    @location(0) xyz: vec4<f32>,
+    @location(1) nd: vec4<f32>,
+};
+
+@fragment
+fn fs_cells_centre(in: VsOut) -> CentreOut {
+    let fr = frame_at(in.normal, in.tangent, in.uv, in.uv_tangent);
+    let wr = normalize(g.eye.xyz - in.world);
+    let wr_l = vec3<f32>(dot(wr, fr[0]), dot(wr, fr[1]), dot(wr, fr[2]));
+    let dist = length(g.eye.xyz - in.world);
+    var o: CentreOut;
+    o.xyz = vec4<f32>(0.0);
+    if (envg.on == 1u && envp.on == 1u && mat.has_pack == 1u && mat.base.w < 1.0 && wr_l.z > ENV_GRAZING_COS) {
+        o.xyz = vec4<f32>(env_cells_shared(fr[0], fr[1], fr[2], wr_l, in.clip.xy, dist), 1.0);
+    }
+    o.nd = vec4<f32>(fr[2], dist);
+    return o;
+}
 
 @fragment
 fn fs_cells(in: VsOut) -> CellsOut {

@@ -40,8 +40,9 @@ struct Globals {
     n_lambda: u32,
     // samples per pixel of the colour target (1 or 4)
     msaa: u32,
-    // the cells' rate (shaders/environment.wgsl env_cells_shared): K > 1 when
-    // the pre-pass shaded them on a grid of K x K pixels (cells_* below), else 0
+    // the cells' rate (shaders/environment.wgsl env_cells_shared,
+    // env_cells_pixel): K >= 1 when the centre pass ran (after a coarse grid
+    // of K x K pixels for K > 1), else 0
     cells_rate: u32,
 };
 
@@ -79,10 +80,13 @@ struct Material {
 };
 
 @group(0) @binding(0) var<uniform> g: Globals;
-// The cells' pre-pass at 1/K of the pixels (fs_cells, shaders/default.wgsl;
-// read by env_cells_shared): the cells' XYZ (w: 1 where shaded), the frame's
-// normal with the distance to the eye, its tangent (1 x 1 stand-ins when
-// g.cells_rate is 0).
+// The cells' pre-passes (crates/sunbeam-render/src/renderer/cells_rate.rs):
+// in the centre pass (fs_cells_centre, read by env_cells_shared) the coarse
+// grid at 1/K of the pixels (fs_cells): the cells' XYZ (w: 1 where shaded),
+// the frame's normal with the distance to the eye, its tangent; in the
+// frame's pass (read by env_cells_pixel) the centre pass's XYZ and normal
+// with the distance, per pixel (binding 4 unused). 1 x 1 stand-ins where
+// none ran.
 @group(0) @binding(2) var cells_xyz: texture_2d<f32>;
 @group(0) @binding(3) var cells_nd: texture_2d<f32>;
 @group(0) @binding(4) var cells_t: texture_2d<f32>;

@@ -548,7 +548,9 @@ fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
 // on that patch (its normal within ENV_LOWRES_OWN (10 degrees), its distance within
 // ENV_LOWRES_DEPTH). Elsewhere (silhouettes, limbs, scale borders, where the
 // surface turns faster than the cone across a block) the pixel walks the
-// cells itself. The test is on the block's corners, so a block's pixels
+// cells itself. This runs in the centre pass (fs_cells_centre, once per
+// pixel; the frame's pass reads its result through env_cells_pixel below).
+// The test is on the block's corners, so a block's pixels
 // decide alike (a SIMD group that mixed both would pay for the walk). The
 // cells' term is a smooth function of the frame and the view on the scale
 // of a cell's spread, a few degrees (the sun and the hot spots have their
@@ -604,6 +606,26 @@ fn env_cells_shared(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, cli
     return env_cells(t, b, n, wr);
 }
 
+// The frame's pass after the centre pass (g.cells_rate >= 1): the centre
+// pass's value of this pixel where this fragment sees the surface it saw
+// (its normal within ENV_LOWRES_OWN, its distance within ENV_LOWRES_DEPTH;
+// the fragment of the triangle under the pixel centre matches exactly), so
+// that a pixel walks the cells once whatever the triangles touching it;
+// else (another surface behind a silhouette, grazing views, no centre pass)
+// the fragment walks them itself.
+fn env_cells_pixel(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec3<f32> {
+    if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS) {
+        let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
+        let p = clamp(vec2<i32>(floor(clip)), vec2<i32>(0), last);
+        let x = textureLoad(cells_xyz, p, 0);
+        let nd = textureLoad(cells_nd, p, 0);
+        if (x.w > 0.5 && dot(nd.xyz, n) >= ENV_LOWRES_OWN && abs(dist - nd.w) <= ENV_LOWRES_DEPTH * nd.w) {
+            return x.xyz;
+        }
+    }
+    return env_cells(t, b, n, wr);
+}
+
 // ---------------------------------------------------------------- the estimator
 // Linear sRGB leaving the surface towards the viewer under the environment (both
 // parts, dw applied): frame (t, b, n), local view wr, base colour, diffuse weight
@@ -649,7 +671,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     let gr = env_grid();
     var xyz = vec3<f32>(0.0);
     if (envg.estimator == 0u) {
-        xyz = env_cells_shared(t, b, n, wr, clip, dist) + env_hotspots(t, b, n, wr);
+        xyz = env_cells_pixel(t, b, n, wr, clip, dist) + env_hotspots(t, b, n, wr);
     } else {
     // The first frame after a reset (every frame while the view moves) is the
     // preview: one direction uniform over the hemisphere, no descent (the

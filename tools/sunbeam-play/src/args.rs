@@ -87,9 +87,11 @@ pub(crate) struct Cli {
     #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_HOT_SPOTS as u64, value_parser = clap::value_parser!(u64).range(0..=256))]
     pub(crate) env_hot_spots: u64,
     /// Environment scenes, `--env-estimator cells`: shade the cells on a grid
-    /// of one pixel in K x K and interpolate them where the surface is smooth
-    /// (1..=16; 1: at every pixel; docs/LIGHTING.md "Cells at a lower rate").
-    #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_CELLS_RATE, value_parser = clap::value_parser!(u32).range(1..=16))]
+    /// of one pixel in K x K and interpolate them where the surface is smooth,
+    /// once per pixel elsewhere (1..=16; 1: once per pixel; 0: once per
+    /// fragment, every triangle touching a pixel, the slow path kept for
+    /// comparisons; docs/LIGHTING.md "Cells at a lower rate").
+    #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_CELLS_RATE, value_parser = clap::value_parser!(u32).range(0..=16))]
     pub(crate) env_cells_rate: u32,
     /// Wavelength samples of the default mode.
     #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES)]

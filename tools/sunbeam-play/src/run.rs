@@ -242,7 +242,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         {
             eprintln!(
                 "sunbeam-play: the first frame under an environment (--env-estimator cells) on a \
-                 CPU rasteriser can take minutes at 512 x 512; --msaa 1 is several times faster on \
+                 CPU rasteriser can take a minute or more at 512 x 512; --msaa 1 is faster on \
                  dense meshes (aliased silhouettes), --env-estimator monte-carlo quick and noisy"
             );
         }

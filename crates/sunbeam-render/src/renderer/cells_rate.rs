@@ -1,12 +1,24 @@
-//! The first-frame cells at a lower rate than the pixels (docs/LIGHTING.md
-//! "Cells at a lower rate"): a pre-pass draws the meshes on a grid of every
-//! K-th pixel corner (the same camera, a viewport K times smaller) with
-//! shaders/default.wgsl's `fs_cells`, which writes the cells' XYZ, the
-//! frame's normal with the distance to the eye, and its tangent into three
-//! float targets; the frame's pass reads them (bind group 0, bindings 2-4)
-//! and mixes the four corners of a pixel's K x K block where they saw one
-//! smooth patch of surface, walking the cells itself elsewhere (shaders/environment.wgsl
-//! `env_cells_shared`).
+//! The first-frame cells shaded once per pixel, and at a lower rate than the
+//! pixels where the surface is smooth (docs/LIGHTING.md "Cells at a lower
+//! rate", "One walk per pixel"). Two pre-passes draw the meshes before the
+//! frame:
+//!
+//! 1. At a rate K > 1, the coarse grid: every K-th pixel corner (the same
+//!    camera, a viewport K times smaller) with shaders/default.wgsl's
+//!    `fs_cells`, which writes the cells' XYZ, the frame's normal with the
+//!    distance to the eye, and its tangent into three float targets.
+//! 2. The centre pass, single-sampled at the frame's size (`fs_cells_centre`):
+//!    each pixel centre takes the bilinear mix of its K x K block's corners
+//!    where they saw one smooth patch of surface and walks the cells itself
+//!    elsewhere (shaders/environment.wgsl `env_cells_shared`); it writes the
+//!    XYZ and the normal with the distance.
+//!
+//! The frame's pass (bind group 0, bindings 2-3) then reads its pixel's
+//! centre value where its own normal and distance match it, and walks the
+//! cells only where they do not (a silhouette's other surface). Without the
+//! centre pass a multisampled frame walked once per triangle touching a
+//! pixel: a dense mesh (the generated snake, several triangles per pixel)
+//! paid that about 6 times on lavapipe.
 //!
 //! The walk over the cells is what a cells frame costs (docs/LIGHTING.md
 //! "Cost"); the sun, the hot spots and the diffuse part stay at every pixel.
@@ -24,29 +36,45 @@ use sunbeam_common::Result;
 const XYZ_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
+/// The centre pass's XYZ: used as it is (not interpolated), so in 32-bit
+/// floats like the frame's own walk.
+const CENTRE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
 /// Default grid spacing in pixels (`--env-cells-rate`): measured in
 /// docs/LIGHTING.md "Cells at a lower rate".
 pub const DEFAULT_CELLS_RATE: u32 = 4;
 
-/// The grid's targets for one frame size, and bind group 0 reading them.
-struct Grid {
-    /// The frame size (pixels) the grid was made for.
-    full: [u32; 2],
+/// The coarse grid's targets (rate K > 1).
+struct Coarse {
     xyz: wgpu::TextureView,
     nd: wgpu::TextureView,
     t: wgpu::TextureView,
     depth: wgpu::TextureView,
-    /// Bind group 0 of the frame's pass: globals, spectrum and the grid.
+}
+
+/// The targets for one frame size, and the bind groups reading them.
+struct Grid {
+    /// The frame size (pixels) the grid was made for.
+    full: [u32; 2],
+    coarse: Option<Coarse>,
+    centre_xyz: wgpu::TextureView,
+    centre_nd: wgpu::TextureView,
+    centre_depth: wgpu::TextureView,
+    /// Bind group 0 of the centre pass: the coarse grid (stand-ins at K = 1).
+    centre_bind: wgpu::BindGroup,
+    /// Bind group 0 of the frame's pass: globals, spectrum and the centres.
     bind: wgpu::BindGroup,
 }
 
-/// The pre-pass: its pipeline, bind group 0 with stand-ins for the grid
-/// (a pass cannot read the targets it writes), and the grid of the last
-/// frame size.
+/// The pre-passes: their pipelines, bind group 0 with stand-ins for the
+/// grids (a pass cannot read the targets it writes), and the grids of the
+/// last frame size.
 pub(super) struct CellsRate {
     rate: u32,
-    pipeline: wgpu::RenderPipeline,
+    coarse: Option<wgpu::RenderPipeline>,
+    centre: wgpu::RenderPipeline,
     pre_bind: wgpu::BindGroup,
+    stand_in: wgpu::TextureView,
     grid: Mutex<Option<Grid>>,
 }
 
@@ -116,9 +144,9 @@ fn target(gpu: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Textu
 }
 
 impl CellsRate {
-    /// The pre-pass at one pixel in `rate` x `rate` (> 1), with the default
-    /// pipeline's bind group layouts; `stand_in` is bound as the grid while
-    /// the pre-pass draws.
+    /// The pre-passes at one pixel in `rate` x `rate` (>= 1; 1: the centre
+    /// pass alone), with the default pipeline's bind group layouts;
+    /// `stand_in` is bound as the grids while a pass cannot read them.
     pub(super) fn new(
         device: &wgpu::Device,
         layouts: &[&wgpu::BindGroupLayout],
@@ -127,16 +155,33 @@ impl CellsRate {
         spectrum: &wgpu::Buffer,
         stand_in: &wgpu::TextureView,
     ) -> Result<CellsRate> {
+        let coarse = if rate > 1 {
+            let technique = Technique {
+                label: "diffraction.wgsl cells pre-pass",
+                source: SHADER,
+                entry: "fs_cells",
+                constants: Vec::new(),
+            };
+            Some(render_pipeline(
+                device,
+                layouts,
+                &[XYZ_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
+                1,
+                &technique,
+            )?)
+        } else {
+            None
+        };
         let technique = Technique {
-            label: "diffraction.wgsl cells pre-pass",
+            label: "diffraction.wgsl cells centre pass",
             source: SHADER,
-            entry: "fs_cells",
+            entry: "fs_cells_centre",
             constants: Vec::new(),
         };
-        let pipeline = render_pipeline(
+        let centre = render_pipeline(
             device,
             layouts,
-            &[XYZ_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
+            &[CENTRE_FORMAT, FRAME_FORMAT],
             1,
             &technique,
         )?;
@@ -149,8 +194,10 @@ impl CellsRate {
         );
         Ok(CellsRate {
             rate,
-            pipeline,
+            coarse,
+            centre,
             pre_bind,
+            stand_in: stand_in.clone(),
             grid: Mutex::new(None),
         })
     }
@@ -160,7 +207,7 @@ impl CellsRate {
         self.rate
     }
 
-    /// Make the grid for a `w x h` frame (kept while the size stays).
+    /// Make the targets for a `w x h` frame (kept while the size stays).
     pub(super) fn prepare(
         &self,
         gpu: &Gpu,
@@ -176,25 +223,50 @@ impl CellsRate {
         }
         // Grid points at the frame's pixel corners 0, K, 2K, ... up to and
         // past the last pixel.
-        let (gw, gh) = (w.div_ceil(self.rate) + 1, h.div_ceil(self.rate) + 1);
-        let xyz = target(gpu, gw, gh, XYZ_FORMAT);
-        let nd = target(gpu, gw, gh, FRAME_FORMAT);
-        let t = target(gpu, gw, gh, FRAME_FORMAT);
-        let depth = super::depth_view(gpu, gw, gh);
-        let bind = global_bind(&gpu.device, layout, globals, spectrum, [&xyz, &nd, &t]);
+        let coarse = (self.rate > 1).then(|| {
+            let (gw, gh) = (w.div_ceil(self.rate) + 1, h.div_ceil(self.rate) + 1);
+            Coarse {
+                xyz: target(gpu, gw, gh, XYZ_FORMAT),
+                nd: target(gpu, gw, gh, FRAME_FORMAT),
+                t: target(gpu, gw, gh, FRAME_FORMAT),
+                depth: super::depth_view(gpu, gw, gh),
+            }
+        });
+        let centre_xyz = target(gpu, w, h, CENTRE_FORMAT);
+        let centre_nd = target(gpu, w, h, FRAME_FORMAT);
+        let centre_depth = super::depth_view(gpu, w, h);
+        let si = &self.stand_in;
+        let centre_bind = match &coarse {
+            Some(c) => global_bind(
+                &gpu.device,
+                layout,
+                globals,
+                spectrum,
+                [&c.xyz, &c.nd, &c.t],
+            ),
+            None => global_bind(&gpu.device, layout, globals, spectrum, [si, si, si]),
+        };
+        let bind = global_bind(
+            &gpu.device,
+            layout,
+            globals,
+            spectrum,
+            [&centre_xyz, &centre_nd, si],
+        );
         *grid = Some(Grid {
             full: [w, h],
-            xyz,
-            nd,
-            t,
-            depth,
+            coarse,
+            centre_xyz,
+            centre_nd,
+            centre_depth,
+            centre_bind,
             bind,
         });
     }
 
-    /// Record the pre-pass (`draw` draws the meshes with groups 1 and 2 set)
-    /// and call `main` with bind group 0 for the frame's pass. Without a
-    /// grid (no [`CellsRate::prepare`] yet) `main` gets `fallback`.
+    /// Record the pre-passes (`draw` draws the meshes with groups 1 and 2
+    /// set) and call `main` with bind group 0 for the frame's pass. Without
+    /// targets (no [`CellsRate::prepare`] yet) `main` gets `fallback`.
     pub(super) fn encode(
         &self,
         enc: &mut wgpu::CommandEncoder,
@@ -207,29 +279,32 @@ impl CellsRate {
             main(enc, fallback);
             return;
         };
-        {
-            let clear = |view| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
-            };
+        let clear = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let depth = |view| {
+            Some(wgpu::RenderPassDepthStencilAttachment {
+                view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            })
+        };
+        if let (Some(c), Some(pipeline)) = (&g.coarse, &self.coarse) {
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("cells pre-pass"),
-                color_attachments: &[clear(&g.xyz), clear(&g.nd), clear(&g.t)],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &g.depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
+                color_attachments: &[clear(&c.xyz), clear(&c.nd), clear(&c.t)],
+                depth_stencil_attachment: depth(&c.depth),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
@@ -245,8 +320,21 @@ impl CellsRate {
                 0.0,
                 1.0,
             );
-            rp.set_pipeline(&self.pipeline);
+            rp.set_pipeline(pipeline);
             rp.set_bind_group(0, &self.pre_bind, &[]);
+            draw(&mut rp);
+        }
+        {
+            let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("cells centre pass"),
+                color_attachments: &[clear(&g.centre_xyz), clear(&g.centre_nd)],
+                depth_stencil_attachment: depth(&g.centre_depth),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            rp.set_pipeline(&self.centre);
+            rp.set_bind_group(0, &g.centre_bind, &[]);
             draw(&mut rp);
         }
         main(enc, &g.bind);

@@ -189,8 +189,9 @@ pub struct Settings {
     /// this many lights (sunbeam_light::hotspots; 0: none).
     pub env_hot_spots: usize,
     /// Environment, cells estimator: shade the cells on a grid of one pixel
-    /// in K x K and interpolate where the surface is smooth (1: every pixel;
-    /// docs/LIGHTING.md "Cells at a lower rate").
+    /// in K x K and interpolate where the surface is smooth, once per pixel
+    /// elsewhere (1: once per pixel; 0: once per fragment, no pre-pass;
+    /// docs/LIGHTING.md "Cells at a lower rate", "One walk per pixel").
     pub env_cells_rate: u32,
 }
 
@@ -249,8 +250,8 @@ pub struct Renderer {
     /// Bind group 0's layout and the group with stand-ins for the cells' grid.
     global_layout: wgpu::BindGroupLayout,
     global_bind: wgpu::BindGroup,
-    /// The cells' pre-pass at a lower rate (environment scenes with the
-    /// cells estimator and `env_cells_rate` > 1).
+    /// The cells' pre-passes: one walk per pixel, at a lower rate where
+    /// the surface is smooth (environment scenes with the cells estimator).
     cells: Option<cells_rate::CellsRate>,
     meshes: Vec<GpuMesh>,
     settings: Settings,
@@ -559,17 +560,22 @@ impl Renderer {
         // tests/threejs_render.rs' studio scene, 0.45 with its hot spots).
         let smooth_term =
             settings.env_hot_spots > 0 || env_scene.env.as_ref().is_some_and(|e| e.sun().is_some());
+        // Without a smooth term the centre pass alone (K = 1): one walk per
+        // pixel, none interpolated.
         let cells = if settings.mode == Mode::Default
             && env_scene.env.is_some()
             && settings.env_estimator == crate::env::EnvEstimator::Cells
-            && settings.env_cells_rate > 1
-            && smooth_term
+            && settings.env_cells_rate > 0
             && p.meshes.iter().any(|(_, m)| m.pack.is_some())
         {
             Some(cells_rate::CellsRate::new(
                 device,
                 &layouts,
-                settings.env_cells_rate,
+                if smooth_term {
+                    settings.env_cells_rate
+                } else {
+                    1
+                },
                 &globals,
                 &spectrum,
                 &dummy_2d,

@@ -40,8 +40,9 @@ pub(super) struct Globals {
     pub(super) n_lambda: u32,
     /// Samples per pixel of the colour target (the shader tells covered pixels from silhouettes).
     pub(super) msaa: u32,
-    /// K > 1: the cells were shaded on a grid of K x K pixels by the
-    /// pre-pass ([`super::cells_rate`]); 0: every pixel walks them.
+    /// K >= 1: the cells' centre pass ran (after the coarse grid of K x K
+    /// pixels for K > 1; [`super::cells_rate`]); 0: every fragment walks
+    /// them.
     pub(super) cells_rate: u32,
 }
 
