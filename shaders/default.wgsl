@@ -44,6 +44,13 @@ struct CellsOut {
     @location(2) t: vec4<f32>,
 };
 
+// Whether the pre-passes shade the cells at a point seen from local view
+// wr_l: a mesh diffracting under the environment, the view above
+// ENV_GRAZING_COS (the frame's pass walks grazing views itself).
+fn cells_shaded_here(wr_l: vec3<f32>) -> bool {
+    return envg.on == 1u && envp.on == 1u && mat.has_pack == 1u && mat.base.w < 1.0 && wr_l.z > ENV_GRAZING_COS;
+}
+
 // The centre pass (g.cells_rate >= 1): single-sampled at the frame's size,
 // the cells' XYZ at each pixel centre, from the coarse grid where it serves
 // (shaders/environment.wgsl env_cells_shared), else one walk (w: 1 where
@@ -63,7 +70,7 @@ fn fs_cells_centre(in: VsOut) -> CentreOut {
     let dist = length(g.eye.xyz - in.world);
     var o: CentreOut;
     o.xyz = vec4<f32>(0.0);
-    if (envg.on == 1u && envp.on == 1u && mat.has_pack == 1u && mat.base.w < 1.0 && wr_l.z > ENV_GRAZING_COS) {
+    if (cells_shaded_here(wr_l)) {
         o.xyz = vec4<f32>(env_cells_shared(fr[0], fr[1], fr[2], wr_l, in.clip.xy, dist), 1.0);
     }
     o.nd = vec4<f32>(fr[2], dist);
@@ -77,7 +84,7 @@ fn fs_cells(in: VsOut) -> CellsOut {
     let wr_l = vec3<f32>(dot(wr, fr[0]), dot(wr, fr[1]), dot(wr, fr[2]));
     var o: CellsOut;
     o.xyz = vec4<f32>(0.0);
-    if (envg.on == 1u && envp.on == 1u && mat.has_pack == 1u && mat.base.w < 1.0 && wr_l.z > ENV_GRAZING_COS) {
+    if (cells_shaded_here(wr_l)) {
         o.xyz = vec4<f32>(env_cells(fr[0], fr[1], fr[2], wr_l), 1.0);
     }
     o.nd = vec4<f32>(fr[2], length(g.eye.xyz - in.world));

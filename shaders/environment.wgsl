@@ -560,6 +560,13 @@ const ENV_LOWRES_CONE: f32 = 0.99939;
 const ENV_LOWRES_OWN: f32 = 0.985;
 const ENV_LOWRES_DEPTH: f32 = 0.02;
 
+// A point with normal n at distance dist from the eye lies on the surface a
+// pre-pass saw with normal n_seen at distance d_seen: the normals within
+// ENV_LOWRES_OWN, the distances within ENV_LOWRES_DEPTH.
+fn env_same_surface(n_seen: vec3<f32>, d_seen: f32, n: vec3<f32>, dist: f32) -> bool {
+    return dot(n_seen, n) >= ENV_LOWRES_OWN && abs(dist - d_seen) <= ENV_LOWRES_DEPTH * d_seen;
+}
+
 fn env_cells_shared(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec3<f32> {
     let k = g.cells_rate;
     if (k > 1u && wr.z > ENV_GRAZING_COS) {
@@ -599,7 +606,7 @@ fn env_cells_shared(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, cli
             one_patch = one_patch && dot(nn[j], nm) >= ENV_LOWRES_CONE && dot(tt[j], tm) >= ENV_LOWRES_CONE;
         }
         let d_mid = 0.5 * (d_lo + d_hi);
-        if (one_patch && dot(nm, n) >= ENV_LOWRES_OWN && abs(dist - d_mid) <= ENV_LOWRES_DEPTH * d_mid) {
+        if (one_patch && env_same_surface(nm, d_mid, n, dist)) {
             return acc;
         }
     }
@@ -619,7 +626,7 @@ fn env_cells_pixel(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip
         let p = clamp(vec2<i32>(floor(clip)), vec2<i32>(0), last);
         let x = textureLoad(cells_xyz, p, 0);
         let nd = textureLoad(cells_nd, p, 0);
-        if (x.w > 0.5 && dot(nd.xyz, n) >= ENV_LOWRES_OWN && abs(dist - nd.w) <= ENV_LOWRES_DEPTH * nd.w) {
+        if (x.w > 0.5 && env_same_surface(nd.xyz, nd.w, n, dist)) {
             return x.xyz;
         }
     }

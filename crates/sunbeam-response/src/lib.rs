@@ -121,9 +121,7 @@ impl Response {
 
     /// XYZ of texel `(i, j, k)`.
     pub fn texel(&self, i: usize, j: usize, k: usize) -> [f64; 3] {
-        let g = &self.info.grid;
-        let o = 4 * ((k * g.n_rho + j) * g.n_theta + i);
-        [0, 1, 2].map(|c| half::f16::from_bits(self.data[o + c]).to_f64())
+        [0, 1, 2].map(|c| self.texel_channel(i, j, k, c))
     }
 
     /// Channel `c` (0, 1, 2: X, Y, Z) of texel `(i, j, k)`.
