@@ -65,6 +65,26 @@ pub fn ridge_pack(d: &Path, name: &str, size: &str, pixel: &str) -> PathBuf {
     p
 }
 
+/// The tests' common pack, `ridges.ktx2` in `d` (with its response maps):
+/// [`ridge_pack`] of 256^2 samples of 20 nm, built once per test binary and
+/// linked into `d` (each build takes about 4 s).
+pub fn ridges(d: &Path) {
+    static BUILT: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    let dir = BUILT.get_or_init(|| {
+        let dir = sunbeam::scratch("threejs-ridges");
+        ridge_pack(&dir, "ridges", "256", "20nm");
+        dir
+    });
+    for f in [
+        "ridges.ktx2",
+        "ridges.response.ktx2",
+        "ridges.env-response.ktx2",
+    ] {
+        assert!(dir.join(f).is_file(), "{f} not built");
+        std::os::unix::fs::symlink(dir.join(f), d.join(f)).unwrap();
+    }
+}
+
 /// render.mjs on the scene file `scene`: the linear frame (also written as
 /// `d`/NAME.exr and NAME.png).
 pub fn threejs_frame(render: &Path, d: &Path, scene: &Path, name: &str) -> LinearImage {

@@ -21,6 +21,9 @@ use std::f64::consts::{PI, TAU};
 
 /// Lights by default (see [`SplitOptions::default`]).
 pub const DEFAULT_MAX_LIGHTS: usize = 32;
+/// A texel is hot above this many times the map's mean by default (see
+/// [`SplitOptions::default`]).
+pub const DEFAULT_THRESHOLD: f64 = 8.0;
 
 /// How hot spots are chosen.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,7 +42,7 @@ impl Default for SplitOptions {
         // 6.4 with 16 / 32 / 64 (`cargo bench -p sunbeam-response --bench
         // cells`); thresholds 2 to 30 change little.
         SplitOptions {
-            threshold: 8.0,
+            threshold: DEFAULT_THRESHOLD,
             max_lights: DEFAULT_MAX_LIGHTS,
         }
     }

@@ -32,6 +32,8 @@ pub const DEFAULT_ENV_CELLS: u64 = 512;
 pub const ENV_CELLS_DEPTH: usize = sunbeam_response::cells::DEFAULT_DEPTH;
 /// The environment's hot spots as at most this many lights (`--env-hot-spots`).
 pub const DEFAULT_ENV_HOT_SPOTS: usize = sunbeam_light::hotspots::DEFAULT_MAX_LIGHTS;
+/// A texel is hot above this many times the map's mean (`--env-hot-threshold`).
+pub const DEFAULT_ENV_HOT_THRESHOLD: f64 = sunbeam_light::hotspots::DEFAULT_THRESHOLD;
 
 /// shaders/environment.wgsl `EnvGlobals`.
 #[repr(C)]
@@ -154,17 +156,14 @@ pub(crate) struct HotSpots {
 }
 
 impl HotSpots {
-    /// At most `max_lights` lights (0: none, the residual is the table).
-    pub fn split(w: usize, h: usize, table: &[f32], max_lights: usize) -> HotSpots {
-        let split = sunbeam_light::hotspots::split(
-            w,
-            h,
-            table,
-            sunbeam_light::hotspots::SplitOptions {
-                max_lights,
-                ..Default::default()
-            },
-        );
+    /// As `opts` chooses them (`max_lights` 0: none, the residual is the table).
+    pub fn split(
+        w: usize,
+        h: usize,
+        table: &[f32],
+        opts: sunbeam_light::hotspots::SplitOptions,
+    ) -> HotSpots {
+        let split = sunbeam_light::hotspots::split(w, h, table, opts);
         if !split.lights.is_empty() {
             log::info!(
                 "{} hot spots as lights ({:.1} % of the environment's energy)",
@@ -215,7 +214,7 @@ impl EnvScene {
         samples: u32,
         estimator: EnvEstimator,
         ior: f64,
-        hot_spots: usize,
+        hot_spots: sunbeam_light::hotspots::SplitOptions,
     ) -> EnvScene {
         let device = &gpu.device;
         let layout = layout(device);

@@ -54,14 +54,15 @@ fn f16_levels(levels: &[(usize, usize, Vec<f32>)]) -> Vec<(usize, usize, Vec<u16
 
 /// Write the environment's files for `p` into `dir` (created if missing);
 /// `cells`: the top cut's cells and the levels below it (as the player's
-/// `--env-cells`); `hot_spots`: at most this many of a map's hot spots as
-/// lights (as the player's `--env-hot-spots`; the chain is then the rest).
+/// `--env-cells`); `hot_spots`: how a map's hot spots become lights (as the
+/// player's `--env-hot-spots`, `--env-hot-threshold`; the chain is then the
+/// rest).
 /// Returns the files written and notes (maps built).
 pub fn export(
     p: &Prepared,
     opts: &sunbeam_response::Options,
     cells: (usize, usize),
-    hot_spots: usize,
+    hot_spots: sunbeam_light::hotspots::SplitOptions,
     dir: &Path,
 ) -> Result<(Vec<PathBuf>, Vec<String>)> {
     let env = p.environment.clone().ok_or_else(|| {

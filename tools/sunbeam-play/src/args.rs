@@ -86,6 +86,13 @@ pub(crate) struct Cli {
     /// frame"); `--export-environment` writes them for the engines too.
     #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_HOT_SPOTS as u64, value_parser = clap::value_parser!(u64).range(0..=256))]
     pub(crate) env_hot_spots: u64,
+    /// Environment scenes, `--env-estimator cells`: a map's texel is a hot
+    /// spot above this many times the map's mean brightness (1..=1000; lower:
+    /// more of the map through the exact lights, but broad bright regions are
+    /// poorly served by a light's four taps; docs/LIGHTING.md "Hot spots as
+    /// lights").
+    #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_HOT_THRESHOLD, value_parser = hot_threshold)]
+    pub(crate) env_hot_threshold: f64,
     /// Environment scenes, `--env-estimator cells`: shade the cells on a grid
     /// of one pixel in K x K and interpolate them where the surface is smooth,
     /// once per pixel elsewhere (1..=16; 1: once per pixel; 0: once per
@@ -142,4 +149,12 @@ pub(crate) enum EnvEstimatorArg {
     Auto,
     Cells,
     MonteCarlo,
+}
+
+/// `--env-hot-threshold`: a finite number in 1..=1000.
+fn hot_threshold(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && (1.0..=1000.0).contains(&v) => Ok(v),
+        _ => Err(format!("'{s}' is not a number from 1 to 1000")),
+    }
 }

@@ -131,6 +131,7 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
         msaa,
         footprint: !cli.no_footprint,
         env_hot_spots: cli.env_hot_spots as usize,
+        env_hot_threshold: cli.env_hot_threshold,
         env_cells_rate: cli.env_cells_rate,
         env_cells: (cli.env_cells as usize, sunbeam_render::env::ENV_CELLS_DEPTH),
         ..Default::default()
@@ -399,7 +400,7 @@ fn export_environment(
         &prepared,
         &st.response,
         st.env_cells,
-        st.env_hot_spots,
+        st.hot_spot_options(),
         dir,
     )?;
     if !quiet {

@@ -347,6 +347,25 @@ fn bad_environments_exit_2() {
         assert!(err.contains(needle), "{name}: {err}");
         assert!(!out.exists(), "{name}");
     }
+    // A hot-spot threshold outside 1..=1000 is a usage error naming the flag.
+    let s = write(
+        &dir,
+        "sky.json",
+        &cases[2].1.replace("\"intensity\": -1", "\"intensity\": 1"),
+    );
+    for bad in ["0.5", "nan", "inf", "2000", "x"] {
+        let out = dir.join("f.png");
+        let o = Command::new(BIN)
+            .arg(&s)
+            .args(["--headless", "--env-hot-threshold", bad, "-o"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{bad}: {err}");
+        assert!(err.contains("--env-hot-threshold"), "{bad}: {err}");
+        assert!(!out.exists(), "{bad}");
+    }
 }
 
 /// The default scene of `--mesh --pack` is sky-lit (issue #13), with the sky

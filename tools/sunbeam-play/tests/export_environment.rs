@@ -197,10 +197,11 @@ fn a_maps_hot_spots_are_exported_as_lights() {
   "environment": { "map": "lamp.exr" } }"#,
     )
     .unwrap();
-    let run = |out: &Path, hot: &str| {
+    let run_with = |out: &Path, hot: &str, threshold: &str| {
         let o = Command::new(BIN)
             .arg(&scene)
             .args(["--env-cells", "32", "--env-hot-spots", hot, "-q"])
+            .args(["--env-hot-threshold", threshold])
             .arg("--export-environment")
             .arg(out)
             .output()
@@ -211,6 +212,7 @@ fn a_maps_hot_spots_are_exported_as_lights() {
         )
         .unwrap()
     };
+    let run = |out: &Path, hot: &str| run_with(out, hot, "8");
     let json = run(&d.join("on"), "32");
     // The lamp: columns 16-17 (phi 2 pi [16, 18) / 64), rows 15-16 (theta
     // pi [15, 17) / 32 from +y).
@@ -226,6 +228,16 @@ fn a_maps_hot_spots_are_exported_as_lights() {
     let m: Vec<Vec<f64>> = serde_json::from_value(json["basis_to_rgb"].clone()).unwrap();
     let taps = json["hot_spots"].as_array().unwrap();
     assert!(!taps.is_empty(), "no hot spots: {json}");
+    let tap_power = |taps: &[serde_json::Value]| {
+        let mut power = [0.0f64; 3];
+        for t in taps {
+            let t: Vec<f64> = serde_json::from_value(t.clone()).unwrap();
+            for (r, row) in m.iter().enumerate() {
+                power[r] += row[0] * t[3] + row[1] * t[4] + row[2] * t[5];
+            }
+        }
+        power
+    };
     let mut power = [0.0f64; 3];
     for t in taps {
         let t: Vec<f64> = serde_json::from_value(t.clone()).unwrap();
@@ -250,6 +262,27 @@ fn a_maps_hot_spots_are_exported_as_lights() {
             "channel {c}: the taps carry {ratio:.3} of the lamp's 200 x {omega:.5} sr"
         );
     }
+    // `--env-hot-threshold`: a texel is hot above that many times the map's
+    // mean, which is 1 + 199 omega / (4 pi), and a light keeps the lamp's
+    // radiance above it: at 100 x the mean the taps carry (200 - 100 mean) /
+    // 200 of the lamp; at 300 x the mean the lamp is not hot.
+    let mean = 1.0 + 199.0 * omega / (4.0 * PI);
+    let hundred = run_with(&d.join("t100"), "32", "100");
+    let p100 = tap_power(hundred["hot_spots"].as_array().unwrap());
+    let want = (200.0 - 100.0 * mean) / 200.0;
+    for (c, p) in p100.iter().enumerate() {
+        let ratio = p / (200.0 * omega);
+        assert!(
+            (ratio - want).abs() < 0.05,
+            "threshold 100, channel {c}: the taps carry {ratio:.3} of the lamp, want {want:.3}"
+        );
+    }
+    let cold = run_with(&d.join("t300"), "32", "300");
+    assert_eq!(
+        cold["hot_spots"].as_array().map(Vec::len),
+        Some(0),
+        "{cold}"
+    );
     let basis: Vec<String> = serde_json::from_value(json["meshes"][0]["basis"].clone()).unwrap();
     assert_eq!(
         basis,

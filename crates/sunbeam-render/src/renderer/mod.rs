@@ -188,11 +188,24 @@ pub struct Settings {
     /// Environment, cells estimator: the map's hot spots pulled out as at most
     /// this many lights (sunbeam_light::hotspots; 0: none).
     pub env_hot_spots: usize,
+    /// Environment, cells estimator: a texel is hot above this many times
+    /// the map's mean (sunbeam_light::hotspots::SplitOptions::threshold).
+    pub env_hot_threshold: f64,
     /// Environment, cells estimator: shade the cells on a grid of one pixel
     /// in K x K and interpolate where the surface is smooth, once per pixel
     /// elsewhere (1: once per pixel; 0: once per fragment, no pre-pass;
     /// docs/LIGHTING.md "Cells at a lower rate", "One walk per pixel").
     pub env_cells_rate: u32,
+}
+
+impl Settings {
+    /// How the cells estimator picks the map's hot spots.
+    pub fn hot_spot_options(&self) -> sunbeam_light::hotspots::SplitOptions {
+        sunbeam_light::hotspots::SplitOptions {
+            threshold: self.env_hot_threshold,
+            max_lights: self.env_hot_spots,
+        }
+    }
 }
 
 /// Default wavelength sample count (docs/PLAY.md: chosen by measurement).
@@ -217,6 +230,7 @@ impl Default for Settings {
                 sunbeam_response::cells::DEFAULT_DEPTH,
             ),
             env_hot_spots: crate::env::DEFAULT_ENV_HOT_SPOTS,
+            env_hot_threshold: crate::env::DEFAULT_ENV_HOT_THRESHOLD,
             env_cells_rate: DEFAULT_CELLS_RATE,
         }
     }
@@ -347,7 +361,7 @@ impl Renderer {
             settings.env_samples,
             settings.env_estimator,
             skin_ior,
-            settings.env_hot_spots,
+            settings.hot_spot_options(),
         );
         let mut notes = Vec::new();
         let mut env_maps: environment::BuiltMaps = Vec::new();
@@ -597,7 +611,10 @@ impl Renderer {
                         1,
                         crate::env::EnvEstimator::MonteCarlo,
                         1.5,
-                        0,
+                        sunbeam_light::hotspots::SplitOptions {
+                            max_lights: 0,
+                            ..Default::default()
+                        },
                     );
                     &own
                 };
