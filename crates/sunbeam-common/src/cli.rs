@@ -120,6 +120,21 @@ pub fn pixel_size(s: &str) -> Result<PixelSize> {
     }
 }
 
+/// clap value parser: a finite number in `lo..=hi` (no unit).
+pub fn ranged(lo: f64, hi: f64) -> impl Fn(&str) -> std::result::Result<f64, String> + Clone {
+    move |s: &str| {
+        let v: f64 = s
+            .trim()
+            .parse()
+            .map_err(|_| format!("{s:?} is not a number"))?;
+        if v.is_finite() && (lo..=hi).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("{v} is outside [{lo}, {hi}]"))
+        }
+    }
+}
+
 /// clap value parser: an angle (`75deg`, `1.3rad`; a bare number is degrees), in radians.
 pub fn angle(s: &str) -> Result<f64> {
     units::parse_angle(s)

@@ -139,27 +139,27 @@ pub(crate) struct Cli {
     pub(crate) scale_rows: u32,
     /// Scale length along the body, in scale widths.
     #[arg(long, value_name = "L", default_value_t = 1.0, requires = "scales",
-          value_parser = ranged(0.25, 4.0))]
+          value_parser = sunbeam_common::cli::ranged(0.25, 4.0))]
     pub(crate) scale_length: f64,
     /// Overlap of a scale's free edge over the scale behind it, in scale lengths.
     #[arg(long, value_name = "F", default_value_t = 0.3, requires = "scales",
-          value_parser = ranged(0.0, 0.6))]
+          value_parser = sunbeam_common::cli::ranged(0.0, 0.6))]
     pub(crate) scale_overlap: f64,
     /// Dome height of a scale, in scale widths.
     #[arg(long, value_name = "H", default_value_t = 0.06, requires = "scales",
-          value_parser = ranged(0.0, 0.3))]
+          value_parser = sunbeam_common::cli::ranged(0.0, 0.3))]
     pub(crate) scale_dome: f64,
     /// Tilt of the free edge, degrees (the scale's normal turns toward the head).
     #[arg(long, value_name = "DEG", default_value_t = 6.0, requires = "scales",
-          allow_hyphen_values = true, value_parser = ranged(-30.0, 30.0))]
+          allow_hyphen_values = true, value_parser = sunbeam_common::cli::ranged(-30.0, 30.0))]
     pub(crate) scale_tilt: f64,
     /// Per-scale jitter of the tilt (uniform in +-DEG).
     #[arg(long, value_name = "DEG", default_value_t = 4.0, requires = "scales",
-          value_parser = ranged(0.0, 20.0))]
+          value_parser = sunbeam_common::cli::ranged(0.0, 20.0))]
     pub(crate) scale_tilt_jitter: f64,
     /// Per-scale jitter of the ridge angle about the normal (uniform in +-DEG).
     #[arg(long, value_name = "DEG", default_value_t = 6.0, requires = "scales",
-          value_parser = ranged(0.0, 45.0))]
+          value_parser = sunbeam_common::cli::ranged(0.0, 45.0))]
     pub(crate) scale_ridge_jitter: f64,
     /// Texels across one scale width (reduced when a side would pass 8192).
     #[arg(long, value_name = "N", default_value_t = 32, requires = "scales",
@@ -215,19 +215,5 @@ fn rms_slope(s: &str) -> Result<[f64; 2], String> {
         [a] => parse(a).map(|a| [a, a]),
         [a, b] => Ok([parse(a)?, parse(b)?]),
         _ => Err(format!("{s:?}: expected S or SX,SY")),
-    }
-}
-
-fn ranged(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
-    move |s: &str| {
-        let v: f64 = s
-            .trim()
-            .parse()
-            .map_err(|_| format!("{s:?} is not a number"))?;
-        if v.is_finite() && (lo..=hi).contains(&v) {
-            Ok(v)
-        } else {
-            Err(format!("{v} is outside [{lo}, {hi}]"))
-        }
     }
 }

@@ -91,7 +91,7 @@ pub(crate) struct Cli {
     /// more of the map through the exact lights, but broad bright regions are
     /// poorly served by a light's four taps; docs/LIGHTING.md "Hot spots as
     /// lights").
-    #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_HOT_THRESHOLD, value_parser = hot_threshold)]
+    #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_HOT_THRESHOLD, value_parser = sunbeam_common::cli::ranged(1.0, 1000.0))]
     pub(crate) env_hot_threshold: f64,
     /// Environment scenes, `--env-estimator cells`: shade the cells on a grid
     /// of one pixel in K x K and interpolate them where the surface is smooth,
@@ -149,12 +149,4 @@ pub(crate) enum EnvEstimatorArg {
     Auto,
     Cells,
     MonteCarlo,
-}
-
-/// `--env-hot-threshold`: a finite number in 1..=1000.
-fn hot_threshold(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && (1.0..=1000.0).contains(&v) => Ok(v),
-        _ => Err(format!("'{s}' is not a number from 1 to 1000")),
-    }
 }

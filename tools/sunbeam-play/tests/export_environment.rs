@@ -238,7 +238,6 @@ fn a_maps_hot_spots_are_exported_as_lights() {
         }
         power
     };
-    let mut power = [0.0f64; 3];
     for t in taps {
         let t: Vec<f64> = serde_json::from_value(t.clone()).unwrap();
         let cos = t[0] * centre[0] + t[1] * centre[1] + t[2] * centre[2];
@@ -247,10 +246,8 @@ fn a_maps_hot_spots_are_exported_as_lights() {
             "a tap {:.1} deg from the lamp: {t:?}",
             cos.min(1.0).acos().to_degrees()
         );
-        for (r, row) in m.iter().enumerate() {
-            power[r] += row[0] * t[3] + row[1] * t[4] + row[2] * t[5];
-        }
     }
+    let power = tap_power(taps);
     eprintln!(
         "{} taps, power {power:?} against the lamp's 200 x {omega:.5} sr",
         taps.len()
