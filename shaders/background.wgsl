@@ -27,7 +27,8 @@ struct BgGlobals {
     output: u32,
     // 1: keep negative linear values (a Monte Carlo frame of a running mean)
     keep_negative: u32,
-    _b0: u32,
+    // where the table's columns start, turns after phi = 0
+    table_phase: f32,
     _b1: u32,
     _b2: u32,
 };
@@ -44,7 +45,7 @@ fn vs_bg(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
 }
 
 fn bg_coefficients(d: vec3<f32>) -> vec3<f32> {
-    return sb_env_texel(bg_table, bg.table_w, bg.table_h, d);
+    return sb_env_texel(bg_table, bg.table_w, bg.table_h, bg.table_phase, d);
 }
 
 @fragment

@@ -278,6 +278,9 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
     let duv_tex_y = dpdy(in.uv);
     let duv_tangent_x = dpdx(in.uv_tangent);
     let duv_tangent_y = dpdy(in.uv_tangent);
+    // The pixel's footprint for the environment's hot spots (the frame's and
+    // the view's derivatives at the centre).
+    let env_fp = EnvFootprint(dpdx(t), dpdy(t), dpdx(b), dpdy(b), dpdx(n), dpdy(n), dpdx(wr_l), dpdy(wr_l));
     // A partly covered pixel whose centre sees the surface at a grazing angle
     // or from below (a silhouette, with MSAA) shades the point lights at each
     // of its covered samples and takes their mean: the centre lies past the
@@ -374,7 +377,7 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
         let fc = frame_at(normal_c, tangent_c, uv_c, uv_tangent_c);
         let wr_c = normalize(g.eye.xyz - world_c);
         let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
-        rgb = rgb + env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, length(g.eye.xyz - world_c));
+        rgb = rgb + env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, length(g.eye.xyz - world_c), env_fp);
     }
     return display(rgb);
 }

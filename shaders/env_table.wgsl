@@ -1,11 +1,14 @@
 // The environment's table lookup, once for the lighting (environment.wgsl)
 // and the background pass (background.wgsl): the texel of an equirectangular
 // table of `w` x `h` that contains world direction `d` (no filtering, as
-// sunbeam_light's EnvMap::lookup: theta = acos(y) from +y, phi = atan2(z, x)).
+// sunbeam_light's EnvMap::lookup: theta = acos(y) from +y, phi = atan2(z, x)),
+// whose columns start `phase` turns after phi = 0 (Environment::table_phase:
+// a map's rotation by a fraction of a texel).
 
-fn sb_env_texel(table: texture_2d<f32>, w: u32, h: u32, d: vec3<f32>) -> vec3<f32> {
+fn sb_env_texel(table: texture_2d<f32>, w: u32, h: u32, phase: f32, d: vec3<f32>) -> vec3<f32> {
     let e = sb_env_equirect(d);
-    let i = min(u32(e.x * f32(w)), w - 1u);
+    let x = fract(e.x - phase) * f32(w);
+    let i = min(u32(x), w - 1u);
     let j = min(u32(e.y * f32(h)), h - 1u);
     return textureLoad(table, vec2<u32>(i, j), 0).xyz;
 }

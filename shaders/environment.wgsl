@@ -56,8 +56,12 @@ struct EnvGlobals {
     chain_levels: u32,
     // the skin index of the transmitted irradiance table
     irr_ior: f32,
-    _e0: u32,
-    _e1: u32,
+    // where the table's (and the chain's) columns start, turns after phi = 0
+    // (Environment::table_phase)
+    table_phase: f32,
+    // 1: the hot spots' taps read the maps over the pixel's footprint
+    // (env_hotspots_footprint), 0: at one point
+    hot_footprint: u32,
     _e2: u32,
 };
 
@@ -118,6 +122,10 @@ fn env_hot_dir(i: u32) -> vec3<f32> {
 
 fn env_hot_power(i: u32) -> vec3<f32> {
     return env_lights[2u * i + 1u].xyz;
+}
+
+fn env_hot_grid() -> SbGrid {
+    return env_grid();
 }
 
 fn env_hot_maps(p: vec3<f32>, uvw: vec3<f32>) -> vec3<f32> {
@@ -182,7 +190,7 @@ fn env_map(tex: texture_3d<f32>, c: vec3<f32>, gr: SbGrid) -> vec3<f32> {
 // Coefficients c_k of the radiance from world direction d: the texel that
 // contains it (no filtering, as EnvMap::lookup).
 fn env_coefficients(d: vec3<f32>) -> vec3<f32> {
-    return sb_env_texel(env_table, envg.table_w, envg.table_h, d);
+    return sb_env_texel(env_table, envg.table_w, envg.table_h, envg.table_phase, d);
 }
 
 fn env_basis_rgb(c: vec3<f32>) -> vec3<f32> {
@@ -527,7 +535,8 @@ fn env_chain_levels() -> u32 {
 }
 
 fn env_chain_read(uv: vec2<f32>, level: f32) -> vec3<f32> {
-    return textureSampleLevel(env_chain, env_smp, uv, level).xyz;
+    // (the sampler repeats in u)
+    return textureSampleLevel(env_chain, env_smp, vec2<f32>(uv.x - envg.table_phase, uv.y), level).xyz;
 }
 
 fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
@@ -637,7 +646,7 @@ fn env_cells_pixel(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip
 // Linear sRGB leaving the surface towards the viewer under the environment (both
 // parts, dw applied): frame (t, b, n), local view wr, base colour, diffuse weight
 // dw, diffract: the mesh has a pack's maps.
-fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32) -> vec3<f32> {
+fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32, fp: EnvFootprint) -> vec3<f32> {
     if (envg.on == 0u || wr.z <= 0.0) {
         return vec3<f32>(0.0);
     }
@@ -678,7 +687,11 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     let gr = env_grid();
     var xyz = vec3<f32>(0.0);
     if (envg.estimator == 0u) {
-        xyz = env_cells_pixel(t, b, n, wr, clip, dist) + env_hotspots(t, b, n, wr);
+        var hot_fp = env_no_footprint();
+        if (envg.hot_footprint == 1u) {
+            hot_fp = fp;
+        }
+        xyz = env_cells_pixel(t, b, n, wr, clip, dist) + env_hotspots_footprint(t, b, n, wr, hot_fp);
     } else {
     // The first frame after a reset (every frame while the view moves) is the
     // preview: one direction uniform over the hemisphere, no descent (the

@@ -5,11 +5,12 @@
 //
 // Bindings (group 0, after the material's 0 to 2):
 //   3 env_chain: the prefiltered coefficient table, 2D RGBA16F with its mip
-//     levels (equirectangular: u = phi / 2 pi with phi = atan2(z, x), v =
-//     theta / pi from +y; level m is w / 2^m x h / 2^m; chain.ktx2);
+//     levels (equirectangular: u = phi / 2 pi - chain.phase with phi =
+//     atan2(z, x), v = theta / pi from +y; level m is w / 2^m x h / 2^m;
+//     chain.ktx2);
 //   4, 5 the irradiance tables without the sun, 2D RGBA16F, one level, the
-//     same coordinates: transmitted through the skin (irradiance-skin.ktx2)
-//     and plain (irradiance.ktx2);
+//     same coordinates without the phase (u = phi / 2 pi): transmitted
+//     through the skin (irradiance-skin.ktx2) and plain (irradiance.ktx2);
 //   6 env_smp: linear, linear between mip levels, repeat in u, clamp in v;
 //   7 env_cells_tex: the cells, 2D R32UI, float i of Cells::gpu_data (its
 //     bits) at texel (i % width, i / width) (cells.ktx2);
@@ -29,7 +30,8 @@ struct SunbeamEnvironment {
     // s layers (n_s), z every node (nodes); w unused
     cells: vec4<f32>,
     // x: the chain's level-0 height (chain.height), y: its levels
-    // (chain.levels); zw unused
+    // (chain.levels), z: where its columns start, turns after phi = 0
+    // (chain.phase: a map's rotation by a fraction of a texel); w unused
     chain: vec4<f32>,
     // xyz: towards the sun's centre (world, unit); w: 1 when the sky's sun
     // is up (sun.direction), else 0
@@ -73,6 +75,10 @@ fn env_hot_dir(i: u32) -> vec3<f32> {
 
 fn env_hot_power(i: u32) -> vec3<f32> {
     return textureLoad(env_lights_tex, vec2<i32>(i32(2u * i + 1u), 0), 0).xyz;
+}
+
+fn env_hot_grid() -> SbGrid {
+    return env_map_grid(sunbeam_env.basis_grid);
 }
 
 fn env_hot_maps(p: vec3<f32>, uvw: vec3<f32>) -> vec3<f32> {
@@ -122,7 +128,8 @@ fn env_chain_levels() -> u32 {
 }
 
 fn env_chain_read(uv: vec2<f32>, level: f32) -> vec3<f32> {
-    return textureSampleLevel(env_chain, env_smp, uv, level).xyz;
+    // (the sampler repeats in u)
+    return textureSampleLevel(env_chain, env_smp, vec2<f32>(uv.x - sunbeam_env.chain.z, uv.y), level).xyz;
 }
 
 fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {

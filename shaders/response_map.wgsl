@@ -44,6 +44,20 @@ fn sb_resp_dtheta(uv: vec2<f32>, duv: vec2<f32>, gr: SbGrid) -> f32 {
     return (uv.x * duv.y - uv.y * duv.x) / r2 * gr.n.x / SB_TAU;
 }
 
+// Derivatives of the texel coordinates (sb_resp_coords, without its clamps)
+// along a change duvw of (u, v, w): how many texels a footprint spans.
+fn sb_resp_dcoords(uvw: vec3<f32>, duvw: vec3<f32>, gr: SbGrid) -> vec3<f32> {
+    let r = length(uvw.xy);
+    var dr = length(duvw.xy);
+    if (r > 1e-6) {
+        dr = dot(uvw.xy, duvw.xy) / r;
+    }
+    let drho = dr / sqrt(gr.r0 * gr.r0 + r * r) / gr.rho_scale;
+    let q = sqrt(max(4.0 - r * r, 1e-12));
+    let ds = -duvw.z / q - uvw.z * r * dr / (q * q * q);
+    return vec3<f32>(sb_resp_dtheta(uvw.xy, duvw.xy, gr), drho * (gr.n.y - 1.0), ds * (gr.n.z - 1.0));
+}
+
 // Normalised texture coordinates of texel coordinates c in a map of grid gr
 // (the angle wraps by the sampler's repeat; rho and s clamped to the grid):
 // every reader of a response map (the material's, the environment's maps)

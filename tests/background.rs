@@ -20,7 +20,10 @@ use sunbeam_scene::Background;
 
 const W: u32 = 48;
 const H: u32 = 32;
-const ROTATION_DEG: f64 = 45.0; // a multiple of 360 / 64: the player's table is exact
+/// 8.37 texels of the 64-wide map: a fraction of a texel, which the player's
+/// table holds as its phase (`Environment::table_phase`); a table at the
+/// map's texel centres moved every texel edge by 0.37 texel.
+const ROTATION_DEG: f64 = 8.37 * 360.0 / 64.0;
 const INTENSITY: f64 = 0.7;
 const EXPOSURE: f64 = -0.5;
 
@@ -233,11 +236,11 @@ fn player_sky_background_matches_reference() {
     let reference = sunbeam_raster::render_prepared(
         &p,
         &Options {
-            samples: 16,
+            samples: 64,
             ..Default::default()
         },
     );
-    let frame = sunbeam_render::render_headless(&gpu, &p, &Settings::default(), None, 16).unwrap();
+    let frame = sunbeam_render::render_headless(&gpu, &p, &Settings::default(), None, 64).unwrap();
     let d = sunbeam_frame::compare(&frame, &reference).unwrap();
     // The table holds the sky at its texels' centres (0.7 degree rows): the
     // horizon's row, where the sky model is steepest, is compared apart.
@@ -263,6 +266,6 @@ fn player_sky_background_matches_reference() {
     );
     eprintln!("player sky background: {s}; within 1.5 degrees of the horizon {h}; whole frame {d}");
     assert!(s.pixels > (W * H * 3 / 4) as usize);
-    assert!(s.p99 < 1.0, "{s}");
-    assert!(h.p99 < 6.0, "{h}");
+    assert!(s.p99 < 0.5, "{s}");
+    assert!(h.p99 < 3.0, "{h}");
 }

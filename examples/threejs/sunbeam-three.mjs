@@ -420,7 +420,7 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
       _group_0_binding_8_fs: {
         value: {
           cells: new THREE.Vector4(envCells ? envCells.nTop : 0, envCells ? envCells.nS : 2, envCells ? envCells.nodes : 0, 0),
-          chain: new THREE.Vector4(env ? env.json.chain.height : 1, env ? env.json.chain.levels : 1, 0, 0),
+          chain: new THREE.Vector4(env ? env.json.chain.height : 1, env ? env.json.chain.levels : 1, env ? env.json.chain.phase ?? 0 : 0, 0),
           sun_dir: sun ? new THREE.Vector4(...sun.direction, 1) : new THREE.Vector4(),
           sun_rgb: sun ? new THREE.Vector4(...sun.rgb, 0) : new THREE.Vector4(),
           // a mesh without its sun map: n_theta 0 (no diffraction from the sun)
@@ -648,7 +648,8 @@ export function sceneCamera(scene, aspect) {
  * drawn first, showing the environment along each pixel's view ray as the
  * player's background pass does: the exported sb_env_texel (the texel of the
  * coefficient table holding the direction: table.ktx2, or level 0 of the
- * chain when there are no hot spots) times
+ * chain when there are no hot spots; its columns start chain.phase turns
+ * after phi = 0) times
  * basis_to_rgb, times 2^exposure. `camera` is the scene camera (a moving
  * camera: update the uniforms sbInvViewProj and sbEye per frame). `display`:
  * clip and sRGB-encode, as sunbeamMaterial's (drawing to a canvas).
@@ -668,6 +669,7 @@ uniform mat4 sbInvViewProj;
 uniform vec3 sbEye;
 uniform mat3 sbBasisToRgb;
 uniform uvec2 sbTable;
+uniform float sbPhase;
 uniform float sbExposure;
 uniform int sbDisplay;
 uniform highp sampler2D sbChain;
@@ -676,7 +678,7 @@ layout(location = 0) out vec4 fragColor;
 void main() {
   vec4 p = sbInvViewProj * vec4(vNdc, 1.0, 1.0);
   vec3 d = normalize(p.xyz / p.w - sbEye);
-  vec3 c = sbBasisToRgb * sb_env_texel(sbChain, sbTable.x, sbTable.y, d) * sbExposure;
+  vec3 c = sbBasisToRgb * sb_env_texel(sbChain, sbTable.x, sbTable.y, sbPhase, d) * sbExposure;
   if (sbDisplay == 1) {
     c = clamp(c, 0.0, 1.0);
     c = mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
@@ -689,6 +691,7 @@ void main() {
       // row-major rows of environment.json, as three's Matrix3.set takes them
       sbBasisToRgb: { value: new THREE.Matrix3().set(...m[0], ...m[1], ...m[2]) },
       sbTable: { value: new THREE.Vector2(environment.json.chain.width, environment.json.chain.height) },
+      sbPhase: { value: environment.json.chain.phase ?? 0 },
       sbExposure: { value: Math.pow(2, exposure) },
       sbDisplay: { value: display ? 1 : 0 },
       sbChain: { value: environment.table },

@@ -22,6 +22,10 @@
 pub struct Prefiltered {
     /// `(width, height, rgba)` per level, level 0 first.
     pub levels: Vec<(usize, usize, Vec<f32>)>,
+    /// Where the table's columns start, in turns after `phi = 0`
+    /// ([`crate::Environment::table_phase`]; 0 unless set by
+    /// [`Prefiltered::with_phase`]).
+    pub phase: f64,
 }
 
 impl Prefiltered {
@@ -77,7 +81,14 @@ impl Prefiltered {
             }
             levels.push((nw, nh, out));
         }
-        Prefiltered { levels }
+        Prefiltered { levels, phase: 0.0 }
+    }
+
+    /// The same chain for a table whose columns start `phase` turns after
+    /// `phi = 0` ([`crate::Environment::table_phase`]).
+    pub fn with_phase(mut self, phase: f64) -> Prefiltered {
+        self.phase = phase;
+        self
     }
 
     /// The level (fractional, clamped to the chain) at which one texel's
@@ -112,7 +123,7 @@ impl Prefiltered {
         let (w, h) = (*w, *h);
         let theta = d[1].clamp(-1.0, 1.0).acos();
         let phi = d[2].atan2(d[0]).rem_euclid(std::f64::consts::TAU);
-        let x = phi / std::f64::consts::TAU * w as f64 - 0.5;
+        let x = (phi / std::f64::consts::TAU - self.phase) * w as f64 - 0.5;
         let y = (theta / std::f64::consts::PI * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
         let (x0, y0) = (x.floor(), y.floor());
         let (tx, ty) = (x - x0, y - y0);
@@ -193,5 +204,27 @@ mod tests {
         );
         assert_eq!(p.level(1e-9), 0.0);
         assert_eq!(p.level(100.0), (p.levels.len() - 1) as f64);
+    }
+
+    /// A table whose columns start 0.3 column after phi = 0 (a map turned
+    /// by a fraction of a texel): read with its phase, the centre of each
+    /// texel gives that texel; read without, a mix with its neighbour.
+    #[test]
+    fn a_phased_table_is_read_at_its_own_columns() {
+        let (w, h) = (16, 8);
+        let phase = 0.3 / w as f64;
+        let rgba: Vec<f32> = (0..w * h)
+            .flat_map(|t| [(t % w) as f32 + 10.0 * (t / w) as f32, 0.0, 0.0, 0.0])
+            .collect();
+        let phased = Prefiltered::new(w, h, rgba.clone()).with_phase(phase);
+        let plain = Prefiltered::new(w, h, rgba);
+        for (i, j) in [(0, 3), (5, 4), (15, 7)] {
+            let theta = (j as f64 + 0.5) / h as f64 * std::f64::consts::PI;
+            let phi = ((i as f64 + 0.5) / w as f64 + phase) * std::f64::consts::TAU;
+            let d = crate::direction(theta.cos(), phi);
+            let want = i as f64 + 10.0 * j as f64;
+            assert!((phased.lookup(d, 1e-9)[0] - want).abs() < 1e-9);
+            assert!((plain.lookup(d, 1e-9)[0] - want).abs() > 0.2);
+        }
     }
 }

@@ -56,8 +56,11 @@ pub(crate) struct EnvGlobals {
     pub(crate) chain_levels: u32,
     /// The skin index the transmitted irradiance table was built for.
     pub(crate) irr_ior: f32,
-    pub(crate) _e0: u32,
-    pub(crate) _e1: u32,
+    /// Where the table's and the chain's columns start, turns after phi = 0
+    /// (`Environment::table_phase`).
+    pub(crate) table_phase: f32,
+    /// 1: the hot spots' taps read the maps over the pixel's footprint.
+    pub(crate) hot_footprint: u32,
     pub(crate) _e2: u32,
 }
 
@@ -156,14 +159,20 @@ pub(crate) struct HotSpots {
 }
 
 impl HotSpots {
-    /// As `opts` chooses them (`max_lights` 0: none, the residual is the table).
+    /// As `opts` chooses them (`max_lights` 0: none, the residual is the
+    /// table), for a table whose columns start `phase` turns after `phi = 0`
+    /// (`Environment::table_phase`): the taps turn with it.
     pub fn split(
         w: usize,
         h: usize,
         table: &[f32],
+        phase: f64,
         opts: sunbeam_light::hotspots::SplitOptions,
     ) -> HotSpots {
         let split = sunbeam_light::hotspots::split(w, h, table, opts);
+        // phi = atan2(z, x) grows by the phase's angle
+        let (s, c) = (std::f64::consts::TAU * phase).sin_cos();
+        let turn = |d: [f64; 3]| [c * d[0] - s * d[2], d[1], s * d[0] + c * d[2]];
         if !split.lights.is_empty() {
             log::info!(
                 "{} hot spots as lights ({:.1} % of the environment's energy)",
@@ -177,7 +186,7 @@ impl HotSpots {
             .flat_map(|l| {
                 sunbeam_response::hotspots::taps(l)
                     .into_iter()
-                    .map(|(d, w)| [v4(d, 0.0), v4(l.power.map(|p| p * w), 0.0)])
+                    .map(|(d, w)| [v4(turn(d), 0.0), v4(l.power.map(|p| p * w), 0.0)])
             })
             .collect();
         HotSpots {
@@ -215,6 +224,7 @@ impl EnvScene {
         estimator: EnvEstimator,
         ior: f64,
         hot_spots: sunbeam_light::hotspots::SplitOptions,
+        footprint: bool,
     ) -> EnvScene {
         let device = &gpu.device;
         let layout = layout(device);
@@ -225,6 +235,7 @@ impl EnvScene {
                 EnvEstimator::MonteCarlo => 1,
             },
             irr_ior: ior as f32,
+            hot_footprint: u32::from(footprint),
             table_w: 1,
             table_h: 1,
             ..Default::default()
@@ -245,6 +256,7 @@ impl EnvScene {
                     values.sun_t = v4(t, 0.0);
                     values.sun_b = v4(b, 0.0);
                 }
+                values.table_phase = e.table_phase() as f32;
                 e.coefficient_table(SKY_TABLE_HEIGHT)
             }
             None => (1, 1, vec![0.0f32; 4]),
@@ -258,7 +270,7 @@ impl EnvScene {
         // (the residual) prefiltered for the cells.
         let mut light_data = vec![[0.0f32; 4]; 2];
         let chain_levels = if cells {
-            let hot = HotSpots::split(tw, th, &tdata, hot_spots);
+            let hot = HotSpots::split(tw, th, &tdata, values.table_phase.into(), hot_spots);
             if !hot.taps.is_empty() {
                 light_data = hot.taps.concat();
             }

@@ -78,13 +78,14 @@ pub fn export(
         Ok(name.to_string())
     };
     let (tw, th, table) = env.coefficient_table(crate::env::SKY_TABLE_HEIGHT);
-    let hot = crate::env::HotSpots::split(tw, th, &table, hot_spots);
+    let phase = env.table_phase();
+    let hot = crate::env::HotSpots::split(tw, th, &table, phase, hot_spots);
     // With hot spots the chain is the rest of the map: the whole map (for a
     // background) is then a file of its own.
     let table_file = if hot.taps.is_empty() {
         None
     } else {
-        let json = serde_json::json!({"width": tw, "height": th});
+        let json = serde_json::json!({"width": tw, "height": th, "phase": phase});
         Some(put(
             "table.ktx2",
             encode_2d(
@@ -95,7 +96,8 @@ pub fn export(
         )?)
     };
     let chain = sunbeam_light::prefilter::Prefiltered::new(tw, th, hot.residual).levels;
-    let chain_json = serde_json::json!({"width": tw, "height": th, "levels": chain.len()});
+    let chain_json =
+        serde_json::json!({"width": tw, "height": th, "levels": chain.len(), "phase": phase});
     let chain_file = put(
         "chain.ktx2",
         encode_2d(
@@ -201,7 +203,7 @@ pub fn export(
         "format": "sunbeam-environment",
         "version": 1,
         "kind": if matches!(*env, sunbeam_light::Environment::Sky(_)) { "sky" } else { "map" },
-        "chain": {"file": chain_file, "width": tw, "height": th, "levels": chain.len()},
+        "chain": {"file": chain_file, "width": tw, "height": th, "levels": chain.len(), "phase": phase},
         "irradiance": {"skin": skin_file, "plain": plain_file, "ior": ior},
         "basis_to_rgb": m,
         "sun": sun,

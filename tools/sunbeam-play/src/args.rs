@@ -37,7 +37,8 @@ pub(crate) struct Cli {
     /// Headless: render K x K times the size and box-filter in linear light.
     #[arg(long, default_value_t = 1)]
     pub(crate) supersample: u32,
-    /// Default mode: read the response map at the pixel centre only (no footprint filter).
+    /// Read the response maps at the pixel centre only (no footprint filter): the point
+    /// lights' map, and the environment's hot spots under the cells estimator.
     #[arg(long)]
     pub(crate) no_footprint: bool,
     /// Frame size WxH (headless: default the scene's size; window: initial size).

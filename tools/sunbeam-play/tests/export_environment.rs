@@ -259,6 +259,61 @@ fn a_maps_hot_spots_are_exported_as_lights() {
             "channel {c}: the taps carry {ratio:.3} of the lamp's 200 x {omega:.5} sr"
         );
     }
+    // The taps' power-weighted direction is the lamp's centre; with the map
+    // turned by 0.4 texel (docs/SCENE.md: from +x towards +z, so phi grows)
+    // it turns with it: the table holds the turned map exactly, its columns
+    // starting 0.4 texel after phi = 0 (chain.phase), and the taps follow
+    // (at the texel centres of the turned map they stayed put: 2.25 degrees).
+    let towards = |taps: &[serde_json::Value]| {
+        let mut s = [0.0f64; 3];
+        for t in taps {
+            let t: Vec<f64> = serde_json::from_value(t.clone()).unwrap();
+            for k in 0..3 {
+                s[k] += t[k] * t[4];
+            }
+        }
+        let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+        s.map(|v| v / n)
+    };
+    let degrees_from = |a: [f64; 3], b: [f64; 3]| {
+        (a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees()
+    };
+    let off = degrees_from(towards(taps), centre);
+    assert!(off < 0.2, "the taps point {off:.3} degrees from the lamp");
+    assert_eq!(json["chain"]["phase"], 0.0);
+    let turn: f64 = 0.4 * 360.0 / 64.0;
+    let turned_scene = d.join("lamp-turned.json");
+    std::fs::write(
+        &turned_scene,
+        std::fs::read_to_string(&scene).unwrap().replace(
+            r#""map": "lamp.exr""#,
+            &format!(r#""map": "lamp.exr", "rotation_deg": {turn}"#),
+        ),
+    )
+    .unwrap();
+    let o = Command::new(BIN)
+        .arg(&turned_scene)
+        .args(["--env-cells", "32", "-q", "--export-environment"])
+        .arg(d.join("turned"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let turned: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("turned/environment.json")).unwrap()).unwrap();
+    let phase = turned["chain"]["phase"].as_f64().unwrap();
+    assert!((phase - 0.4 / 64.0).abs() < 1e-9, "phase {phase}");
+    let phi_t = phi + turn.to_radians();
+    let off = degrees_from(
+        towards(turned["hot_spots"].as_array().unwrap()),
+        [phi_t.cos(), 0.0, phi_t.sin()],
+    );
+    assert!(
+        off < 0.2,
+        "turned: the taps point {off:.3} degrees from the lamp"
+    );
     // `--env-hot-threshold`: a texel is hot above that many times the map's
     // mean, which is 1 + 199 omega / (4 pi), and a light keeps the lamp's
     // radiance above it: at 100 x the mean the taps carry (200 - 100 mean) /

@@ -36,7 +36,9 @@ struct BgGlobals {
     curve: u32,
     output: u32,
     keep_negative: u32,
-    _b: [u32; 3],
+    /// Where the table's columns start, turns after phi = 0.
+    table_phase: f32,
+    _b: [u32; 2],
 }
 
 /// The pass: its pipeline, uniforms and bind group.
@@ -74,6 +76,7 @@ impl Background {
             sun_rgb: v.sun_rgb,
             table_w: v.table_w,
             table_h: v.table_h,
+            table_phase: v.table_phase,
             has_sun: v.has_sun,
             ..Default::default()
         };

@@ -175,8 +175,9 @@ pub struct Settings {
     pub response: sunbeam_response::Options,
     /// Multisample count of the colour target (1 or 4): anti-aliased silhouettes.
     pub msaa: u32,
-    /// Default mode: average the response over the pixel's footprint (up to 4 x 4
-    /// samples) instead of reading it at the pixel centre.
+    /// Average the response over the pixel's footprint (up to 4 x 4 samples)
+    /// instead of reading it at the pixel centre: the point lights' map in the
+    /// default mode, and the environment's hot spots (cells estimator).
     pub footprint: bool,
     /// Environment: proposal samples per pixel per frame (crate::env).
     pub env_samples: u32,
@@ -362,6 +363,7 @@ impl Renderer {
             settings.env_estimator,
             skin_ior,
             settings.hot_spot_options(),
+            settings.footprint,
         );
         let mut notes = Vec::new();
         let mut env_maps: environment::BuiltMaps = Vec::new();
@@ -615,6 +617,7 @@ impl Renderer {
                             max_lights: 0,
                             ..Default::default()
                         },
+                        false,
                     );
                     &own
                 };
