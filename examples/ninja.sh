@@ -207,7 +207,12 @@ EOF
       echo "build $(path "$t")$extra: $rule $o/$m.$from |$dep $(path "$BIN/$tool")"
       echo "  target = $(esc "$t")"
       if [ "$rule" = pack ]; then echo "  sky = $o/$m-sky.json"; fi
-      echo "  tidy = $(esc "$OUT/.$m$sep$ext").tmp.*"
+      if [ "$rule" = pack ]; then
+        # all three outputs' temp files (a killed run may leave any)
+        echo "  tidy = $(esc "$OUT/.$m.ktx2").tmp.* $(esc "$OUT/.$m.response.ktx2").tmp.* $(esc "$OUT/.$m.env-response.ktx2").tmp.*"
+      else
+        echo "  tidy = $(esc "$OUT/.$m$sep$ext").tmp.*"
+      fi
     done
     echo "build $o/$m-scene.json: scene scene.json.in"
     echo "  target = $o/$m-scene.json"

@@ -251,6 +251,50 @@ fn msaa_position(j: u32) -> vec2<f32> {
     return pos[j];
 }
 
+// The screen derivatives of a fragment's attributes (dpdx, dpdy), which
+// carry them from the pixel centre to another point of the pixel.
+struct AttrDerivs {
+    world_x: vec3<f32>,
+    world_y: vec3<f32>,
+    normal_x: vec3<f32>,
+    normal_y: vec3<f32>,
+    tangent_x: vec3<f32>,
+    tangent_y: vec3<f32>,
+    uv_x: vec2<f32>,
+    uv_y: vec2<f32>,
+    uv_tangent_x: vec4<f32>,
+    uv_tangent_y: vec4<f32>,
+};
+
+// The point and shading frame at offset o (pixels) from the centre, along the
+// attributes' derivatives (the triangle's plane: it stays on the surface).
+struct Carried {
+    world: vec3<f32>,
+    frame: mat3x3<f32>,
+};
+
+fn carried(in: VsOut, d: AttrDerivs, o: vec2<f32>) -> Carried {
+    var c: Carried;
+    c.world = in.world + d.world_x * o.x + d.world_y * o.y;
+    c.frame = frame_at(
+        in.normal + d.normal_x * o.x + d.normal_y * o.y,
+        in.tangent + d.tangent_x * o.x + d.tangent_y * o.y,
+        in.uv + d.uv_x * o.x + d.uv_y * o.y,
+        in.uv_tangent + d.uv_tangent_x * o.x + d.uv_tangent_y * o.y
+    );
+    return c;
+}
+
+// The environment (shaders/environment.wgsl env_shade) at offset o (pixels)
+// from the pixel centre.
+fn env_shade_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw: f32, diffract: bool, fp: EnvFootprint) -> vec3<f32> {
+    let c = carried(in, d, o);
+    let fc = c.frame;
+    let wr_c = normalize(g.eye.xyz - c.world);
+    let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
+    return env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, length(g.eye.xyz - c.world), fp);
+}
+
 // The colour of a fragment (`covered`: its sample mask), whichever the
 // technique: each technique's entry point returns it.
 fn shade(in: VsOut, covered: u32) -> vec4<f32> {
@@ -268,16 +312,11 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
     }
     // The attributes' screen derivatives, in uniform control flow: they carry
     // the attributes from the centre to a covered sample below.
-    let dworld_x = dpdx(in.world);
-    let dworld_y = dpdy(in.world);
-    let dnormal_x = dpdx(in.normal);
-    let dnormal_y = dpdy(in.normal);
-    let dtangent_x = dpdx(in.tangent);
-    let dtangent_y = dpdy(in.tangent);
-    let duv_tex_x = dpdx(in.uv);
-    let duv_tex_y = dpdy(in.uv);
-    let duv_tangent_x = dpdx(in.uv_tangent);
-    let duv_tangent_y = dpdy(in.uv_tangent);
+    let da = AttrDerivs(
+        dpdx(in.world), dpdy(in.world), dpdx(in.normal), dpdy(in.normal),
+        dpdx(in.tangent), dpdy(in.tangent), dpdx(in.uv), dpdy(in.uv),
+        dpdx(in.uv_tangent), dpdy(in.uv_tangent)
+    );
     // The pixel's footprint for the environment's hot spots (the frame's and
     // the view's derivatives at the centre).
     let env_fp = EnvFootprint(dpdx(t), dpdy(t), dpdx(b), dpdy(b), dpdx(n), dpdy(n), dpdx(wr_l), dpdy(wr_l));
@@ -318,18 +357,11 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
             var acc = vec3<f32>(0.0);
             for (var j = 0u; j < 4u; j = j + 1u) {
                 if (((covered >> j) & 1u) == 1u) {
-                    let o = msaa_position(j);
-                    let world_s = in.world + dworld_x * o.x + dworld_y * o.y;
-                    let fs = frame_at(
-                        in.normal + dnormal_x * o.x + dnormal_y * o.y,
-                        in.tangent + dtangent_x * o.x + dtangent_y * o.y,
-                        in.uv + duv_tex_x * o.x + duv_tex_y * o.y,
-                        in.uv_tangent + duv_tangent_x * o.x + duv_tangent_y * o.y
-                    );
-                    let wr_s = normalize(g.eye.xyz - world_s);
+                    let c = carried(in, da, msaa_position(j));
+                    let wr_s = normalize(g.eye.xyz - c.world);
                     // each sample stands for a quarter of the pixel: half the
                     // footprint along each axis
-                    acc = acc + shade_light(i, fs, wr_s, diffract, dw, 0.5 * duv_x, 0.5 * duv_y, 0.5 * dw_x, 0.5 * dw_y, 0.5 * jx, 0.5 * jy);
+                    acc = acc + shade_light(i, c.frame, wr_s, diffract, dw, 0.5 * duv_x, 0.5 * duv_y, 0.5 * dw_x, 0.5 * dw_y, 0.5 * jx, 0.5 * jy);
                 }
             }
             rgb = rgb + acc / f32(n_cov);
@@ -338,7 +370,8 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
         }
     }
     // The scene's environment (shaders/environment.wgsl): one Monte Carlo
-    // estimate per frame, accumulated by the caller.
+    // estimate per frame, accumulated by the caller, or the first-frame
+    // estimator's cells.
     if (envg.on == 1u) {
         // Where the environment's Monte Carlo estimate shades: the pixel centre,
         // except in a partly covered pixel whose centre sees the surface at a
@@ -364,20 +397,41 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
         // samples have infinite variance (docs/LIGHTING.md "Grazing views").
         // (Derivatives here: envg is uniform, so this is uniform control flow;
         // the pick only moves the point along them.)
-        var off = vec2<f32>(0.0);
-        if (g.msaa >= 4u && dot(wr, n) <= ENV_GRAZING_COS) {
-            env_seed_at(vec2<u32>(in.clip.xy), envg.frame);
-            off = covered_pick(covered, env_qmc(envg.frame + 1u, 31u));
+        //
+        // The first-frame estimator (the cells) is one frame, not a running
+        // mean, so it picks no sample: a partly covered pixel (a silhouette,
+        // or an edge between triangles) shades every covered sample and
+        // takes their mean, as the point lights do at silhouettes; every
+        // other pixel its centre. The centre of a partly covered pixel may
+        // lie past its triangle, where the attributes are extrapolated: on
+        // the baked snake under the sky (96 x 48, 4 x 4 supersampled) the
+        // first frame's interior p99 against the reference was 8.5 so, 1.4
+        // at the samples, and 8.5 again when only the pixels whose centre
+        // missed the surface took the samples: along the tapering tail the
+        // triangles are smaller than a sub-pixel and turn fast
+        // (docs/LIGHTING.md "The first frame"). Branches, not one call in a
+        // loop over the samples: on llvmpipe the loop cost the snake's frame
+        // 2x.
+        if (envg.estimator == 0u) {
+            if (g.msaa >= 4u && n_cov < 4u) {
+                var acc = vec3<f32>(0.0);
+                for (var j = 0u; j < 4u; j = j + 1u) {
+                    if (((covered >> j) & 1u) == 1u) {
+                        acc = acc + env_shade_carried(in, da, msaa_position(j), base, dw, diffract, env_fp);
+                    }
+                }
+                rgb = rgb + acc / f32(n_cov);
+            } else {
+                rgb = rgb + env_shade_carried(in, da, vec2<f32>(0.0), base, dw, diffract, env_fp);
+            }
+        } else {
+            var off = vec2<f32>(0.0);
+            if (g.msaa >= 4u && dot(wr, n) <= ENV_GRAZING_COS) {
+                env_seed_at(vec2<u32>(in.clip.xy), envg.frame);
+                off = covered_pick(covered, env_qmc(envg.frame + 1u, 31u));
+            }
+            rgb = rgb + env_shade_carried(in, da, off, base, dw, diffract, env_fp);
         }
-        let world_c = in.world + dworld_x * off.x + dworld_y * off.y;
-        let normal_c = in.normal + dnormal_x * off.x + dnormal_y * off.y;
-        let tangent_c = in.tangent + dtangent_x * off.x + dtangent_y * off.y;
-        let uv_c = in.uv + duv_tex_x * off.x + duv_tex_y * off.y;
-        let uv_tangent_c = in.uv_tangent + duv_tangent_x * off.x + duv_tangent_y * off.y;
-        let fc = frame_at(normal_c, tangent_c, uv_c, uv_tangent_c);
-        let wr_c = normalize(g.eye.xyz - world_c);
-        let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
-        rgb = rgb + env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, length(g.eye.xyz - world_c), env_fp);
     }
     return display(rgb);
 }
