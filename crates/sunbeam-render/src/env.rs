@@ -171,8 +171,7 @@ impl HotSpots {
     ) -> HotSpots {
         let split = sunbeam_light::hotspots::split(w, h, table, opts);
         // phi = atan2(z, x) grows by the phase's angle
-        let (s, c) = (std::f64::consts::TAU * phase).sin_cos();
-        let turn = |d: [f64; 3]| [c * d[0] - s * d[2], d[1], s * d[0] + c * d[2]];
+        let turn = |d: [f64; 3]| sunbeam_light::rot_y(d, 360.0 * phase);
         if !split.lights.is_empty() {
             log::info!(
                 "{} hot spots as lights ({:.1} % of the environment's energy)",
