@@ -4,6 +4,10 @@
 // clustered into cells (sunbeam_response::cells::Cells::gpu_data), each
 // evaluated per shading point against the prefiltered coefficient table
 // (sunbeam_light::prefilter), and the irradiance tables of the diffuse base.
+// A cell that straddles the view's horizon counts each of its 9 masses'
+// share inside the disc from that mass's own centroid: on a pack of real
+// size a cell on a narrow diffraction order is a rainbow, and the horizon
+// keeps one end of it.
 //
 // Needs shaders/material.wgsl (sb_erf), shaders/response_map.wgsl (SB_TAU)
 // and shaders/env_table.wgsl (sb_env_equirect) before it. The host supplies
@@ -34,8 +38,12 @@ fn env_prefiltered(d: vec3<f32>, omega: f32) -> vec3<f32> {
 // Cells refine near the horizon while their spread times this reaches it
 // (sunbeam_response::cells::REFINE).
 const ENV_REFINE: f32 = 2.0;
-// Cells::gpu_data: floats per node before its masses, and "no node".
-const ENV_CELL_HEADER: u32 = 5u;
+// Cells::gpu_data: floats per node before its masses (u, v, spread, first,
+// next, then the 9 masses' offsets), and "no node".
+const ENV_CELL_HEADER: u32 = 23u;
+// A cell inside the disc by less than this share straddles the horizon
+// (cells::STRADDLE).
+const ENV_CELL_STRADDLE: f32 = 0.999;
 const ENV_CELL_NONE: u32 = 0xffffffffu;
 
 // The diffraction part (XYZ) of the environment without the sun at local
@@ -86,10 +94,11 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         let sc = s * f32(ns - 1u);
         let k0 = min(u32(floor(sc)), ns - 2u);
         let f = sc - f32(k0);
-        let gw = env_cells_gain(wi, wr, view) / wi.z * inside;
+        let gw = env_cells_gain(wi, wr, view) / wi.z;
         if (!(gw > 0.0)) {
             continue;
         }
+        let straddles = inside < ENV_CELL_STRADDLE && spread > 0.0;
         let omega = max(SB_TAU * spread * spread / wi.z, 1e-9);
         let c = env_prefiltered(wi.x * t + wi.y * b + wi.z * n, omega);
         let m0 = o + ENV_CELL_HEADER + k0 * 9u;
@@ -98,11 +107,28 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         for (var bb = 0u; bb < 3u; bb = bb + 1u) {
             let a0 = vec3<f32>(env_cell_f32(m0 + 3u * bb), env_cell_f32(m0 + 3u * bb + 1u), env_cell_f32(m0 + 3u * bb + 2u));
             let a1 = vec3<f32>(env_cell_f32(m1 + 3u * bb), env_cell_f32(m1 + 3u * bb + 1u), env_cell_f32(m1 + 3u * bb + 2u));
-            e = e + c[bb] * mix(a0, a1, f);
+            var share = vec3<f32>(inside);
+            if (straddles) {
+                let q = o + 5u + 6u * bb;
+                share = vec3<f32>(
+                    env_cell_inside(uv, spread, vec2<f32>(env_cell_f32(q), env_cell_f32(q + 1u)), wr),
+                    env_cell_inside(uv, spread, vec2<f32>(env_cell_f32(q + 2u), env_cell_f32(q + 3u)), wr),
+                    env_cell_inside(uv, spread, vec2<f32>(env_cell_f32(q + 4u), env_cell_f32(q + 5u)), wr));
+            }
+            e = e + c[bb] * mix(a0, a1, f) * share;
         }
         xyz = xyz + gw * e;
     }
     return xyz;
+}
+
+// The share of one mass inside the disc for view wr: a Gaussian about the
+// mass's own centroid (the cell's plus `off`), with the cell's spread less
+// the offset, at least a quarter of it (cells::channel_inside).
+fn env_cell_inside(uv: vec2<f32>, spread: f32, off: vec2<f32>, wr: vec3<f32>) -> f32 {
+    let sq = sqrt(max(spread * spread - dot(off, off), 0.0625 * spread * spread));
+    let d = 1.0 - length(-uv - off - wr.xy);
+    return 0.5 * (1.0 + sb_erf(d / (1.4142135623730951 * sq)));
 }
 
 // Irradiance (linear sRGB, without the sun) at world normal n from a table

@@ -1,11 +1,28 @@
 //! The first-frame cells against the reference's quadrature at single
 //! shading points (docs/LIGHTING.md "The first frame"): CIEDE2000 over random
-//! frames and views for several cell counts. Prints; asserts nothing.
+//! frames and views for several cell counts. Prints; asserts nothing. Also
+//! prints how much of each environment's energy its brightest texels hold,
+//! and the top cut's spread.
 //!
-//! `cargo bench -p sunbeam-response --bench cells [-- elaphe]`; `CELLS_CFG=TOP:DEPTH,..`
-//! picks the cell counts; `HOT=THRESHOLD:MAX` pulls the hot spots out as lights
-//! first (`sunbeam_light::hotspots`, through `sunbeam_response::hotspots`). Also prints how much of each environment's energy its
-//! brightest texels hold.
+//! `cargo bench -p sunbeam-response --bench cells [-- elaphe]`, and in the
+//! environment:
+//!
+//! - `CELLS_CFG=TOP:DEPTH,..`: the cell counts;
+//! - `PACK=FILE`: a pack file (e.g. a 20 um synthetic scan) instead of the
+//!   thesis patch;
+//! - `ENVS=sky,studio,white`: the environments (`white`: a constant map, so
+//!   only the factors `G / cos` and the layers vary across a cell);
+//! - `HOT=THRESHOLD:MAX`: the hot spots pulled out as lights first
+//!   (`sunbeam_light::hotspots`, through `sunbeam_response::hotspots`);
+//! - `LAMBDA=N`: the player's maps with `N` wavelength samples (the reference
+//!   keeps its 160);
+//! - `YONLY=1`: the error of luminance alone (the estimate's Y with the
+//!   reference's chromaticity);
+//! - `TEXELS=1`: also every texel as its own cell at its centre, the
+//!   environment read unfiltered there (no horizon band: the floor of a
+//!   midpoint rule on the maps' own grid);
+//! - `NOPRE=1`, `OMS=X`: the environment read at the centroid unfiltered, or
+//!   its solid angle scaled by `X`; `WORST=1`: print the worst points.
 
 use std::time::Instant;
 use sunbeam_common::rng::SplitMix64;
@@ -29,7 +46,11 @@ fn main() {
     } else {
         fixtures::XENO
     };
-    let pack = fixtures::pack(&patch, &dir, &BuildOptions::default()).expect("pack");
+    // PACK=path: a pack file (e.g. a 20 um synthetic scan) instead of the thesis patch
+    let pack = match std::env::var("PACK") {
+        Ok(p) => sunbeam_pack::Pack::read(std::path::Path::new(&p)).expect("PACK"),
+        Err(_) => fixtures::pack(&patch, &dir, &BuildOptions::default()).expect("pack"),
+    };
     let envs: Vec<(&str, Environment)> = vec![
         (
             "sky",
@@ -48,9 +69,29 @@ fn main() {
             ),
         ),
     ];
+    // ENVS=white: a constant white map (the factors G / cos and the layers
+    // alone, no environment gradient); ENVS=sky,studio,white picks
+    let mut envs = envs;
+    envs.push((
+        "white",
+        Environment::Map(
+            sunbeam_light::EnvMap::new(64, 32, vec![[1.0; 3]; 64 * 32], 0.0, 1.0).expect("white"),
+        ),
+    ));
+    let pick = std::env::var("ENVS").unwrap_or_else(|_| "sky,studio".into());
+    envs.retain(|(n, _)| pick.split(',').any(|p| p == *n));
     for (name, env) in &envs {
         let t0 = Instant::now();
-        let er = build_env(&pack, env, &Options::default());
+        // LAMBDA=N: the player's maps with N wavelength samples (default 96;
+        // the reference's 160)
+        let opts = match std::env::var("LAMBDA") {
+            Ok(n) => Options {
+                lambda_samples: n.parse().expect("LAMBDA"),
+                ..Options::default()
+            },
+            Err(_) => Options::default(),
+        };
+        let er = build_env(&pack, env, &opts);
         let t_env = t0.elapsed();
         let t0 = Instant::now();
         let quad = EnvQuadrature::build(&pack, env, &EnvQuadrature::reference_options());
@@ -175,8 +216,77 @@ fn main() {
                 )
             })
             .collect();
+        if std::env::var("TEXELS").is_ok() {
+            // every texel its own cell, at its centre: what the cells approximate
+            let g = er.basis[0].info.grid;
+            let (nt, nr, ns) = (g.n_theta, g.n_rho, g.n_s);
+            let mut de = Vec::new();
+            for ((f, wr), r) in pts.iter().zip(&refs) {
+                let (t, b, n) = *f;
+                let mut x = [0.0; 3];
+                for j in 0..nr {
+                    let a = g.texel_extent(j).2;
+                    let rr = g.r_at(j);
+                    for i in 0..nt {
+                        let th = g.theta_at(i);
+                        let (wx, wy) = (-rr * th.cos() - wr[0], -rr * th.sin() - wr[1]);
+                        let l2 = wx * wx + wy * wy;
+                        if l2 >= 1.0 {
+                            continue;
+                        }
+                        let wi = [wx, wy, (1.0 - l2).sqrt()];
+                        let sv =
+                            ((wi[2] + wr[2]) / (4.0 - rr * rr).max(1e-12).sqrt()).clamp(0.0, 1.0);
+                        let sc = sv * (ns - 1) as f64;
+                        let k0 = (sc.floor() as usize).min(ns - 2);
+                        let fr = sc - k0 as f64;
+                        let gg = sunbeam_optics::gain::g(wi, *wr, skin) / wi[2] * a;
+                        let d = [0, 1, 2].map(|k| wi[0] * t[k] + wi[1] * b[k] + wi[2] * n[k]);
+                        let ck = env.coefficients(d);
+                        for (bb, m) in er.basis.iter().enumerate() {
+                            let e0 = m.texel(i, j, k0);
+                            let e1 = m.texel(i, j, k0 + 1);
+                            for c in 0..3 {
+                                x[c] += gg * ck[bb] * (e0[c] * (1.0 - fr) + e1[c] * fr);
+                            }
+                        }
+                    }
+                }
+                let sc = |v: [f64; 3]| v.map(|c| (c / white).max(0.0));
+                de.push(colour::ciede2000_xyz(sc(x), sc(*r)));
+            }
+            de.sort_by(f64::total_cmp);
+            eprintln!(
+                "  texels at their centres: dE mean {:.3} p99 {:.3} max {:.3}",
+                de.iter().sum::<f64>() / de.len() as f64,
+                de[de.len() * 99 / 100],
+                de[de.len() - 1]
+            );
+        }
         for (n_top, depth) in cfgs {
             let cells = Cells::build(&er.basis, n_top, depth);
+            {
+                // the top cut's spread, mass-weighted (Y of E_0 summed over layers)
+                let (mut sw, mut sm, mut sp) = (0.0, 0.0, Vec::new());
+                for c in &cells.nodes[..cells.n_top] {
+                    let m: f64 = c.mass.iter().map(|l| l[1].abs()).sum();
+                    sw += m * c.spread;
+                    sm += m;
+                    sp.push(c.spread);
+                }
+                sp.sort_by(f64::total_cmp);
+                let g = cells.grid;
+                eprintln!(
+                    "  grid {} x {} x {}, r0 {:.4}; top spread mass-weighted {:.4}, median {:.4}, p90 {:.4}",
+                    g.n_theta,
+                    g.n_rho,
+                    g.n_s,
+                    g.r0,
+                    sw / sm,
+                    sp[sp.len() / 2],
+                    sp[sp.len() * 9 / 10]
+                );
+            }
             let t0 = Instant::now();
             let mut de = Vec::new();
             let mut bins: Vec<Vec<f64>> = vec![Vec::new(); 5];
@@ -223,6 +333,12 @@ fn main() {
                 }
                 let sc = |v: [f64; 3]| v.map(|c| (c / white).max(0.0));
                 de.push(colour::ciede2000_xyz(sc(x), sc(*r)));
+                if std::env::var("YONLY").is_ok() {
+                    // the same chromaticity as the reference: luminance's share
+                    let k = x[1] / r[1].max(1e-30);
+                    let y_only = r.map(|c| c * k);
+                    *de.last_mut().unwrap() = colour::ciede2000_xyz(sc(y_only), sc(*r));
+                }
                 if std::env::var("WORST").is_ok() && *de.last().unwrap() > 8.0 {
                     eprintln!(
                         "    dE {:.1} cos_r {:.3} est {:?} ref {:?}",

@@ -30,7 +30,11 @@
 //! two children the clustering made (kept as a binary tree), while its spread
 //! reaches the horizon (`dist < REFINE * spread`), so that the `1 / cos` peak
 //! there is followed; leaves straddling it count the share of their spread
-//! inside the disc (a Gaussian's, along the normal to the horizon).
+//! inside the disc (a Gaussian's, along the normal to the horizon), each
+//! channel from its own centroid ([`Cell::offsets`]): on a pack of real size
+//! the diffraction orders are narrow, a cell on one holds a rainbow along
+//! it, and the horizon keeps one end of it (docs/LIGHTING.md "Why 20 um is
+//! harder").
 
 use crate::grid::Grid;
 use crate::Response;
@@ -51,7 +55,7 @@ pub const DEFAULT_TOP: usize = 256;
 /// Levels below the top cut kept for views whose horizon a cell reaches.
 pub const DEFAULT_DEPTH: usize = 4;
 /// Floats per node in [`Cells::gpu_data`] before its layers' masses.
-pub const GPU_HEADER: usize = 5;
+pub const GPU_HEADER: usize = 5 + 18;
 /// "No node" in [`Cells::gpu_data`]'s links.
 pub const GPU_NONE: u32 = u32::MAX;
 
@@ -67,6 +71,9 @@ pub struct Cell {
     /// Per layer `k` (the maps' `s` texels): `int_cell E_b d(u, v)`, XYZ of
     /// `b = 0, 1, 2` (9 values).
     pub mass: Vec<[f64; 9]>,
+    /// Per value of `mass`: its own centroid less `uv`, over all layers
+    /// (`int E (uv - centroid) / int E`), at most `2 spread` long.
+    pub offsets: [[f64; 2]; 9],
 }
 
 /// The cells of one pack's maps.
@@ -232,6 +239,7 @@ impl Cells {
                 spread: 0.0,
                 children: None,
                 mass: Vec::new(),
+                offsets: [[0.0; 2]; 9],
             });
             queue.push((out.len() - 1, m, 0));
         }
@@ -271,31 +279,48 @@ impl Cells {
         // (children come after their parent). One pass instead of one per
         // tree level, and no strided reads: most of the player's start-up
         // under an environment before (docs/bench/play.md "Start-up").
-        let per_layer: Vec<Vec<[f64; 9]>> = (0..ns)
+        // The same pass sums each value's first moment over the layers
+        // (raw, about the origin), for the channels' own centroids.
+        // per layer: each node's 9 masses and their raw first moments
+        type Layer = (Vec<[f64; 9]>, Vec<[[f64; 2]; 9]>);
+        let per_layer: Vec<Layer> = (0..ns)
             .into_par_iter()
             .map(|k| {
                 let mut acc = vec![[0.0; 9]; out.len()];
+                let mut mom = vec![[[0.0; 2]; 9]; out.len()];
                 for j in 0..nr {
                     let a = areas[j];
+                    let r = g.r_at(j);
                     for i in 0..nt {
                         let leaf = owner[j * nt + i];
                         if leaf == u32::MAX {
                             continue;
                         }
-                        let o = &mut acc[leaf as usize];
+                        let (sn, cs) = g.theta_at(i).sin_cos();
+                        let (o, q) = (&mut acc[leaf as usize], &mut mom[leaf as usize]);
                         for (b, map) in basis.iter().enumerate() {
                             let e = map.texel(i, j, k);
                             for c in 0..3 {
-                                o[3 * b + c] += a * e[c];
+                                let m = a * e[c];
+                                o[3 * b + c] += m;
+                                q[3 * b + c][0] += m * r * cs;
+                                q[3 * b + c][1] += m * r * sn;
                             }
                         }
                     }
                 }
-                acc
+                (acc, mom)
             })
             .collect();
+        let mut moment = vec![[[0.0; 2]; 9]; out.len()];
         for (id, cell) in out.iter_mut().enumerate() {
-            cell.mass = per_layer.iter().map(|l| l[id]).collect();
+            cell.mass = per_layer.iter().map(|l| l.0[id]).collect();
+            for l in &per_layer {
+                for (x, y) in moment[id].iter_mut().zip(&l.1[id]) {
+                    x[0] += y[0];
+                    x[1] += y[1];
+                }
+            }
         }
         for id in (0..out.len()).rev() {
             if let Some([a, b]) = out[id].children {
@@ -306,7 +331,32 @@ impl Cells {
                     .map(|(x, y)| std::array::from_fn(|c| x[c] + y[c]))
                     .collect();
                 out[id].mass = sum;
+                let (qa, qb) = (moment[a as usize], moment[b as usize]);
+                moment[id] = std::array::from_fn(|c| [qa[c][0] + qb[c][0], qa[c][1] + qb[c][1]]);
             }
+        }
+        for (cell, q) in out.iter_mut().zip(&moment) {
+            let total: [f64; 9] = std::array::from_fn(|c| cell.mass.iter().map(|l| l[c]).sum());
+            let scale: f64 = total.iter().map(|m| m.abs()).sum();
+            let longest = 2.0 * cell.spread;
+            cell.offsets = std::array::from_fn(|c| {
+                // a value whose mass nearly cancels over the cell (the basis
+                // maps are signed) has no centroid to speak of
+                if total[c].abs() <= 1e-6 * scale {
+                    return [0.0; 2];
+                }
+                let d = [
+                    q[c][0] / total[c] - cell.uv[0],
+                    q[c][1] / total[c] - cell.uv[1],
+                ];
+                let l = d[0].hypot(d[1]);
+                if l > longest {
+                    let k = longest / l;
+                    [d[0] * k, d[1] * k]
+                } else {
+                    d
+                }
+            });
         }
         Cells {
             grid: g,
@@ -317,8 +367,9 @@ impl Cells {
 
     /// The nodes for the shader (shaders/environment.wgsl `env_cells`): per
     /// node `[u, v, spread, first child, next]` (links as u32 bits,
-    /// [`GPU_NONE`] for none), then `n_s` layers of 9 masses (XYZ of `E_0,
-    /// E_1, E_2`); the second child follows the first.
+    /// [`GPU_NONE`] for none), the 9 `offsets` (u, v each), then `n_s`
+    /// layers of 9 masses (XYZ of `E_0, E_1, E_2`); the second child follows
+    /// the first.
     ///
     /// `next` threads the tree: the node a depth-first walk visits after this
     /// one and its subtree (the next top cell, or the sibling, or the
@@ -351,6 +402,7 @@ impl Cells {
                 f32::from_bits(first),
                 f32::from_bits(nx),
             ]);
+            out.extend(c.offsets.iter().flat_map(|o| o.map(|x| x as f32)));
             for layer in &c.mass {
                 out.extend(layer.iter().map(|&m| m as f32));
             }
@@ -405,18 +457,43 @@ impl Cells {
             let sc = s * (self.grid.n_s - 1) as f64;
             let k0 = (sc.floor() as usize).min(self.grid.n_s - 2);
             let f = sc - k0 as f64;
-            let g = masking.gain(wi, wr, skin) / wi[2] * inside;
+            let g = masking.gain(wi, wr, skin) / wi[2];
             let omega = (std::f64::consts::TAU * c.spread * c.spread / wi[2]).max(1e-9);
             let ck = coeffs(world(wi), omega);
+            let straddles = inside < STRADDLE && c.spread > 0.0;
             for (bb, cb) in ck.iter().enumerate() {
                 for (a, x) in xyz.iter_mut().enumerate() {
-                    let m = c.mass[k0][3 * bb + a] * (1.0 - f) + c.mass[k0 + 1][3 * bb + a] * f;
-                    *x += g * cb * m;
+                    let q = 3 * bb + a;
+                    let m = c.mass[k0][q] * (1.0 - f) + c.mass[k0 + 1][q] * f;
+                    let share = if straddles {
+                        channel_inside(c, q, wr)
+                    } else {
+                        inside
+                    };
+                    *x += g * share * cb * m;
                 }
             }
         }
         xyz
     }
+}
+
+/// A cell whose share inside the disc is below this straddles the horizon:
+/// each channel counts its own share ([`channel_inside`]).
+pub const STRADDLE: f64 = 0.999;
+
+/// The share of value `q`'s mass inside the disc for view `wr`: a Gaussian
+/// about the value's own centroid, with the cell's spread less the offset
+/// (at least a quarter of it). As shaders/env_cells.wgsl `env_cell_inside`.
+fn channel_inside(c: &Cell, q: usize, wr: [f64; 3]) -> f64 {
+    let off = c.offsets[q];
+    let o2 = off[0] * off[0] + off[1] * off[1];
+    let sq = (c.spread * c.spread - o2)
+        .max(0.0625 * c.spread * c.spread)
+        .sqrt();
+    let wxy = [-c.uv[0] - off[0] - wr[0], -c.uv[1] - off[1] - wr[1]];
+    let d = 1.0 - wxy[0].hypot(wxy[1]);
+    0.5 * (1.0 + sunbeam_optics::masking::erf(d / (std::f64::consts::SQRT_2 * sq)))
 }
 
 #[cfg(test)]
@@ -429,6 +506,7 @@ mod tests {
             spread: 0.0,
             children,
             mass: vec![[0.0; 9]; 2],
+            offsets: [[0.0; 2]; 9],
         }
     }
 

@@ -741,3 +741,35 @@ fn snake_first_frame_matches_the_reference_inside() {
 /// 1.815 (mean 0.617, max 2.12 over 159 pixels; lavapipe, 2026-11-28), plus
 /// 25 %; every pixel shaded at its centre instead: 3.27.
 const SNAKE_INTERIOR_P99: f64 = 2.3;
+
+/// Without 32-bit float render targets (an OpenGL adapter: llvmpipe when no
+/// Vulkan driver is installed, forced here with `WGPU_BACKEND=gl`) the
+/// first-frame cells fail saying what to do instead (install Vulkan, or use
+/// Monte Carlo) and write nothing; where the adapter renders them, the frame
+/// is written.
+#[test]
+fn an_adapter_without_float_targets_says_what_to_do() {
+    let Some((dir, scene)) =
+        sky_lit_ridge_sphere("gl", r#"{ "eye": [0, 0, 3], "target": [0, 0, 0] }"#, 8)
+    else {
+        return;
+    };
+    let out = dir.join("f.exr");
+    let o = Command::new(BIN)
+        .arg(&scene)
+        .args(["--headless", "--env-estimator", "cells", "-o"])
+        .arg(&out)
+        .env("WGPU_BACKEND", "gl")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    if o.status.success() {
+        assert!(out.exists(), "{err}");
+    } else {
+        assert!(
+            err.contains("mesa-vulkan-drivers") && err.contains("--env-estimator monte-carlo"),
+            "{err}"
+        );
+        assert!(!out.exists());
+    }
+}

@@ -143,6 +143,22 @@ fn target(gpu: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Textu
         .create_view(&Default::default())
 }
 
+/// OpenGL adapters (llvmpipe, what wgpu falls back to when no Vulkan driver
+/// is installed) may not render to 32-bit float targets: a pre-pass that
+/// cannot be built says what to do instead.
+fn explain(e: sunbeam_common::Error) -> sunbeam_common::Error {
+    if e.to_string().contains("not renderable") {
+        e.context(
+            "the first-frame cells (--env-estimator cells) render to 32-bit float targets, \
+             which this GPU adapter refuses (an OpenGL one, such as llvmpipe without a Vulkan \
+             driver?): install Vulkan (Debian: mesa-vulkan-drivers) or use --env-estimator \
+             monte-carlo",
+        )
+    } else {
+        e
+    }
+}
+
 impl CellsRate {
     /// The pre-passes at one pixel in `rate` x `rate` (>= 1; 1: the centre
     /// pass alone), with the default pipeline's bind group layouts;
@@ -162,13 +178,16 @@ impl CellsRate {
                 entry: "fs_cells",
                 constants: Vec::new(),
             };
-            Some(render_pipeline(
-                device,
-                layouts,
-                &[XYZ_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
-                1,
-                &technique,
-            )?)
+            Some(
+                render_pipeline(
+                    device,
+                    layouts,
+                    &[XYZ_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
+                    1,
+                    &technique,
+                )
+                .map_err(explain)?,
+            )
         } else {
             None
         };
@@ -184,7 +203,8 @@ impl CellsRate {
             &[CENTRE_FORMAT, FRAME_FORMAT],
             1,
             &technique,
-        )?;
+        )
+        .map_err(explain)?;
         let pre_bind = global_bind(
             device,
             layouts[0],
