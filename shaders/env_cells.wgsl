@@ -79,7 +79,7 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         id = env_cell_u32(o + 4u);
         var inside = select(0.0, 1.0, dist > 0.0);
         if (spread > 0.0) {
-            inside = 0.5 * (1.0 + sb_erf(dist / (1.4142135623730951 * spread)));
+            inside = env_gaussian_inside(dist, spread);
         }
         if (inside <= 0.0 || dist <= -0.5) {
             continue;
@@ -127,8 +127,13 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
 // the offset, at least a quarter of it (cells::channel_inside).
 fn env_cell_inside(uv: vec2<f32>, spread: f32, off: vec2<f32>, wr: vec3<f32>) -> f32 {
     let sq = sqrt(max(spread * spread - dot(off, off), 0.0625 * spread * spread));
-    let d = 1.0 - length(-uv - off - wr.xy);
-    return 0.5 * (1.0 + sb_erf(d / (1.4142135623730951 * sq)));
+    return env_gaussian_inside(1.0 - length(-uv - off - wr.xy), sq);
+}
+
+// The share inside the disc of a Gaussian of rms sigma whose centre lies dist
+// inside the horizon (negative: outside) (cells::gaussian_inside).
+fn env_gaussian_inside(dist: f32, sigma: f32) -> f32 {
+    return 0.5 * (1.0 + sb_erf(dist / (1.4142135623730951 * sigma)));
 }
 
 // Irradiance (linear sRGB, without the sun) at world normal n from a table

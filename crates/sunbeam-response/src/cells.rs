@@ -279,9 +279,10 @@ impl Cells {
         // (children come after their parent). One pass instead of one per
         // tree level, and no strided reads: most of the player's start-up
         // under an environment before (docs/bench/play.md "Start-up").
-        // The same pass sums each value's first moment over the layers
-        // (raw, about the origin), for the channels' own centroids.
-        // per layer: each node's 9 masses and their raw first moments
+        // The same pass takes each value's first moment (raw, about the
+        // origin), summed over the layers below, for the values' own
+        // centroids. Per layer: each node's 9 masses and their moments.
+        let cols: Vec<(f64, f64)> = (0..nt).map(|i| g.theta_at(i).sin_cos()).collect();
         type Layer = (Vec<[f64; 9]>, Vec<[[f64; 2]; 9]>);
         let per_layer: Vec<Layer> = (0..ns)
             .into_par_iter()
@@ -296,7 +297,7 @@ impl Cells {
                         if leaf == u32::MAX {
                             continue;
                         }
-                        let (sn, cs) = g.theta_at(i).sin_cos();
+                        let (sn, cs) = cols[i];
                         let (o, q) = (&mut acc[leaf as usize], &mut mom[leaf as usize]);
                         for (b, map) in basis.iter().enumerate() {
                             let e = map.texel(i, j, k);
@@ -439,8 +440,7 @@ impl Cells {
                 }
             }
             let inside = if c.spread > 0.0 {
-                0.5 * (1.0
-                    + sunbeam_optics::masking::erf(dist / (std::f64::consts::SQRT_2 * c.spread)))
+                gaussian_inside(dist, c.spread)
             } else {
                 f64::from(dist > 0.0)
             };
@@ -492,8 +492,13 @@ fn channel_inside(c: &Cell, q: usize, wr: [f64; 3]) -> f64 {
         .max(0.0625 * c.spread * c.spread)
         .sqrt();
     let wxy = [-c.uv[0] - off[0] - wr[0], -c.uv[1] - off[1] - wr[1]];
-    let d = 1.0 - wxy[0].hypot(wxy[1]);
-    0.5 * (1.0 + sunbeam_optics::masking::erf(d / (std::f64::consts::SQRT_2 * sq)))
+    gaussian_inside(1.0 - wxy[0].hypot(wxy[1]), sq)
+}
+
+/// The share inside the disc of a Gaussian of rms `sigma` whose centre lies
+/// `dist` inside the horizon (negative: outside), along the horizon's normal.
+fn gaussian_inside(dist: f64, sigma: f64) -> f64 {
+    0.5 * (1.0 + sunbeam_optics::masking::erf(dist / (std::f64::consts::SQRT_2 * sigma)))
 }
 
 #[cfg(test)]

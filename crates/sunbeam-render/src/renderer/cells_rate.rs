@@ -143,20 +143,22 @@ fn target(gpu: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Textu
         .create_view(&Default::default())
 }
 
-/// OpenGL adapters (llvmpipe, what wgpu falls back to when no Vulkan driver
-/// is installed) may not render to 32-bit float targets: a pre-pass that
-/// cannot be built says what to do instead.
-fn explain(e: sunbeam_common::Error) -> sunbeam_common::Error {
-    if e.to_string().contains("not renderable") {
-        e.context(
-            "the first-frame cells (--env-estimator cells) render to 32-bit float targets, \
-             which this GPU adapter refuses (an OpenGL one, such as llvmpipe without a Vulkan \
-             driver?): install Vulkan (Debian: mesa-vulkan-drivers) or use --env-estimator \
-             monte-carlo",
-        )
-    } else {
-        e
+/// The pre-passes write float targets (16- and 32-bit), which OpenGL adapters
+/// (llvmpipe, what wgpu falls back to when no Vulkan driver is installed) may
+/// not render to: say so, and what to do instead, before building them.
+fn check_targets(adapter: &wgpu::Adapter) -> Result<()> {
+    for format in [XYZ_FORMAT, FRAME_FORMAT, CENTRE_FORMAT] {
+        let usages = adapter.get_texture_format_features(format).allowed_usages;
+        if !usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT) {
+            return Err(sunbeam_common::Error::internal(format!(
+                "the first-frame cells (--env-estimator cells) render to {format:?} targets, \
+                 which this GPU adapter ({}) refuses: install Vulkan (Debian: \
+                 mesa-vulkan-drivers) or use --env-estimator monte-carlo",
+                adapter.get_info().name
+            )));
+        }
     }
+    Ok(())
 }
 
 impl CellsRate {
@@ -164,6 +166,7 @@ impl CellsRate {
     /// pass alone), with the default pipeline's bind group layouts;
     /// `stand_in` is bound as the grids while a pass cannot read them.
     pub(super) fn new(
+        adapter: &wgpu::Adapter,
         device: &wgpu::Device,
         layouts: &[&wgpu::BindGroupLayout],
         rate: u32,
@@ -171,6 +174,7 @@ impl CellsRate {
         spectrum: &wgpu::Buffer,
         stand_in: &wgpu::TextureView,
     ) -> Result<CellsRate> {
+        check_targets(adapter)?;
         let coarse = if rate > 1 {
             let technique = Technique {
                 label: "diffraction.wgsl cells pre-pass",
@@ -178,16 +182,13 @@ impl CellsRate {
                 entry: "fs_cells",
                 constants: Vec::new(),
             };
-            Some(
-                render_pipeline(
-                    device,
-                    layouts,
-                    &[XYZ_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
-                    1,
-                    &technique,
-                )
-                .map_err(explain)?,
-            )
+            Some(render_pipeline(
+                device,
+                layouts,
+                &[XYZ_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
+                1,
+                &technique,
+            )?)
         } else {
             None
         };
@@ -203,8 +204,7 @@ impl CellsRate {
             &[CENTRE_FORMAT, FRAME_FORMAT],
             1,
             &technique,
-        )
-        .map_err(explain)?;
+        )?;
         let pre_bind = global_bind(
             device,
             layouts[0],

@@ -585,6 +585,7 @@ impl Renderer {
             && p.meshes.iter().any(|(_, m)| m.pack.is_some())
         {
             Some(cells_rate::CellsRate::new(
+                &gpu.adapter,
                 device,
                 &layouts,
                 if smooth_term {
