@@ -21,6 +21,10 @@
 //! - `TEXELS=1`: also every texel as its own cell at its centre, the
 //!   environment read unfiltered there (no horizon band: the floor of a
 //!   midpoint rule on the maps' own grid);
+//! - `MASK=1`: Smith masking from the pack's rms slope, for the reference,
+//!   the cells, the hot spots and the sun alike (default: off);
+//! - `GRAZE=LO:HI`: the views' `cos` to the normal drawn in `[LO, HI]`
+//!   (default `0.02:1`), to look at grazing or near-normal views alone;
 //! - `NOPRE=1`, `OMS=X`: the environment read at the centroid unfiltered, or
 //!   its solid angle scaled by `X`; `WORST=1`: print the worst points.
 
@@ -154,6 +158,22 @@ fn main() {
             t_pre
         );
         let skin = Material::default();
+        let mask = if std::env::var("MASK").is_ok() {
+            Masking::smith(pack.manifest.rms_slope.expect("rms_slope"))
+        } else {
+            Masking::Off
+        };
+        eprintln!("  masking {mask:?}");
+        let (glo, ghi) = std::env::var("GRAZE")
+            .ok()
+            .map(|v| {
+                let mut it = v.split(':').map(|x| x.parse::<f64>().expect("GRAZE=LO:HI"));
+                (
+                    it.next().expect("GRAZE=LO:HI"),
+                    it.next().expect("GRAZE=LO:HI"),
+                )
+            })
+            .unwrap_or((0.02, 1.0));
         let mut rng = SplitMix64::new(7);
         let mut pts = Vec::new();
         for _ in 0..600 {
@@ -180,7 +200,7 @@ fn main() {
             };
             let t = norm(cross(a, n));
             let b = cross(n, t);
-            let cr = 0.02 + 0.98 * rng.unit();
+            let cr = glo + (ghi - glo) * rng.unit();
             let pr = std::f64::consts::TAU * rng.unit();
             let sr = (1.0 - cr * cr).sqrt();
             pts.push(((t, b, n), [sr * pr.cos(), sr * pr.sin(), cr]));
@@ -195,7 +215,7 @@ fn main() {
                         frame: *f,
                         wr: *wr,
                         sun_u,
-                        masking: Masking::Off,
+                        masking: mask,
                         skin,
                     }],
                     (0, 1),
@@ -304,16 +324,10 @@ fn main() {
                         )
                     }
                 };
-                let mut x = cells.estimate(*f, *wr, Masking::Off, skin, &coeffs);
+                let mut x = cells.estimate(*f, *wr, mask, skin, &coeffs);
                 // the hot spots: each a small light through the basis maps
-                let hx = sunbeam_response::hotspots::estimate(
-                    &lights,
-                    &er.basis,
-                    *f,
-                    *wr,
-                    Masking::Off,
-                    skin,
-                );
+                let hx =
+                    sunbeam_response::hotspots::estimate(&lights, &er.basis, *f, *wr, mask, skin);
                 for a in 0..3 {
                     x[a] += hx[a];
                 }
@@ -324,7 +338,7 @@ fn main() {
                     let dot = |a: [f64; 3]| a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
                     let wi = [dot(t), dot(b), dot(n)];
                     if wi[2] > 0.0 {
-                        let g = sunbeam_optics::gain::g(wi, *wr, skin);
+                        let g = mask.gain(wi, *wr, skin);
                         let e = es.lookup(-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
                         for a in 0..3 {
                             x[a] += g * e[a];

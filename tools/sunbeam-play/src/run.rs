@@ -115,8 +115,8 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
     if msaa != 1 && msaa != 4 {
         return Err(Error::usage("--msaa must be 1 or 4"));
     }
-    if !(1..=4).contains(&cli.supersample) {
-        return Err(Error::usage("--supersample must be 1..4"));
+    if !(1..=8).contains(&cli.supersample) {
+        return Err(Error::usage("--supersample must be 1..8"));
     }
     if cli.env_samples == 0 || cli.env_samples > 64 {
         return Err(Error::usage("--env-samples must be 1..64"));
@@ -171,6 +171,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     // The default mode draws with the response maps: a pack with current maps
     // beside it is read as its manifest only (the CPU renderer needs the terms,
     // and so does building the environment's maps when they are not current).
+    let t_prepare = std::time::Instant::now();
     let prepared = if st.mode == Mode::Default && !cli.cpu && scene.environment.is_none() {
         sunbeam_frame::prepare_with(&scene, &sunbeam_render::response::load_pack)?
     } else if st.mode == Mode::Default && !cli.cpu {
@@ -201,6 +202,9 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
     let mut report = serde_json::json!({
         "tool": "sunbeam-play",
         "size": size,
+        // reading the scene's meshes and packs (the environment's maps are
+        // read or built in the renderer's set-up, `setup_ms`)
+        "prepare_ms": t_prepare.elapsed().as_secs_f64() * 1e3,
         "mode": format!("{:?}", st.mode).to_lowercase(),
         "msaa": st.msaa,
     });
@@ -314,10 +318,12 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             let k = cli.supersample.max(1);
             let target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;
             let state = sunbeam_render::FrameState::from_scene(&prepared);
+            let t = std::time::Instant::now();
             for _ in 1..cli.frames.unwrap_or(1).max(1) {
                 target.draw(&gpu, &r, &state)?;
             }
             let img = target.render_linear(&gpu, &r, &state)?.downsample(k);
+            report["render_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
             if r.progressive() {
                 // The environment's Monte Carlo frames, averaged (the settled frame).
                 report["accumulated_frames"] = target.frames().into();

@@ -409,6 +409,11 @@ fn default_scene_is_sky_lit() {
     assert_eq!(r["accumulated_frames"].as_u64(), Some(1), "{r}");
     assert_eq!(r["env_estimator"], "cells", "{r}");
     assert_eq!(r["env_cells"], 512, "{r}");
+    // Where the time went: each phase's milliseconds, the frame's not zero.
+    for k in ["prepare_ms", "setup_ms", "render_ms"] {
+        assert!(r[k].as_f64().is_some_and(|t| t >= 0.0), "{k}: {r}");
+    }
+    assert!(r["render_ms"].as_f64().unwrap() > 0.0, "{r}");
     // The sky behind the sphere: the top corner sees it, lit and blue
     // (the sky's zenith is bluer than its horizon and the ground grey).
     let img = LinearImage::read_exr(&one).unwrap();

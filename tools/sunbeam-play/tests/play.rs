@@ -109,6 +109,26 @@ fn usage_and_input_errors_have_their_exit_codes() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
+    // --supersample is 1..8: outside, a usage error naming the flag, no frame.
+    for k in ["0", "9"] {
+        let f = std::env::temp_dir().join(format!("sunbeam-play-ss{k}-{}.png", std::process::id()));
+        let o = Command::new(BIN)
+            .args([
+                "--mesh",
+                "builtin:quad",
+                "--headless",
+                "--supersample",
+                k,
+                "-o",
+            ])
+            .arg(&f)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "--supersample {k}: {err}");
+        assert!(err.contains("--supersample must be 1..8"), "{err}");
+        assert!(!f.exists());
+    }
 }
 
 #[test]
