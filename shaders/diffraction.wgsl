@@ -292,7 +292,34 @@ fn env_shade_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw
     let fc = c.frame;
     let wr_c = normalize(g.eye.xyz - c.world);
     let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
-    return env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, length(g.eye.xyz - c.world), fp);
+    return env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, length(g.eye.xyz - c.world), fp, true);
+}
+
+// The environment at offset o (pixels) from the pixel centre without
+// walking the cells (env_shade's `walk`): its colour in xyz, and in w 1
+// where env_shade would have walked them (env_cells_walks), else 0.
+fn env_shade_carried_nowalk(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw: f32, diffract: bool, fp: EnvFootprint) -> vec4<f32> {
+    let c = carried(in, d, o);
+    let fc = c.frame;
+    let wr_c = normalize(g.eye.xyz - c.world);
+    let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
+    let dist = length(g.eye.xyz - c.world);
+    let rgb = env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, dist, fp, false);
+    let walks = env_cells_walks(fc[2], wr_cl, dw, diffract, in.clip.xy, dist);
+    return vec4<f32>(rgb, select(0.0, 1.0, walks));
+}
+
+// The cells' term (linear sRGB, dw applied) at offset o (pixels) from the
+// pixel centre: one walk.
+fn env_cells_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, dw: f32) -> vec3<f32> {
+    let c = carried(in, d, o);
+    let fc = c.frame;
+    let wr_c = normalize(g.eye.xyz - c.world);
+    let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
+    if (wr_cl.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    return (1.0 - dw) * xyz_to_rgb(env_cells(fc[0], fc[1], fc[2], wr_cl));
 }
 
 // The colour of a fragment (`covered`: its sample mask), whichever the
@@ -409,16 +436,28 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
         // at the samples, and 8.5 again when only the pixels whose centre
         // missed the surface took the samples: along the tapering tail the
         // triangles are smaller than a sub-pixel and turn fast
-        // (docs/LIGHTING.md "The first frame"). Branches, not one call in a
-        // loop over the samples: on llvmpipe the loop cost the snake's frame
-        // 2x.
+        // (docs/LIGHTING.md "The first frame"). The cells are walked once,
+        // at the mean of the samples that would walk them (inside the
+        // triangle: the mean of points of a convex set), for all of them:
+        // Mesa's llvmpipe stops an invocation's loops after 65,535
+        // iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS), and three walks
+        // of 2048 cells were cut short, darkening the partly covered pixels
+        // of grazing views (docs/LIGHTING.md "One walk per fragment").
         if (envg.estimator == 0u) {
             if (g.msaa >= 4u && n_cov < 4u) {
                 var acc = vec3<f32>(0.0);
+                var at = vec2<f32>(0.0);
+                var k = 0.0;
                 for (var j = 0u; j < 4u; j = j + 1u) {
                     if (((covered >> j) & 1u) == 1u) {
-                        acc = acc + env_shade_carried(in, da, msaa_position(j), base, dw, diffract, env_fp);
+                        let sj = env_shade_carried_nowalk(in, da, msaa_position(j), base, dw, diffract, env_fp);
+                        acc = acc + sj.xyz;
+                        at = at + sj.w * msaa_position(j);
+                        k = k + sj.w;
                     }
+                }
+                if (k > 0.0) {
+                    acc = acc + k * env_cells_carried(in, da, at / k, dw);
                 }
                 rgb = rgb + acc / f32(n_cov);
             } else {

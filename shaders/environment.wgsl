@@ -626,27 +626,48 @@ fn env_cells_shared(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, cli
 // pass's value of this pixel where this fragment sees the surface it saw
 // (its normal within ENV_LOWRES_OWN, its distance within ENV_LOWRES_DEPTH;
 // the fragment of the triangle under the pixel centre matches exactly), so
-// that a pixel walks the cells once whatever the triangles touching it;
-// else (another surface behind a silhouette, grazing views, no centre pass)
-// the fragment walks them itself.
-fn env_cells_pixel(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec3<f32> {
+// that a pixel walks the cells once whatever the triangles touching it:
+// (its XYZ, 1); else (another surface behind a silhouette, grazing views, no
+// centre pass) 0: the fragment walks them itself.
+fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
     if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS) {
         let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
         let p = clamp(vec2<i32>(floor(clip)), vec2<i32>(0), last);
         let x = textureLoad(cells_xyz, p, 0);
         let nd = textureLoad(cells_nd, p, 0);
         if (x.w > 0.5 && env_same_surface(nd.xyz, nd.w, n, dist)) {
-            return x.xyz;
+            return vec4<f32>(x.xyz, 1.0);
         }
     }
+    return vec4<f32>(0.0);
+}
+
+// The cells' XYZ at a fragment: the centre pass's (env_cells_read) or,
+// with `walk`, a walk of its own; without, 0 (the caller walks for several
+// points at once: env_cells_walk).
+fn env_cells_pixel(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32, walk: bool) -> vec3<f32> {
+    let r = env_cells_read(n, wr, clip, dist);
+    if (r.w > 0.5 || !walk) {
+        return r.xyz;
+    }
     return env_cells(t, b, n, wr);
+}
+
+// Whether env_shade with `walk` would walk the cells at this fragment: the
+// first-frame estimator's diffraction part where the centre pass has no
+// value for it.
+fn env_cells_walks(n: vec3<f32>, wr: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32) -> bool {
+    return envg.on == 1u && envg.estimator == 0u && wr.z > 0.0 && diffract && envp.on == 1u && dw < 1.0
+        && env_cells_read(n, wr, clip, dist).w < 0.5;
 }
 
 // ---------------------------------------------------------------- the estimator
 // Linear sRGB leaving the surface towards the viewer under the environment (both
 // parts, dw applied): frame (t, b, n), local view wr, base colour, diffuse weight
-// dw, diffract: the mesh has a pack's maps.
-fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32, fp: EnvFootprint) -> vec3<f32> {
+// dw, diffract: the mesh has a pack's maps; walk: the first-frame estimator
+// walks the cells where the centre pass has no value (else the caller does,
+// for several points at once: env_cells_walks, env_cells_walk).
+fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32, fp: EnvFootprint, walk: bool) -> vec3<f32> {
     if (envg.on == 0u || wr.z <= 0.0) {
         return vec3<f32>(0.0);
     }
@@ -691,7 +712,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
         if (envg.hot_footprint == 1u) {
             hot_fp = fp;
         }
-        xyz = env_cells_pixel(t, b, n, wr, clip, dist) + env_hotspots_footprint(t, b, n, wr, hot_fp);
+        xyz = env_cells_pixel(t, b, n, wr, clip, dist, walk) + env_hotspots_footprint(t, b, n, wr, hot_fp);
     } else {
     // The first frame after a reset (every frame while the view moves) is the
     // preview: one direction uniform over the hemisphere, no descent (the

@@ -458,6 +458,8 @@ pub(crate) struct EnvMaps {
     cells: wgpu::Buffer,
     views: [wgpu::TextureView; 3],
     sun: Option<wgpu::TextureView>,
+    /// Nodes of the cells' tree: what one walk of them may visit.
+    pub(crate) nodes: usize,
 }
 
 impl EnvMaps {
@@ -506,6 +508,7 @@ impl EnvMaps {
             cells.nodes.len(),
             t0.elapsed()
         );
+        let nodes = cells.nodes.len();
         let mut uniform = uniform;
         uniform.n_cells = cells.n_top as u32;
         let cell_data = cells.gpu_data();
@@ -538,6 +541,7 @@ impl EnvMaps {
             cells,
             views: [view(&r.basis[0]), view(&r.basis[1]), view(&r.basis[2])],
             sun: r.sun.as_ref().map(view),
+            nodes,
         })
     }
 }

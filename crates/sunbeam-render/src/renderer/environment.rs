@@ -35,8 +35,21 @@ pub(super) fn of_scene(p: &Prepared, mode: Mode) -> Result<Option<Arc<Environmen
 /// The environment's maps already built, per pack (the same `Arc`).
 pub(super) type BuiltMaps = Vec<(*const Pack, Arc<crate::env::EnvMaps>)>;
 
+/// Iterations after which Mesa's llvmpipe (lavapipe's rasteriser) ends every
+/// loop of a shader invocation (LP_MAX_TGSI_LOOP_ITERATIONS, one count for
+/// all of its loops): a walk of the cells longer than this is cut short and
+/// its view darkens.
+pub(crate) const CPU_LOOP_LIMIT: usize = 65_535;
+
+/// Cells' nodes above which a CPU rasteriser may cut a walk: a grazing view
+/// refines most of the tree, and the invocation's other loops (lights, MSAA
+/// samples, hot spots) take their share of [`CPU_LOOP_LIMIT`].
+pub(crate) const CPU_CELL_NODES: usize = 60_000;
+
 /// The extended-light maps of `pack` (meshes[`mi`], read from `path`) under
-/// `env` on the GPU, once per pack (`built`; [`response`] reads or builds them).
+/// `env` on the GPU, once per pack (`built`; [`response`] reads or builds
+/// them). On a CPU rasteriser whose loops a walk of these cells may outrun,
+/// a warning naming the count to use (`warnings`, with `estimator` cells).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn maps(
     gpu: &crate::gpu::Gpu,
@@ -46,8 +59,10 @@ pub(super) fn maps(
     mi: usize,
     opts: &sunbeam_response::Options,
     cells: (usize, usize),
+    estimator: crate::env::EnvEstimator,
     built: &mut BuiltMaps,
     notes: &mut Vec<String>,
+    warnings: &mut Vec<String>,
 ) -> Result<Arc<crate::env::EnvMaps>> {
     let key = Arc::as_ptr(pack);
     if let Some((_, m)) = built.iter().find(|(k, _)| *k == key) {
@@ -55,6 +70,17 @@ pub(super) fn maps(
     }
     let er = response(env, pack, path, mi, opts, notes)?;
     let m = Arc::new(crate::env::EnvMaps::new(gpu, &er, cells)?);
+    if estimator == crate::env::EnvEstimator::Cells && gpu.is_cpu() && m.nodes > CPU_CELL_NODES {
+        // nodes grow about as the cells: the power of two that fits
+        let fit = (cells.0 * CPU_CELL_NODES / m.nodes).max(1);
+        let fewer = 1usize << fit.ilog2();
+        warnings.push(format!(
+            "meshes[{mi}].pack: {} cells make {} nodes, more than a CPU rasteriser's shader loops \
+             may run ({CPU_LOOP_LIMIT} iterations in all): grazing views may darken; use \
+             --env-cells {fewer} or fewer here (docs/LIGHTING.md \"One walk per fragment\")",
+            cells.0, m.nodes
+        ));
+    }
     built.push((key, m.clone()));
     Ok(m)
 }

@@ -546,8 +546,10 @@ impl Renderer {
                     mi,
                     &settings.response,
                     settings.env_cells,
+                    settings.env_estimator,
                     &mut env_maps,
                     &mut notes,
+                    &mut warnings,
                 )?),
                 _ => None,
             };
