@@ -285,41 +285,47 @@ fn carried(in: VsOut, d: AttrDerivs, o: vec2<f32>) -> Carried {
     return c;
 }
 
-// The environment (shaders/environment.wgsl env_shade) at offset o (pixels)
-// from the pixel centre.
-fn env_shade_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw: f32, diffract: bool, fp: EnvFootprint) -> vec3<f32> {
+// What the environment needs at offset o (pixels) from the pixel centre:
+// the frame carried there, the view in it and the distance to the eye.
+struct CarriedView {
+    frame: mat3x3<f32>,
+    wr: vec3<f32>,
+    dist: f32,
+};
+
+fn carried_view(in: VsOut, d: AttrDerivs, o: vec2<f32>) -> CarriedView {
     let c = carried(in, d, o);
     let fc = c.frame;
     let wr_c = normalize(g.eye.xyz - c.world);
     let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
-    return env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, length(g.eye.xyz - c.world), fp, true);
+    return CarriedView(fc, wr_cl, length(g.eye.xyz - c.world));
+}
+
+// The environment (shaders/environment.wgsl env_shade) at offset o (pixels)
+// from the pixel centre.
+fn env_shade_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw: f32, diffract: bool, fp: EnvFootprint) -> vec3<f32> {
+    let v = carried_view(in, d, o);
+    return env_shade(v.frame[0], v.frame[1], v.frame[2], v.wr, base, dw, diffract, in.clip.xy, v.dist, fp, true);
 }
 
 // The environment at offset o (pixels) from the pixel centre without
 // walking the cells (env_shade's `walk`): its colour in xyz, and in w 1
 // where env_shade would have walked them (env_cells_walks), else 0.
 fn env_shade_carried_nowalk(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw: f32, diffract: bool, fp: EnvFootprint) -> vec4<f32> {
-    let c = carried(in, d, o);
-    let fc = c.frame;
-    let wr_c = normalize(g.eye.xyz - c.world);
-    let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
-    let dist = length(g.eye.xyz - c.world);
-    let rgb = env_shade(fc[0], fc[1], fc[2], wr_cl, base, dw, diffract, in.clip.xy, dist, fp, false);
-    let walks = env_cells_walks(fc[2], wr_cl, dw, diffract, in.clip.xy, dist);
+    let v = carried_view(in, d, o);
+    let rgb = env_shade(v.frame[0], v.frame[1], v.frame[2], v.wr, base, dw, diffract, in.clip.xy, v.dist, fp, false);
+    let walks = env_cells_walks(v.frame[2], v.wr, dw, diffract, in.clip.xy, v.dist);
     return vec4<f32>(rgb, select(0.0, 1.0, walks));
 }
 
 // The cells' term (linear sRGB, dw applied) at offset o (pixels) from the
 // pixel centre: one walk.
 fn env_cells_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, dw: f32) -> vec3<f32> {
-    let c = carried(in, d, o);
-    let fc = c.frame;
-    let wr_c = normalize(g.eye.xyz - c.world);
-    let wr_cl = vec3<f32>(dot(wr_c, fc[0]), dot(wr_c, fc[1]), dot(wr_c, fc[2]));
-    if (wr_cl.z <= 0.0) {
+    let v = carried_view(in, d, o);
+    if (v.wr.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    return (1.0 - dw) * xyz_to_rgb(env_cells(fc[0], fc[1], fc[2], wr_cl));
+    return (1.0 - dw) * xyz_to_rgb(env_cells(v.frame[0], v.frame[1], v.frame[2], v.wr));
 }
 
 // The colour of a fragment (`covered`: its sample mask), whichever the

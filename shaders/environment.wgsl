@@ -643,8 +643,8 @@ fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> ve
 }
 
 // The cells' XYZ at a fragment: the centre pass's (env_cells_read) or,
-// with `walk`, a walk of its own; without, 0 (the caller walks for several
-// points at once: env_cells_walk).
+// with `walk`, a walk of its own; without, 0 (the caller walks once for
+// several points: shaders/diffraction.wgsl env_cells_carried).
 fn env_cells_pixel(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32, walk: bool) -> vec3<f32> {
     let r = env_cells_read(n, wr, clip, dist);
     if (r.w > 0.5 || !walk) {
@@ -666,7 +666,8 @@ fn env_cells_walks(n: vec3<f32>, wr: vec3<f32>, dw: f32, diffract: bool, clip: v
 // parts, dw applied): frame (t, b, n), local view wr, base colour, diffuse weight
 // dw, diffract: the mesh has a pack's maps; walk: the first-frame estimator
 // walks the cells where the centre pass has no value (else the caller does,
-// for several points at once: env_cells_walks, env_cells_walk).
+// once for several points: env_cells_walks, shaders/diffraction.wgsl
+// env_cells_carried).
 fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32, fp: EnvFootprint, walk: bool) -> vec3<f32> {
     if (envg.on == 0u || wr.z <= 0.0) {
         return vec3<f32>(0.0);
