@@ -101,7 +101,7 @@ rule import
   deps = gcc
   description = import \${name}
 rule pack
-  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-pack \$in -o \${target} --response --response-sky \${sky} $(esc "$PACK_FLAGS") --depfile \${target}.d \$q
+  command = rm -f \$tidy && $(esc "$BIN")/sunbeam-pack \$in -o \${target} --response --response-sky \${sky} --response-cells 512,$(esc "$PLAY_FIRST_CELLS") $(esc "$PACK_FLAGS") --depfile \${target}.d \$q
   depfile = \${target}.d
   deps = gcc
   description = pack \${target}
@@ -201,15 +201,15 @@ EOF
       t="$OUT/$m$sep$ext"
       extra=; dep=
       if [ "$rule" = pack ]; then
-        extra=" | $o/$m.response.ktx2 $o/$m.env-response.ktx2"
+        extra=" | $o/$m.response.ktx2 $o/$m.env-response.ktx2 $o/$m.env-cells.ktx2"
         dep=" $o/$m-sky.json"
       fi
       echo "build $(path "$t")$extra: $rule $o/$m.$from |$dep $(path "$BIN/$tool")"
       echo "  target = $(esc "$t")"
       if [ "$rule" = pack ]; then echo "  sky = $o/$m-sky.json"; fi
       if [ "$rule" = pack ]; then
-        # all three outputs' temp files (a killed run may leave any)
-        echo "  tidy = $(esc "$OUT/.$m.ktx2").tmp.* $(esc "$OUT/.$m.response.ktx2").tmp.* $(esc "$OUT/.$m.env-response.ktx2").tmp.*"
+        # all four outputs' temp files (a killed run may leave any)
+        echo "  tidy = $(esc "$OUT/.$m.ktx2").tmp.* $(esc "$OUT/.$m.response.ktx2").tmp.* $(esc "$OUT/.$m.env-response.ktx2").tmp.* $(esc "$OUT/.$m.env-cells.ktx2").tmp.*"
       else
         echo "  tidy = $(esc "$OUT/.$m$sep$ext").tmp.*"
       fi
@@ -228,10 +228,10 @@ EOF
     echo "build $o/$m-sky.png: sky $o/$m-sky.json | $o/$m.ktx2 $o/snake-$m.glb $(path "$EVAL")"
     echo "  target = $(esc "$OUT/$m-sky.png")"
     echo "  tidy = $(esc "$OUT/.$m-sky.png").tmp.*"
-    echo "build $o/$m-play-first.png: play_first $o/$m-sky.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/$m.env-response.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
+    echo "build $o/$m-play-first.png: play_first $o/$m-sky.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/$m.env-response.ktx2 $o/$m.env-cells.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
     echo "  target = $(esc "$OUT/$m-play-first.png")"
     echo "  tidy = $(esc "$OUT/.$m-play-first.png").tmp.*"
-    echo "build $o/$m-play-sky.png: play_sky $o/$m-sky.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/$m.env-response.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
+    echo "build $o/$m-play-sky.png: play_sky $o/$m-sky.json | $o/$m.ktx2 $o/$m.response.ktx2 $o/$m.env-response.ktx2 $o/$m.env-cells.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
     echo "  target = $(esc "$OUT/$m-play-sky.png")"
     echo "  tidy = $(esc "$OUT/.$m-play-sky.png").tmp.*"
     echo "build $o/snake-$m.glb: bake_pack $o/$m.ktx2 | $o/$m.response.ktx2 $(path "$BIN/sunbeam-bake")"
@@ -247,9 +247,9 @@ EOF
         echo "  target = $o/$m-studio.json"
         echo "  name = $m"
         echo "  tidy = $(esc "$OUT/.$m-studio.json").tmp.*"
-        echo "build $o/env-studio-$m/environment.json: export_environment $o/$m-studio.json | $(path "$HDRI") $o/$m.ktx2 $o/$m.env-response.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
+        echo "build $o/env-studio-$m/environment.json: export_environment $o/$m-studio.json | $(path "$HDRI") $o/$m.ktx2 $o/$m.env-response.ktx2 $o/$m.env-cells.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
       else
-        echo "build $o/env-sky-$m/environment.json: export_environment $o/$m-sky.json | $o/$m.ktx2 $o/$m.env-response.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
+        echo "build $o/env-sky-$m/environment.json: export_environment $o/$m-sky.json | $o/$m.ktx2 $o/$m.env-response.ktx2 $o/$m.env-cells.ktx2 $o/snake-$m.glb $(path "$BIN/sunbeam-play")"
       fi
       echo "  dir = $(esc "$OUT/env-$e-$m")"
     done

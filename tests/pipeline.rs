@@ -408,7 +408,12 @@ fn interrupted_build_keeps_nothing_half_written_and_is_redone() {
     // pack rule writes three): plant one for each of Xeno's and make the
     // rule run again (its pack gone), as a kill during its last write would.
     let _ = std::fs::remove_file(out.join("xeno.ktx2"));
-    for f in ["xeno.ktx2", "xeno.response.ktx2", "xeno.env-response.ktx2"] {
+    for f in [
+        "xeno.ktx2",
+        "xeno.response.ktx2",
+        "xeno.env-response.ktx2",
+        "xeno.env-cells.ktx2",
+    ] {
         std::fs::write(out.join(format!(".{f}.tmp.1")), b"stale").unwrap();
     }
     // The next run redoes what was cut off and leaves no temp files of those rules.

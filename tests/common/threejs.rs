@@ -79,6 +79,7 @@ pub fn ridges(d: &Path) {
         "ridges.ktx2",
         "ridges.response.ktx2",
         "ridges.env-response.ktx2",
+        "ridges.env-cells.ktx2",
     ] {
         assert!(dir.join(f).is_file(), "{f} not built");
         std::os::unix::fs::symlink(dir.join(f), d.join(f)).unwrap();

@@ -27,7 +27,7 @@ pub const DEFAULT_ENV_SAMPLES: u32 = 1;
 /// 128 / 256 / 512 cells was 2.17 / 1.71 / 1.36 under the sky, 3.95 / 2.86 /
 /// 1.66 under studio.exr and 2.58 / 1.98 / 1.20 under night.exr, at about
 /// 0.55 / 1 / 1.6 times the time (docs/LIGHTING.md "How many cells").
-pub const DEFAULT_ENV_CELLS: u64 = 512;
+pub const DEFAULT_ENV_CELLS: u64 = sunbeam_response::cells::FIRST_FRAME_TOP as u64;
 /// Levels kept below the top cut for views whose horizon a cell reaches.
 pub const ENV_CELLS_DEPTH: usize = sunbeam_response::cells::DEFAULT_DEPTH;
 /// The environment's hot spots as at most this many lights (`--env-hot-spots`).
@@ -463,7 +463,11 @@ pub(crate) struct EnvMaps {
 }
 
 impl EnvMaps {
-    pub(crate) fn new(gpu: &Gpu, r: &EnvResponse, cells: (usize, usize)) -> Result<EnvMaps> {
+    pub(crate) fn new(
+        gpu: &Gpu,
+        r: &EnvResponse,
+        cells: Option<&sunbeam_response::cells::GpuCells>,
+    ) -> Result<EnvMaps> {
         let p = &r.proposal;
         let g = r.grid;
         if p.offsets.is_empty() || p.offsets.len() > MAX_LEVELS || r.basis.len() != 3 {
@@ -499,19 +503,13 @@ impl EnvMaps {
             has_sun: u32::from(r.sun.is_some()),
             n_cells: 0,
         };
-        let t0 = std::time::Instant::now();
-        let (top, depth) = cells;
-        let cells = sunbeam_response::cells::Cells::build(&r.basis, top, depth);
-        log::info!(
-            "clustered the environment maps into {} cells ({} nodes) in {:.2?}",
-            cells.n_top,
-            cells.nodes.len(),
-            t0.elapsed()
-        );
-        let nodes = cells.nodes.len();
+        // Without cells (Monte Carlo) a stand-in: the walk sees no top cells.
+        let (n_top, nodes, cell_data) = match cells {
+            Some(c) => (c.n_top, c.nodes, &c.data[..]),
+            None => (0, 0, &[][..]),
+        };
         let mut uniform = uniform;
-        uniform.n_cells = cells.n_top as u32;
-        let cell_data = cells.gpu_data();
+        uniform.n_cells = n_top as u32;
         let cells = gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -519,7 +517,7 @@ impl EnvMaps {
                 contents: bytemuck::cast_slice(if cell_data.is_empty() {
                     &[0.0f32; 4][..]
                 } else {
-                    &cell_data
+                    cell_data
                 }),
                 usage: wgpu::BufferUsages::STORAGE,
             });

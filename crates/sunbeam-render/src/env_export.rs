@@ -147,13 +147,13 @@ pub fn export(
         }
         let path = p.scene.meshes.get(mi).and_then(|s| s.pack.as_deref());
         let er = environment::response(&env, pack, path, mi, opts, &mut notes)?;
-        let c = sunbeam_response::cells::Cells::build(&er.basis, cells.0, cells.1);
-        let mut bits: Vec<u32> = c.gpu_data().iter().map(|v| v.to_bits()).collect();
+        let c = environment::first_frame_cells(&er, &env, pack, path, mi, cells, &mut notes)?;
+        let mut bits: Vec<u32> = c.data.iter().map(|v| v.to_bits()).collect();
         let w = CELLS_WIDTH.min(bits.len().max(1));
         let h = bits.len().div_ceil(w).max(1);
         bits.resize(w * h, 0);
         let info = serde_json::json!({
-            "n_top": c.n_top, "n_s": c.grid.n_s, "nodes": c.nodes.len(),
+            "n_top": c.n_top, "n_s": er.grid.n_s, "nodes": c.nodes,
             "header": sunbeam_response::cells::GPU_HEADER, "width": w, "height": h,
         });
         let file = put(

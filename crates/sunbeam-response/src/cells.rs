@@ -54,6 +54,9 @@ pub const REFINE: f64 = 2.0;
 pub const DEFAULT_TOP: usize = 256;
 /// Levels below the top cut kept for views whose horizon a cell reaches.
 pub const DEFAULT_DEPTH: usize = 4;
+/// The top cut of the player's first frame and the engines' export
+/// (`--env-cells`), and what `sunbeam-pack --response` clusters by default.
+pub const FIRST_FRAME_TOP: usize = 512;
 /// Floats per node in [`Cells::gpu_data`] before its layers' masses.
 pub const GPU_HEADER: usize = 5 + 18;
 /// "No node" in [`Cells::gpu_data`]'s links.
@@ -84,6 +87,18 @@ pub struct Cells {
     /// every view visits), the rest their descendants.
     pub nodes: Vec<Cell>,
     pub n_top: usize,
+}
+
+/// The cells as the shaders read them ([`Cells::gpu_data`]) with their
+/// counts: what the player uploads and the pipeline's cells file holds
+/// (crate::cells_file).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GpuCells {
+    /// Cells of the top cut.
+    pub n_top: usize,
+    /// Nodes in all: what one walk of them may visit.
+    pub nodes: usize,
+    pub data: Vec<f32>,
 }
 
 struct Texel {
@@ -363,6 +378,15 @@ impl Cells {
             grid: g,
             nodes: out,
             n_top,
+        }
+    }
+
+    /// [`Cells::gpu_data`] with the counts.
+    pub fn gpu(&self) -> GpuCells {
+        GpuCells {
+            n_top: self.n_top,
+            nodes: self.nodes.len(),
+            data: self.gpu_data(),
         }
     }
 

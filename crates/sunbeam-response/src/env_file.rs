@@ -78,11 +78,7 @@ pub struct EnvFile {
 /// Where the environment's maps of a pack live: `dir/NAME.env-response.ktx2`
 /// for `dir/NAME.ext`.
 pub fn sidecar_path(pack: &Path) -> PathBuf {
-    let stem = pack
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    pack.with_file_name(format!("{stem}.env-response.ktx2"))
+    crate::beside(pack, "env-response.ktx2")
 }
 
 /// The sun's key of `sky` at `lambdas` (None when its sun is down).

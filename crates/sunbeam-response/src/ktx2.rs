@@ -232,6 +232,31 @@ pub(crate) fn decode_texture<'a>(
     bytes: &'a [u8],
     key: &str,
 ) -> Result<(String, [usize; 3], &'a [u8])> {
+    decode_as(bytes, key, VK_R16G16B16A16_SFLOAT, TEXEL)
+}
+
+/// The JSON under `key`, the size and the raw level of a one-level KTX2
+/// R32_UINT texture (the cells' data textures, crate::cells_file); every
+/// size is checked against the file length first.
+pub(crate) fn decode_r32u<'a>(
+    bytes: &'a [u8],
+    key: &str,
+) -> Result<(String, [usize; 3], &'a [u8])> {
+    decode_as(bytes, key, VK_R32_UINT, 4)
+}
+
+/// [`decode_texture`] for texels of `vk_format`, `texel` bytes each.
+fn decode_as<'a>(
+    bytes: &'a [u8],
+    key: &str,
+    vk_format: u32,
+    texel: usize,
+) -> Result<(String, [usize; 3], &'a [u8])> {
+    let what = if vk_format == VK_R32_UINT {
+        "R32_UINT, 98"
+    } else {
+        "R16G16B16A16_SFLOAT, 97"
+    };
     if !bytes.starts_with(&IDENTIFIER) {
         return Err(Error::input("not a KTX2 file (wrong identifier)"));
     }
@@ -240,9 +265,9 @@ pub(crate) fn decode_texture<'a>(
     }
     let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
     let u64_at = |o: usize| u64::from_le_bytes(bytes[o..o + 8].try_into().unwrap());
-    if u32_at(12) != VK_R16G16B16A16_SFLOAT {
+    if u32_at(12) != vk_format {
         return Err(Error::input(format!(
-            "KTX2 vkFormat {} is not a response map (R16G16B16A16_SFLOAT, 97)",
+            "KTX2 vkFormat {} is not {what}",
             u32_at(12)
         )));
     }
@@ -258,7 +283,7 @@ pub(crate) fn decode_texture<'a>(
     }
     let (kvd_off, kvd_len) = (u32_at(56) as usize, u32_at(60) as usize);
     let (lv_off, lv_len) = (u64_at(80), u64_at(88));
-    let need = (w as u128) * (h as u128) * (d as u128) * TEXEL as u128;
+    let need = (w as u128) * (h as u128) * (d.max(1) as u128) * texel as u128;
     if lv_len as u128 != need
         || lv_off
             .checked_add(lv_len)
@@ -266,7 +291,7 @@ pub(crate) fn decode_texture<'a>(
         || kvd_off.checked_add(kvd_len).is_none_or(|e| e > bytes.len())
     {
         return Err(Error::input(format!(
-            "KTX2 level of {lv_len} bytes at {lv_off} does not fit a {w}x{h}x{d} RGBA16F texture in a {}-byte file",
+            "KTX2 level of {lv_len} bytes at {lv_off} does not fit a {w}x{h}x{d} texture ({what}) in a {}-byte file",
             bytes.len()
         )));
     }

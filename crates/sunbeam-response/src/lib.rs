@@ -18,6 +18,7 @@
 
 pub mod build;
 pub mod cells;
+pub mod cells_file;
 pub mod energy;
 pub mod env;
 pub mod env_file;
@@ -71,11 +72,17 @@ pub struct Info {
 /// Where the map of a pack lives: `dir/NAME.response.ktx2` for `dir/NAME.ext`
 /// (what `sunbeam-pack --response` writes and the player looks for).
 pub fn sidecar_path(pack: &std::path::Path) -> std::path::PathBuf {
+    beside(pack, "response.ktx2")
+}
+
+/// `dir/NAME.SUFFIX` for a pack `dir/NAME.ext`: the files `sunbeam-pack
+/// --response` writes beside a pack.
+pub(crate) fn beside(pack: &std::path::Path, suffix: &str) -> std::path::PathBuf {
     let stem = pack
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    pack.with_file_name(format!("{stem}.response.ktx2"))
+    pack.with_file_name(format!("{stem}.{suffix}"))
 }
 
 /// A response map in memory: `data` holds f16 bits, RGBA, texel

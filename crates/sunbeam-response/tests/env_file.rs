@@ -4,35 +4,12 @@
 //! for a map; it refuses another pack, sun or wavelength count; a damaged file
 //! is an input error, never a panic.
 
-use std::sync::Arc;
+mod common;
+
+use common::{opts, pack};
 use sunbeam_light::{sky::Sky, EnvMap, Environment};
-use sunbeam_pack::build::{BuildOptions, FieldRef};
-use sunbeam_pack::Pack;
 use sunbeam_response::env::{build_env, EnvResponse};
 use sunbeam_response::env_file;
-use sunbeam_response::Options;
-
-/// A 32 x 32 patch of 50 nm samples of the synthetic snake skin `preset`.
-fn pack(preset: &str) -> Arc<Pack> {
-    let f = sunbeam_synth::preset(preset, 32, 50e-9).unwrap();
-    let (width, height, dx, dy) = (f.width, f.height, f.dx, f.dy);
-    let r = FieldRef {
-        width,
-        height,
-        dx,
-        dy,
-        data: &f.data,
-    };
-    Arc::new(sunbeam_pack::build(r, &BuildOptions::default(), &mut |_, _| {}).unwrap())
-}
-
-fn opts() -> Options {
-    Options {
-        lambda_samples: 24,
-        budget_bytes: 1 << 20,
-        grid: None,
-    }
-}
 
 fn sky(elevation: f64) -> Sky {
     Sky::new(elevation, 120.0, 3.0, 1.0)

@@ -103,6 +103,12 @@ pub(crate) struct Cli {
     /// Size bound of the response map (e.g. 64MiB; RGBA16F texels).
     #[arg(long, default_value = "64MiB", value_name = "SIZE", value_parser = sunbeam_common::cli::byte_size)]
     pub(crate) response_budget: usize,
+    /// The first-frame cells written with --response beside the environment's
+    /// maps as NAME.env-cells.ktx2, for these `sunbeam-play --env-cells` counts
+    /// (comma-separated, each 1..=4096; docs/PACK_FORMAT.md "Cells file"): the
+    /// player and the engines' export cluster any other count at start.
+    #[arg(long, value_name = "N[,N...]", value_delimiter = ',', default_values_t = [sunbeam_response::cells::FIRST_FRAME_TOP as u64], value_parser = clap::value_parser!(u64).range(1..=4096))]
+    pub(crate) response_cells: Vec<u64>,
     /// Print a JSON report on stdout.
     #[arg(long)]
     pub(crate) json: bool,

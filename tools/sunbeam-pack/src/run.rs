@@ -168,19 +168,31 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             let t_point = t.elapsed().as_secs_f64();
             let t = Instant::now();
             let e = sunbeam_response::env_file::build(&pack, sky.as_ref(), &ro);
-            Some((r, t_point, e, t.elapsed().as_secs_f64()))
+            let t_env = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let counts: Vec<(usize, usize)> = cli
+                .response_cells
+                .iter()
+                .map(|&n| (n as usize, sunbeam_response::cells::DEFAULT_DEPTH))
+                .collect();
+            let c = sunbeam_response::cells_file::build(&e, &counts);
+            Some((r, t_point, e, t_env, c, t.elapsed().as_secs_f64()))
         }
         None => None,
     };
     let mut files = write_pack(&pack, &cli.output, kind)?;
-    if let (Some(rp), Some((r, _, e, _))) = (&response_path, &response) {
+    if let (Some(rp), Some((r, _, e, _, c, _))) = (&response_path, &response) {
         let bytes = sunbeam_response::ktx2::encode(r);
         sunbeam_common::output::write_atomic(rp, &bytes)?;
         files.push((rp.clone(), bytes.len() as u64));
-        let ep = env_maps_path(rp);
+        let ep = beside_point_map(rp, "env-response");
         let bytes = sunbeam_response::env_file::encode(e);
         sunbeam_common::output::write_atomic(&ep, &bytes)?;
         files.push((ep, bytes.len() as u64));
+        let cp = beside_point_map(rp, "env-cells");
+        let bytes = sunbeam_response::cells_file::encode(c);
+        sunbeam_common::output::write_atomic(&cp, &bytes)?;
+        files.push((cp, bytes.len() as u64));
         if let Some(ep) = &cli.response_exr {
             let bytes = sunbeam_response::exr::encode(r)?;
             sunbeam_common::output::write_atomic(ep, &bytes)?;
@@ -222,7 +234,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             "bytes_written": bytes,
             "time_s": secs,
             "pack_time_s": pack_secs,
-            "response": response.as_ref().map(|(r, t, e, te)| serde_json::json!({
+            "response": response.as_ref().map(|(r, t, e, te, c, tc)| serde_json::json!({
                 "grid": [r.info.grid.n_theta, r.info.grid.n_rho, r.info.grid.n_s],
                 "r0": r.info.grid.r0,
                 "lambda_samples": r.info.lambda_samples,
@@ -232,6 +244,11 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
                 "environment_sun": e.info.sun_key.is_some(),
                 "environment_bytes": e.maps.iter().map(|m| m.byte_len()).sum::<usize>(),
                 "environment_time_s": te,
+                "cells": c.info.sets.iter().map(|s| serde_json::json!({
+                    "basis": s.basis, "cells": s.cells, "depth": s.depth,
+                    "n_top": s.n_top, "nodes": s.nodes,
+                })).collect::<Vec<_>>(),
+                "cells_time_s": tc,
             })),
             "warnings": warnings,
             "notes": m.notes,
@@ -273,15 +290,20 @@ fn response_sky(
     }))
 }
 
-/// Where the environment's maps go: beside the point map `dir/NAME.response.ktx2`
-/// as `dir/NAME.env-response.ktx2` (for another name `dir/X.ktx2`, `dir/X.env-response.ktx2`).
-fn env_maps_path(point_map: &Path) -> std::path::PathBuf {
+/// Where the environment's maps (`kind` "env-response") and the first-frame
+/// cells ("env-cells") go: beside the point map `dir/NAME.response.ktx2` as
+/// `dir/NAME.KIND.ktx2` (for another name `dir/X.ktx2`, `dir/X.KIND.ktx2`).
+fn beside_point_map(point_map: &Path, kind: &str) -> std::path::PathBuf {
     let name = point_map
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    match name.strip_suffix(".response.ktx2") {
-        Some(stem) => point_map.with_file_name(format!("{stem}.env-response.ktx2")),
-        None => sunbeam_response::env_file::sidecar_path(point_map),
-    }
+    let stem = match name.strip_suffix(".response.ktx2") {
+        Some(stem) => stem.to_string(),
+        None => point_map
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+    };
+    point_map.with_file_name(format!("{stem}.{kind}.ktx2"))
 }

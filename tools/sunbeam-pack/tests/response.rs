@@ -1,6 +1,7 @@
-//! `sunbeam-pack --response`: the response map beside the pack, built from the
-//! same pack (its manifest embedded), listed in the depfile and the report,
-//! byte-identical across runs and thread counts; bad flags exit 1.
+//! `sunbeam-pack --response`: the response map, the environment's maps and
+//! the first-frame cells beside the pack, built from the same pack (its
+//! manifest embedded), listed in the depfile and the report, byte-identical
+//! across runs and thread counts; bad flags exit 1.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -51,6 +52,8 @@ fn response_map_is_written_beside_the_pack() {
         "--response",
         "--response-lambda",
         "16",
+        "--response-cells",
+        "8,32",
         "--response-exr",
         d.join("skin.response.exr").to_str().unwrap(),
         "--depfile",
@@ -72,6 +75,24 @@ fn response_map_is_written_beside_the_pack() {
     let depfile = std::fs::read_to_string(&dep).unwrap();
     assert!(depfile.contains("skin.response.ktx2"), "{depfile}");
     assert!(depfile.contains("skin.response.exr"), "{depfile}");
+    assert!(depfile.contains("skin.env-cells.ktx2"), "{depfile}");
+    // The first-frame cells beside the environment's maps, both bases at each
+    // count asked for, from this pack and those maps.
+    let cells = sunbeam_response::cells_file::read(&d.join("skin.env-cells.ktx2")).unwrap();
+    let env = sunbeam_response::env_file::read(&d.join("skin.env-response.ktx2")).unwrap();
+    assert_eq!(cells.info.pack, p.manifest);
+    assert_eq!(cells.info.grid, env.info.grid);
+    let sets: Vec<(String, usize)> = cells
+        .info
+        .sets
+        .iter()
+        .map(|s| (s.basis.clone(), s.cells))
+        .collect();
+    assert_eq!(
+        sets,
+        [("sky", 8), ("map", 8), ("sky", 32), ("map", 32)].map(|(b, n)| (b.to_string(), n)),
+    );
+    assert_eq!(report["response"]["cells"].as_array().unwrap().len(), 4);
     let exr = std::fs::read(d.join("skin.response.exr")).unwrap();
     assert_eq!(exr, sunbeam_response::exr::encode(&map).unwrap());
     // Deterministic, whatever the thread count.
@@ -85,12 +106,19 @@ fn response_map_is_written_beside_the_pack() {
         d.join("again.map.ktx2").to_str().unwrap(),
         "--response-lambda",
         "16",
+        "--response-cells",
+        "32,8,8",
         "--threads",
         "1",
         "-q",
     ]);
     assert_eq!(code, 0, "{stderr}");
     assert_eq!(first, std::fs::read(d.join("again.map.ktx2")).unwrap());
+    assert_eq!(
+        std::fs::read(d.join("skin.env-cells.ktx2")).unwrap(),
+        std::fs::read(d.join("again.map.env-cells.ktx2")).unwrap(),
+        "the same cells whatever the threads and the counts' order"
+    );
     std::fs::remove_dir_all(&d).ok();
 }
 
@@ -110,5 +138,18 @@ fn bad_response_budget_is_a_usage_error() {
     assert_eq!(code, 1, "{stderr}");
     assert!(stderr.contains("--response-budget"), "{stderr}");
     assert!(!out.exists() && !d.join("p.response.ktx2").exists());
+    for bad in ["0", "4097", "512,lots"] {
+        let (code, _, stderr) = pack(&[
+            h.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--response",
+            "--response-cells",
+            bad,
+        ]);
+        assert_eq!(code, 1, "{bad}: {stderr}");
+        assert!(stderr.contains("--response-cells"), "{bad}: {stderr}");
+        assert!(!out.exists() && !d.join("p.env-cells.ktx2").exists());
+    }
     std::fs::remove_dir_all(&d).ok();
 }

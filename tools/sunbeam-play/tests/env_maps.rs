@@ -3,7 +3,9 @@
 //! player draws with them when they serve the scene (no build at start, the
 //! same frame bit for bit as with the maps built in memory), rebuilds them in
 //! memory with a note for another sun or another pack (no line that says
-//! error), and refuses a damaged file naming it (exit 2, no panic).
+//! error), and refuses a damaged file naming it (exit 2, no panic). The same
+//! for the first-frame cells (`NAME.env-cells.ktx2`, docs/PACK_FORMAT.md
+//! "Cells file"), clustered at start for a count the file does not hold.
 
 mod common;
 
@@ -108,4 +110,75 @@ fn the_pipelines_environment_maps_are_read_rebuilt_when_stale_refused_when_damag
         assert!(err.contains("x.env-response.ktx2"), "{err}");
         assert!(!err.contains("panicked"), "{err}");
     }
+}
+
+/// One first frame of `scene` with the cells (`--env-cells` `cells`).
+fn render_cells(scene: &Path, out: &str, cells: &str) -> Output {
+    Command::new(BIN)
+        .arg(scene)
+        .args(["--headless", "--size", "16x16", "--env-estimator", "cells"])
+        .args(["--env-cells", cells, "-o"])
+        .arg(scene.with_file_name(out))
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap()
+}
+
+const CLUSTERED: &str = "clustered the environment's maps";
+
+#[test]
+fn the_pipelines_cells_are_read_clustered_when_missing_refused_when_damaged() {
+    if !gpu_available() {
+        return;
+    }
+    let d = scratch("play-env-cells");
+    pack(&d, "x", "xenopeltis");
+    let cells = d.join("x.env-cells.ktx2");
+    assert!(cells.is_file(), "sunbeam-pack --response wrote {cells:?}");
+    let scene = sky_scene(&d, "sky.json", 35.0);
+
+    // Current (the default count): read, not clustered.
+    let o = render_cells(&scene, "read.exr", "512");
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        !err.contains(CLUSTERED),
+        "cells clustered although current: {err}"
+    );
+
+    // Without the file: clustered with a note naming it, the same frame.
+    std::fs::rename(&cells, d.join("aside.ktx2")).unwrap();
+    let o = render_cells(&scene, "built.exr", "512");
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains(CLUSTERED) && err.contains("x.env-cells.ktx2"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(d.join("read.exr")).unwrap(),
+        std::fs::read(d.join("built.exr")).unwrap(),
+        "the frame from the file's cells differs from the one from cells clustered in memory"
+    );
+    std::fs::rename(d.join("aside.ktx2"), &cells).unwrap();
+
+    // A count the file does not hold: clustered, the flag that writes it named.
+    let o = render_cells(&scene, "other.exr", "64");
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains(CLUSTERED) && err.contains("--response-cells 64"),
+        "{err}"
+    );
+    assert!(!err.to_lowercase().contains("error"), "{err}");
+
+    // Damaged: an input error naming the file, nothing written.
+    let good = std::fs::read(&cells).unwrap();
+    std::fs::write(&cells, &good[..good.len() / 2]).unwrap();
+    let o = render_cells(&scene, "bad.exr", "512");
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("x.env-cells.ktx2"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!d.join("bad.exr").exists());
 }

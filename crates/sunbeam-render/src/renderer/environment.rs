@@ -12,7 +12,8 @@ use sunbeam_common::{Error, Result};
 use sunbeam_frame::Prepared;
 use sunbeam_light::Environment;
 use sunbeam_pack::Pack;
-use sunbeam_response::env_file;
+use sunbeam_response::cells::{Cells, GpuCells};
+use sunbeam_response::{cells_file, env_file};
 
 /// The environment a mode shades: the scene's in the default mode, none for
 /// the Lambert baseline; the other baselines refuse a scene with one.
@@ -68,8 +69,19 @@ pub(super) fn maps(
     if let Some((_, m)) = built.iter().find(|(k, _)| *k == key) {
         return Ok(m.clone());
     }
+    let tq = std::time::Instant::now();
     let er = response(env, pack, path, mi, opts, notes)?;
-    let m = Arc::new(crate::env::EnvMaps::new(gpu, &er, cells)?);
+    eprintln!("TIMING read {:?}", tq.elapsed());
+    // Monte Carlo draws from the maps' pyramid and never walks the cells.
+    let gc = match estimator {
+        crate::env::EnvEstimator::Cells => {
+            Some(first_frame_cells(&er, env, pack, path, mi, cells, notes)?)
+        }
+        crate::env::EnvEstimator::MonteCarlo => None,
+    };
+    eprintln!("TIMING cells {:?}", tq.elapsed());
+    let m = Arc::new(crate::env::EnvMaps::new(gpu, &er, gc.as_ref())?);
+    eprintln!("TIMING upload {:?}", tq.elapsed());
     if estimator == crate::env::EnvEstimator::Cells && gpu.is_cpu() && m.nodes > CPU_CELL_NODES {
         // nodes grow about as the cells: the power of two that fits
         let fit = (cells.0 * CPU_CELL_NODES / m.nodes).max(1);
@@ -152,4 +164,60 @@ pub(crate) fn response(
         t0.elapsed().as_secs_f64()
     ));
     Ok(er)
+}
+
+/// The first-frame cells of `er` (`env`'s basis maps; meshes[`mi`]'s pack,
+/// read from `path`), `cells` = (top cut, levels below): read from the
+/// pack's `NAME.env-cells.ktx2` (`sunbeam-pack --response`) when it holds
+/// them, else clustered here; where the pipeline's maps stand beside the
+/// pack but its cells do not serve, a note says what the clustering took
+/// and why. A cells file that cannot be read is an input error naming it.
+pub(crate) fn first_frame_cells(
+    er: &sunbeam_response::env::EnvResponse,
+    env: &Environment,
+    pack: &Pack,
+    path: Option<&Path>,
+    mi: usize,
+    cells: (usize, usize),
+    notes: &mut Vec<String>,
+) -> Result<GpuCells> {
+    let t0 = std::time::Instant::now();
+    let side = path.map(cells_file::sidecar_path).filter(|p| p.is_file());
+    let lambdas = er.basis.first().map_or(0, |m| m.info.lambda_samples);
+    let basis = cells_file::basis_of(env);
+    let why = match &side {
+        Some(side) => {
+            let f = cells_file::read(side)?;
+            match f.get(&pack.manifest, &er.grid, lambdas, basis, cells) {
+                Ok(g) => {
+                    log::info!(
+                        "read the cells of meshes[{mi}].pack from {} in {:.2?}",
+                        side.display(),
+                        t0.elapsed()
+                    );
+                    return Ok(g);
+                }
+                Err(why) => Some(format!("{} {why}", side.display())),
+            }
+        }
+        None => path
+            .filter(|p| env_file::sidecar_path(p).is_file())
+            .map(|p| {
+                format!(
+                    "no cells beside the pack ({}; write them once with `sunbeam-pack --response`)",
+                    cells_file::sidecar_path(p).display()
+                )
+            }),
+    };
+    let t0 = std::time::Instant::now();
+    let g = Cells::build(&er.basis, cells.0, cells.1).gpu();
+    if let Some(why) = why {
+        notes.push(format!(
+            "clustered the environment's maps of meshes[{mi}].pack into {} cells ({} nodes) in {:.2} s: {why}",
+            g.n_top,
+            g.nodes,
+            t0.elapsed().as_secs_f64()
+        ));
+    }
+    Ok(g)
 }

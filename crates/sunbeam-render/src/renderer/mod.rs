@@ -393,6 +393,61 @@ impl Renderer {
             [&dummy_2d, &dummy_2d, &dummy_2d],
         );
 
+        // The cells at a lower rate need a smooth term: the sky (its sun has
+        // its own path) or a map whose hot spots are lights; a map's
+        // softboxes seen by the cells themselves (`env_hot_spots` 0) are
+        // sharp at the cells' scale (CIEDE2000 p99 8.3 against every pixel on
+        // tests/threejs_render.rs' studio scene, 0.45 with its hot spots).
+        let smooth_term =
+            settings.env_hot_spots > 0 || env_scene.env.as_ref().is_some_and(|e| e.sun().is_some());
+        // Without a smooth term the centre pass alone (K = 1): one walk per
+        // pixel, none interpolated.
+        let cells_rate = (settings.mode == Mode::Default
+            && env_scene.env.is_some()
+            && settings.env_estimator == crate::env::EnvEstimator::Cells
+            && settings.env_cells_rate > 0
+            && p.meshes.iter().any(|(_, m)| m.pack.is_some()))
+        .then_some(if smooth_term {
+            settings.env_cells_rate
+        } else {
+            1
+        });
+        // The pipelines compile on a second thread while the meshes' maps are
+        // read and uploaded below: neither needs the other, and each is about
+        // a second of an environment scene's start-up on lavapipe
+        // (docs/bench/play.md "Start-up").
+        let compiled = {
+            let device = device.clone();
+            let adapter = gpu.adapter.clone();
+            #[cfg_attr(not(feature = "baselines"), allow(unused_mut))]
+            let mut owned = vec![gl0.clone(), gl1.clone(), env_scene.layout.clone()];
+            #[cfg(feature = "baselines")]
+            if let Some(b) = &baselines {
+                owned.push(b.layout.clone());
+            }
+            let technique = technique.clone();
+            let msaa = settings.msaa;
+            let (globals, spectrum, stand_in) =
+                (globals.clone(), spectrum.clone(), dummy_2d.clone());
+            std::thread::Builder::new()
+                .name("sunbeam pipelines".into())
+                .spawn(
+                    move || -> Result<(wgpu::RenderPipeline, Option<cells_rate::CellsRate>)> {
+                        let layouts: Vec<&wgpu::BindGroupLayout> = owned.iter().collect();
+                        let pipeline =
+                            render_pipeline(&device, &layouts, &[format], msaa, &technique)?;
+                        let cells = match cells_rate {
+                            Some(rate) => Some(cells_rate::CellsRate::new(
+                                &adapter, &device, &layouts, rate, &globals, &spectrum, &stand_in,
+                            )?),
+                            None => None,
+                        };
+                        Ok((pipeline, cells))
+                    },
+                )
+                .map_err(|e| Error::internal(format!("cannot start the pipelines' thread: {e}")))?
+        };
+
         let mut meshes = Vec::new();
         for (mi, (mesh, mat)) in p.meshes.iter().enumerate() {
             let scales = mat.scales.as_deref();
@@ -564,44 +619,9 @@ impl Renderer {
             });
         }
 
-        #[cfg_attr(not(feature = "baselines"), allow(unused_mut))]
-        let mut layouts = vec![&gl0, &gl1, &env_scene.layout];
-        #[cfg(feature = "baselines")]
-        if let Some(b) = &baselines {
-            layouts.push(&b.layout);
-        }
-        let pipeline = render_pipeline(device, &layouts, &[format], settings.msaa, &technique)?;
-        // The cells at a lower rate need a smooth term: the sky (its sun has
-        // its own path) or a map whose hot spots are lights; a map's
-        // softboxes seen by the cells themselves (`env_hot_spots` 0) are
-        // sharp at the cells' scale (CIEDE2000 p99 8.3 against every pixel on
-        // tests/threejs_render.rs' studio scene, 0.45 with its hot spots).
-        let smooth_term =
-            settings.env_hot_spots > 0 || env_scene.env.as_ref().is_some_and(|e| e.sun().is_some());
-        // Without a smooth term the centre pass alone (K = 1): one walk per
-        // pixel, none interpolated.
-        let cells = if settings.mode == Mode::Default
-            && env_scene.env.is_some()
-            && settings.env_estimator == crate::env::EnvEstimator::Cells
-            && settings.env_cells_rate > 0
-            && p.meshes.iter().any(|(_, m)| m.pack.is_some())
-        {
-            Some(cells_rate::CellsRate::new(
-                &gpu.adapter,
-                device,
-                &layouts,
-                if smooth_term {
-                    settings.env_cells_rate
-                } else {
-                    1
-                },
-                &globals,
-                &spectrum,
-                &dummy_2d,
-            )?)
-        } else {
-            None
-        };
+        let (pipeline, cells) = compiled
+            .join()
+            .map_err(|_| Error::internal("the pipelines' thread panicked"))??;
         // `"background": "environment"`: the lighting's table and sun (or,
         // in the Lambert mode, which lights without them, the same built here).
         let background = match (&p.scene.background, &p.environment) {

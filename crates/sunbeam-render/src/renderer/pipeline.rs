@@ -140,6 +140,7 @@ pub(super) fn mesh_buffers(
 
 /// A technique's shader: the composed WGSL, its fragment entry point and the
 /// values of its pipeline constants.
+#[derive(Clone)]
 pub(super) struct Technique {
     pub(super) label: &'static str,
     pub(super) source: &'static str,
