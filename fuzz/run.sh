@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 secs=${1:-120}
 shift || true
-targets=${*:-"nanoscope gwy gsf ibw sxm park_tiff jpk png tiff bmp ascii xyz nid mi wsxm mdt detect envmap"}
+targets=${*:-"nanoscope gwy gsf ibw sxm park_tiff jpk png tiff bmp ascii xyz nid mi wsxm mdt detect envmap response_files"}
 python3 seeds.py corpus "${SUNBEAM_SHARED_DATA:-../../shared/data}"
 tc=+nightly
 rustup run nightly true 2>/dev/null || { tc=; export RUSTC_BOOTSTRAP=1; }

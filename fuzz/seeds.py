@@ -130,6 +130,20 @@ hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n"
 put("envmap", "flat.hdr", hdr + b"-Y 2 +X 4\n" + bytes([128, 64, 32, 129]) * 8)
 rle_line = bytes([2, 2, 0, 8]) + b"".join(bytes([128 + 8, v]) for v in (100, 90, 80, 129))
 put("envmap", "rle.hdr", hdr + b"-Y 4 +X 8\n" + rle_line * 4)
+# The files sunbeam-pack --response writes (response map, environment maps,
+# first-frame cells) for a tiny synthetic patch, when the tools are built.
+B = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "target", "release")
+if os.path.exists(os.path.join(B, "sunbeam-pack")):
+    import subprocess, tempfile
+    with tempfile.TemporaryDirectory() as d:
+        h, p = os.path.join(d, "h.exr"), os.path.join(d, "p.ktx2")
+        subprocess.run([os.path.join(B, "sunbeam-import"), "synthetic:xenopeltis",
+                        "--synthetic-size", "16", "-q", "-o", h], check=True)
+        subprocess.run([os.path.join(B, "sunbeam-pack"), h, "-o", p, "--response",
+                        "--response-budget", "16KiB", "--response-lambda", "8",
+                        "--response-cells", "2,4", "-q"], check=True)
+        for f in ("p.response.ktx2", "p.env-response.ktx2", "p.env-cells.ktx2"):
+            cp("response_files", os.path.join(d, f))
 for t in os.listdir(out):
     if t == "detect":
         continue

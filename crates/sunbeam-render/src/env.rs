@@ -470,7 +470,10 @@ impl EnvMaps {
     ) -> Result<EnvMaps> {
         let p = &r.proposal;
         let g = r.grid;
-        if p.offsets.is_empty() || p.offsets.len() > MAX_LEVELS || r.basis.len() != 3 {
+        // The first frame reads neither the proposal nor, under the sky with
+        // its cells from the pipeline, the basis maps (env_file::Needs):
+        // stand-ins then, which its shader paths never sample.
+        if p.offsets.len() > MAX_LEVELS || !(r.basis.len() == 3 || r.basis.is_empty()) {
             return Err(Error::internal(format!(
                 "environment maps: {} basis maps, {} pyramid levels (the player takes 3 and up to {MAX_LEVELS})",
                 r.basis.len(),
@@ -492,7 +495,7 @@ impl EnvMaps {
             offsets,
             pw: p.pw as u32,
             ph: p.ph as u32,
-            top: (p.offsets.len() - 1) as u32,
+            top: p.offsets.len().saturating_sub(1) as u32,
             n_s: p.n_s as u32,
             n_theta: g.n_theta as f32,
             n_rho: g.n_rho as f32,
@@ -533,11 +536,16 @@ impl EnvMaps {
                 usage: wgpu::BufferUsages::STORAGE,
             });
         let view = |m: &sunbeam_response::Response| crate::response::response_texture(gpu, m);
+        let stand_in = || crate::response::texture_3d(gpu, [1, 1, 1], &[0; 4]);
+        let views = match &r.basis[..] {
+            [a, b, c] => [view(a), view(b), view(c)],
+            _ => [stand_in(), stand_in(), stand_in()],
+        };
         Ok(EnvMaps {
             uniform,
             pyramid,
             cells,
-            views: [view(&r.basis[0]), view(&r.basis[1]), view(&r.basis[2])],
+            views,
             sun: r.sun.as_ref().map(view),
             nodes,
         })

@@ -146,7 +146,15 @@ pub fn export(
             continue;
         }
         let path = p.scene.meshes.get(mi).and_then(|s| s.pack.as_deref());
-        let er = environment::response(&env, pack, path, mi, opts, &mut notes)?;
+        let er = environment::response(
+            &env,
+            pack,
+            path,
+            mi,
+            opts,
+            sunbeam_response::env_file::Needs::ALL,
+            &mut notes,
+        )?;
         let c = environment::first_frame_cells(&er, &env, pack, path, mi, cells, &mut notes)?;
         let mut bits: Vec<u32> = c.data.iter().map(|v| v.to_bits()).collect();
         let w = CELLS_WIDTH.min(bits.len().max(1));

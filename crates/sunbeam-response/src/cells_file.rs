@@ -148,96 +148,134 @@ pub fn build(env: &EnvFile, counts: &[(usize, usize)]) -> CellsFile {
     }
 }
 
-impl CellsFile {
-    /// The cells of `basis` for `(cells, depth)` if the file was built from
+impl CellsInfo {
+    /// The set of `basis` for `(cells, depth)` if the file was built from
     /// `manifest` on `grid` with `lambda_samples`, or why it does not serve
     /// them.
-    pub fn get(
+    pub fn select(
         &self,
         manifest: &Manifest,
         grid: &Grid,
         lambda_samples: usize,
         basis: &str,
         (cells, depth): (usize, usize),
-    ) -> std::result::Result<GpuCells, String> {
-        let i = &self.info;
-        if i.pack != *manifest {
+    ) -> std::result::Result<&CellSet, String> {
+        if self.pack != *manifest {
             return Err("was built from another pack".into());
         }
-        if i.lambda_samples != lambda_samples || i.grid != *grid {
+        if self.lambda_samples != lambda_samples || self.grid != *grid {
             return Err("was built for other environment maps (grid or wavelength samples)".into());
         }
-        let Some(s) = i
-            .sets
+        self.sets
             .iter()
             .find(|s| s.basis == basis && s.cells == cells && s.depth == depth)
-        else {
-            let held: Vec<String> = i
-                .sets
-                .iter()
-                .filter(|s| s.basis == basis)
-                .map(|s| s.cells.to_string())
-                .collect();
-            return Err(format!(
-                "holds {basis} cells for --env-cells {} only, not {cells} (write them with \
-                 sunbeam-pack --response-cells {cells})",
-                if held.is_empty() {
-                    "none".to_string()
-                } else {
-                    held.join(", ")
-                }
-            ));
-        };
-        let at = s.row * WIDTH;
-        Ok(GpuCells {
-            n_top: s.n_top,
-            nodes: s.nodes,
-            data: self.bits[at..at + s.len]
-                .iter()
-                .map(|&b| f32::from_bits(b))
-                .collect(),
-        })
+            .ok_or_else(|| {
+                let held: Vec<String> = self
+                    .sets
+                    .iter()
+                    .filter(|s| s.basis == basis)
+                    .map(|s| s.cells.to_string())
+                    .collect();
+                format!(
+                    "holds {basis} cells for --env-cells {} only, not {cells} (write them with \
+                     sunbeam-pack --response-cells {cells})",
+                    if held.is_empty() {
+                        "none".to_string()
+                    } else {
+                        held.join(", ")
+                    }
+                )
+            })
     }
 
-    /// Check the description against the texels: every set inside the
-    /// texture, its length that of its nodes, its links to nodes of its own.
-    fn validate(&self) -> Result<()> {
-        let i = &self.info;
-        if i.format != FORMAT || i.version != VERSION {
+    /// Floats per node.
+    fn stride(&self) -> usize {
+        GPU_HEADER + 9 * self.grid.n_s
+    }
+
+    /// Check the description against a texture of `texels`: every set
+    /// inside it, its length that of its nodes.
+    fn check(&self, texels: usize) -> Result<()> {
+        if self.format != FORMAT || self.version != VERSION {
             return Err(Error::input(format!(
                 "not a {FORMAT} v{VERSION} file (format '{}', version {})",
-                i.format, i.version
+                self.format, self.version
             )));
         }
-        if i.header != GPU_HEADER {
+        if self.header != GPU_HEADER {
             return Err(Error::input(format!(
                 "{INFO_KEY}: header {} is not {GPU_HEADER}",
-                i.header
+                self.header
             )));
         }
-        let stride = GPU_HEADER + 9 * i.grid.n_s;
-        for (n, s) in i.sets.iter().enumerate() {
-            let bad = |why: &str| Err(Error::input(format!("{INFO_KEY}: sets[{n}] {why}")));
+        let stride = self.stride();
+        for (n, s) in self.sets.iter().enumerate() {
+            let bad = |why: String| Err(Error::input(format!("{INFO_KEY}: sets[{n}] {why}")));
             if s.basis != "sky" && s.basis != "map" {
-                return bad("basis must be 'sky' or 'map'");
+                return bad("basis must be 'sky' or 'map'".into());
             }
             if s.n_top > s.nodes || s.nodes.checked_mul(stride) != Some(s.len) {
-                return bad(&format!(
+                return bad(format!(
                     "has {} floats for {} nodes of {stride} ({} top cells)",
                     s.len, s.nodes, s.n_top
                 ));
             }
-            let at = s.row.checked_mul(WIDTH);
-            let Some(data) = at.and_then(|a| self.bits.get(a..a.checked_add(s.len)?)) else {
-                return bad("lies outside the texture");
-            };
-            for node in data.chunks_exact(stride) {
-                for link in [node[3], node[4]] {
-                    if link != GPU_NONE && link as usize >= s.nodes {
-                        return bad(&format!("links to node {link} of {}", s.nodes));
-                    }
+            let end = s.row.checked_mul(WIDTH).and_then(|a| a.checked_add(s.len));
+            if end.is_none_or(|e| e > texels) {
+                return bad("lies outside the texture".into());
+            }
+        }
+        Ok(())
+    }
+}
+
+impl CellSet {
+    /// The set's floats from its texels (`stride` floats per node), every
+    /// link to a node of its own.
+    fn cells(&self, stride: usize, texels: &[u32]) -> Result<GpuCells> {
+        for node in texels.chunks_exact(stride) {
+            for link in [node[3], node[4]] {
+                if link != GPU_NONE && link as usize >= self.nodes {
+                    return Err(Error::input(format!(
+                        "{INFO_KEY}: a {} set's node links to node {link} of {}",
+                        self.basis, self.nodes
+                    )));
                 }
             }
+        }
+        Ok(GpuCells {
+            n_top: self.n_top,
+            nodes: self.nodes,
+            data: texels.iter().map(|&b| f32::from_bits(b)).collect(),
+        })
+    }
+}
+
+impl CellsFile {
+    /// The cells of `basis` for `(cells, depth)` if the file serves them
+    /// ([`CellsInfo::select`]), or why not.
+    pub fn get(
+        &self,
+        manifest: &Manifest,
+        grid: &Grid,
+        lambda_samples: usize,
+        basis: &str,
+        cells: (usize, usize),
+    ) -> std::result::Result<GpuCells, String> {
+        let s = self
+            .info
+            .select(manifest, grid, lambda_samples, basis, cells)?;
+        let at = s.row * WIDTH;
+        s.cells(self.info.stride(), &self.bits[at..at + s.len])
+            .map_err(|e| e.to_string())
+    }
+
+    /// Check the description against the texels (after reading a file).
+    fn validate(&self) -> Result<()> {
+        self.info.check(self.bits.len())?;
+        for s in &self.info.sets {
+            let at = s.row * WIDTH;
+            s.cells(self.info.stride(), &self.bits[at..at + s.len])?;
         }
         Ok(())
     }
@@ -270,6 +308,47 @@ pub fn decode(bytes: &[u8]) -> Result<CellsFile> {
     let f = CellsFile { info, bits };
     f.validate()?;
     Ok(f)
+}
+
+/// The cells of `basis` for `cells` = (top cut, levels) from the file at
+/// `path` for maps of `manifest`'s pack on `grid` with `lambda_samples`,
+/// reading its head and that set's texels only, or why the file does not
+/// serve them (the outer error: the file cannot be read or is not a valid
+/// file; its message names it).
+pub fn read_set(
+    path: &Path,
+    manifest: &Manifest,
+    grid: &Grid,
+    lambda_samples: usize,
+    basis: &str,
+    cells: (usize, usize),
+) -> Result<std::result::Result<GpuCells, String>> {
+    use std::io::{Read, Seek, SeekFrom};
+    let ctx = |e: Error| e.context(path.display().to_string());
+    let (text, [w, h, _], lv_off) = ktx2::read_head_as(path, INFO_KEY, ktx2::VK_R32_UINT, 4)?;
+    let info: CellsInfo = serde_json::from_str(&text)
+        .map_err(|e| ctx(Error::input(format!("{INFO_KEY} JSON is invalid: {e}"))))?;
+    if w != WIDTH {
+        return Err(ctx(Error::input(format!(
+            "{INFO_KEY}: the texture is {w} x {h}, not {WIDTH} wide"
+        ))));
+    }
+    info.check(w * h.max(1)).map_err(ctx)?;
+    let s = match info.select(manifest, grid, lambda_samples, basis, cells) {
+        Ok(s) => s,
+        Err(why) => return Ok(Err(why)),
+    };
+    let err = |e: std::io::Error| Error::input_file(path, format!("cannot read: {e}"));
+    let mut f = std::fs::File::open(path).map_err(err)?;
+    f.seek(SeekFrom::Start(lv_off + (s.row * WIDTH * 4) as u64))
+        .map_err(err)?;
+    let mut raw = vec![0u8; s.len * 4];
+    f.read_exact(&mut raw).map_err(err)?;
+    let texels: Vec<u32> = raw
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    Ok(Ok(s.cells(info.stride(), &texels).map_err(ctx)?))
 }
 
 /// Read a file (errors name it).

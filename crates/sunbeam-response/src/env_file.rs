@@ -182,10 +182,19 @@ impl EnvInfo {
         Ok(picked)
     }
 
-    /// The [`EnvResponse`] of `env` from the maps [`EnvInfo::select`] picked.
-    fn assemble(&self, env: &Environment, mut maps: Vec<Response>) -> EnvResponse {
-        let sun = (maps.len() > 3).then(|| maps.remove(3));
-        let proposal = crate::Proposal::from_maps(self.grid, env::proposal_maps(env, &maps));
+    /// The [`EnvResponse`] of `env` from the maps [`EnvInfo::select`] picked
+    /// (the basis maps only where `needs` asks for them).
+    fn assemble(&self, env: &Environment, mut maps: Vec<Response>, needs: Needs) -> EnvResponse {
+        let sun = if needs.basis {
+            (maps.len() > 3).then(|| maps.remove(3))
+        } else {
+            maps.pop()
+        };
+        let proposal = if needs.proposal {
+            crate::Proposal::from_maps(self.grid, env::proposal_maps(env, &maps))
+        } else {
+            crate::Proposal::none(self.grid)
+        };
         EnvResponse {
             grid: self.grid,
             basis: maps,
@@ -208,7 +217,7 @@ impl EnvFile {
         let picked = self.info.select(manifest, env, opts)?;
         let mut all: Vec<Option<Response>> = self.maps.into_iter().map(Some).collect();
         let maps = picked.iter().filter_map(|&m| all[m].take()).collect();
-        Ok(self.info.assemble(env, maps))
+        Ok(self.info.assemble(env, maps, Needs::ALL))
     }
 
     /// Check the description against the texels (after reading a file).
@@ -298,6 +307,23 @@ pub fn read_info(path: &Path) -> Result<EnvInfo> {
     })
 }
 
+/// What a reader of the file draws with: the basis maps (Monte Carlo, the
+/// hot spots, clustering the cells) and the proposal built from them (Monte
+/// Carlo only). The sun's map, when the sky has one, is always read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Needs {
+    pub basis: bool,
+    pub proposal: bool,
+}
+
+impl Needs {
+    /// Everything: what [`env::build_env`] builds.
+    pub const ALL: Needs = Needs {
+        basis: true,
+        proposal: true,
+    };
+}
+
 /// The maps of `env` from the file at `path`, reading only the maps it needs
 /// (the head first, then those maps' texels), or why the file does not serve
 /// `env` (the outer error: the file cannot be read, or is not a valid file;
@@ -308,15 +334,35 @@ pub fn read_for(
     env: &Environment,
     opts: &Options,
 ) -> Result<std::result::Result<EnvResponse, String>> {
+    read_needed(path, manifest, env, opts, Needs::ALL)
+}
+
+/// [`read_for`] reading only what `needs` asks for: without the basis maps,
+/// the sun's map alone (an [`EnvResponse`] with no `basis`); without the
+/// proposal, [`crate::Proposal::none`].
+pub fn read_needed(
+    path: &Path,
+    manifest: &Manifest,
+    env: &Environment,
+    opts: &Options,
+    needs: Needs,
+) -> Result<std::result::Result<EnvResponse, String>> {
     use std::io::{Read, Seek, SeekFrom};
     let ctx = |e: Error| e.context(path.display().to_string());
     let (text, [w, h, d], lv_off) = ktx2::read_head_layout(path, INFO_KEY)?;
     let info: EnvInfo = serde_json::from_str(&text)
         .map_err(|e| ctx(Error::input(format!("{INFO_KEY} JSON is invalid: {e}"))))?;
     check_layout(&info, [w, h, d]).map_err(ctx)?;
-    let picked = match info.select(manifest, env, opts) {
+    let mut picked = match info.select(manifest, env, opts) {
         Ok(p) => p,
         Err(why) => return Ok(Err(why)),
+    };
+    if !needs.basis {
+        picked.drain(..3);
+    }
+    let needs = Needs {
+        proposal: needs.proposal && needs.basis,
+        ..needs
     };
     let per = info.grid.texels() * 8;
     let err = |e: std::io::Error| Error::input_file(path, format!("cannot read: {e}"));
@@ -334,7 +380,7 @@ pub fn read_for(
         r.validate().map_err(ctx)?;
         maps.push(r);
     }
-    Ok(Ok(info.assemble(env, maps)))
+    Ok(Ok(info.assemble(env, maps, needs)))
 }
 
 /// The texture `[w, h, d]` holds `info.maps` on `info.grid`.

@@ -245,6 +245,15 @@ pub(crate) fn decode_r32u<'a>(
     decode_as(bytes, key, VK_R32_UINT, 4)
 }
 
+/// The name of a vkFormat this module reads.
+fn format_name(vk_format: u32) -> &'static str {
+    if vk_format == VK_R32_UINT {
+        "R32_UINT"
+    } else {
+        "a response map's R16G16B16A16_SFLOAT"
+    }
+}
+
 /// [`decode_texture`] for texels of `vk_format`, `texel` bytes each.
 fn decode_as<'a>(
     bytes: &'a [u8],
@@ -252,11 +261,7 @@ fn decode_as<'a>(
     vk_format: u32,
     texel: usize,
 ) -> Result<(String, [usize; 3], &'a [u8])> {
-    let what = if vk_format == VK_R32_UINT {
-        "R32_UINT, 98"
-    } else {
-        "R16G16B16A16_SFLOAT, 97"
-    };
+    let what = format_name(vk_format);
     if !bytes.starts_with(&IDENTIFIER) {
         return Err(Error::input("not a KTX2 file (wrong identifier)"));
     }
@@ -267,7 +272,7 @@ fn decode_as<'a>(
     let u64_at = |o: usize| u64::from_le_bytes(bytes[o..o + 8].try_into().unwrap());
     if u32_at(12) != vk_format {
         return Err(Error::input(format!(
-            "KTX2 vkFormat {} is not {what}",
+            "KTX2 vkFormat {} is not {what} ({vk_format})",
             u32_at(12)
         )));
     }
@@ -360,7 +365,18 @@ pub(crate) fn read_head_layout(
     path: &std::path::Path,
     key: &str,
 ) -> Result<(String, [usize; 3], u64)> {
-    let text = read_entry(path, key)?;
+    read_head_as(path, key, VK_R16G16B16A16_SFLOAT, TEXEL)
+}
+
+/// [`read_head_layout`] for a one-level texture of `vk_format`, `texel`
+/// bytes per texel.
+pub(crate) fn read_head_as(
+    path: &std::path::Path,
+    key: &str,
+    vk_format: u32,
+    texel: usize,
+) -> Result<(String, [usize; 3], u64)> {
+    let text = read_entry_as(path, key, vk_format)?;
     let head = sunbeam_common::magic::read_ktx2_head(path)?
         .ok_or_else(|| Error::input_file(path, "not a KTX2 file (wrong identifier)"))?;
     let u32_at = |o: usize| u32::from_le_bytes(head[o..o + 4].try_into().unwrap());
@@ -376,7 +392,7 @@ pub(crate) fn read_head_layout(
         ));
     }
     let (lv_off, lv_len) = (u64_at(80), u64_at(88));
-    let need = size.iter().map(|&v| v as u128).product::<u128>() * TEXEL as u128;
+    let need = size.iter().map(|&v| v.max(1) as u128).product::<u128>() * texel as u128;
     let file_len = std::fs::metadata(path)
         .map_err(|e| Error::input_file(path, e))?
         .len();
@@ -384,7 +400,7 @@ pub(crate) fn read_head_layout(
         return Err(Error::input_file(
             path,
             format!(
-                "KTX2 level of {lv_len} bytes at {lv_off} does not fit a {}x{}x{} RGBA16F texture in a {file_len}-byte file",
+                "KTX2 level of {lv_len} bytes at {lv_off} does not fit a {}x{}x{} texture of {texel}-byte texels in a {file_len}-byte file",
                 size[0], size[1], size[2]
             ),
         ));
@@ -394,6 +410,11 @@ pub(crate) fn read_head_layout(
 
 /// The text under `key` from a KTX2 file's head (the texels are not read).
 pub(crate) fn read_entry(path: &std::path::Path, key: &str) -> Result<String> {
+    read_entry_as(path, key, VK_R16G16B16A16_SFLOAT)
+}
+
+/// [`read_entry`] from a texture of `vk_format`.
+fn read_entry_as(path: &std::path::Path, key: &str, vk_format: u32) -> Result<String> {
     let head = sunbeam_common::magic::read_ktx2_head(path)?
         .ok_or_else(|| Error::input_file(path, "not a KTX2 file (wrong identifier)"))?;
     let ctx = |e: Error| e.context(path.display().to_string());
@@ -401,10 +422,11 @@ pub(crate) fn read_entry(path: &std::path::Path, key: &str) -> Result<String> {
         return Err(ctx(Error::input("KTX2 file truncated in its header")));
     }
     let u32_at = |o: usize| u32::from_le_bytes(head[o..o + 4].try_into().unwrap());
-    if u32_at(12) != VK_R16G16B16A16_SFLOAT {
+    if u32_at(12) != vk_format {
         return Err(ctx(Error::input(format!(
-            "KTX2 vkFormat {} is not a response map (R16G16B16A16_SFLOAT, 97)",
-            u32_at(12)
+            "KTX2 vkFormat {} is not {} ({vk_format})",
+            u32_at(12),
+            format_name(vk_format)
         ))));
     }
     parse_entry(&head, u32_at(56) as usize, u32_at(60) as usize, key).map_err(ctx)

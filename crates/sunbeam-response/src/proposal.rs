@@ -40,6 +40,21 @@ pub struct Proposal {
 }
 
 impl Proposal {
+    /// No proposal (no levels): what a reader that draws no samples holds
+    /// (the first-frame estimator, crate::env_file::Needs).
+    pub fn none(grid: Grid) -> Proposal {
+        Proposal {
+            grid,
+            pw: 0,
+            ph: 0,
+            n_s: grid.n_s,
+            widths: Vec::new(),
+            heights: Vec::new(),
+            offsets: Vec::new(),
+            data: Vec::new(),
+        }
+    }
+
     /// Build from the luminance `y` of the proposal map at every texel (the
     /// response-map layout, `(k * n_rho + j) * n_theta + i`).
     pub fn new(grid: Grid, y: &[f32]) -> Proposal {

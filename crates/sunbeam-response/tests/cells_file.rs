@@ -68,6 +68,35 @@ fn the_file_holds_the_clustering_of_either_basis_at_each_count() {
             .get(&p.manifest, &er.grid, lambdas + 1, "sky", counts[0])
             .is_err());
     }
+    // From disk, reading one set: the same cells, the same refusals.
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cells-file-sets");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("x.env-cells.ktx2");
+    std::fs::write(&path, &bytes).unwrap();
+    let er = build_env(&p, &envs[0], &opts());
+    let lambdas = er.basis[0].info.lambda_samples;
+    for &c in &counts {
+        let read = cells_file::read_set(&path, &p.manifest, &er.grid, lambdas, "sky", c)
+            .unwrap()
+            .unwrap();
+        let whole = f.get(&p.manifest, &er.grid, lambdas, "sky", c).unwrap();
+        assert_eq!(
+            (read.n_top, read.nodes),
+            (whole.n_top, whole.nodes),
+            "{c:?}"
+        );
+        assert!(
+            read.data
+                .iter()
+                .map(|x| x.to_bits())
+                .eq(whole.data.iter().map(|x| x.to_bits())),
+            "{c:?}: one set read differs from the whole file's"
+        );
+    }
+    let why = cells_file::read_set(&path, &p.manifest, &er.grid, lambdas, "map", (8, 1))
+        .unwrap()
+        .unwrap_err();
+    assert!(why.contains("--response-cells 8"), "{why}");
     // Deterministic.
     assert_eq!(
         bytes,
@@ -121,4 +150,15 @@ fn damaged_files_are_input_errors() {
     let e = cells_file::read(&path).unwrap_err();
     assert_eq!(e.exit_code(), 2, "{e}");
     assert!(e.to_string().contains("cut.env-cells.ktx2"), "{e}");
+    let er = build_env(&p, &Environment::Map(EnvMap::constant([1.0; 3])), &opts());
+    let lambdas = er.basis[0].info.lambda_samples;
+    let cells = (16, DEFAULT_DEPTH);
+    let e = cells_file::read_set(&path, &p.manifest, &er.grid, lambdas, "map", cells).unwrap_err();
+    assert_eq!(e.exit_code(), 2, "{e}");
+    assert!(e.to_string().contains("cut.env-cells.ktx2"), "{e}");
+    // A link past the last node, read as one set.
+    std::fs::write(&path, cases.last().unwrap()).unwrap();
+    let e = cells_file::read_set(&path, &p.manifest, &er.grid, lambdas, "sky", cells).unwrap_err();
+    assert_eq!(e.exit_code(), 2, "{e}");
+    assert!(e.to_string().contains("links to node"), "{e}");
 }

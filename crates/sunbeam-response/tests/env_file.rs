@@ -49,6 +49,22 @@ fn read_maps_equal_the_in_memory_build_for_a_sky_and_a_map() {
         .unwrap()
         .unwrap();
     assert_same(&got, &want);
+    // Only what a reader needs: the first frame under the sky with its cells
+    // from the pipeline reads the sun's map alone, no proposal.
+    let needs = |basis, proposal| env_file::Needs { basis, proposal };
+    let sun_only = env_file::read_needed(&path, &p.manifest, &sky_env, &opts(), needs(false, true))
+        .unwrap()
+        .unwrap();
+    assert!(sun_only.basis.is_empty() && sun_only.proposal.levels() == 0);
+    assert_eq!(sun_only.sun, want.sun, "the sun's map alone");
+    assert_eq!(sun_only.grid, want.grid);
+    let no_proposal =
+        env_file::read_needed(&path, &p.manifest, &sky_env, &opts(), needs(true, false))
+            .unwrap()
+            .unwrap();
+    assert_eq!(no_proposal.basis, want.basis);
+    assert_eq!(no_proposal.sun, want.sun);
+    assert_eq!(no_proposal.proposal.levels(), 0);
 
     // A map: any map, the basis does not depend on it.
     let map_env = Environment::Map(EnvMap::constant([0.3, 0.5, 0.9]));

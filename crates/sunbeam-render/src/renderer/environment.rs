@@ -69,19 +69,34 @@ pub(super) fn maps(
     if let Some((_, m)) = built.iter().find(|(k, _)| *k == key) {
         return Ok(m.clone());
     }
-    let tq = std::time::Instant::now();
-    let er = response(env, pack, path, mi, opts, notes)?;
-    eprintln!("TIMING read {:?}", tq.elapsed());
+    // The first frame with the pipeline's cells: under the sky it needs no
+    // basis map (its sun has its own map, the sky no hot spots) and never the
+    // proposal, so only the sun's map is read (docs/bench/play.md "Start-up").
+    let cells_first = estimator == crate::env::EnvEstimator::Cells;
+    let from_file = match path.map(env_file::sidecar_path).filter(|p| p.is_file()) {
+        // a head that cannot be read is reported by `response` below
+        Some(side) if cells_first => match env_file::read_info(&side) {
+            Ok(head) => cells_from_file(env, pack, path, &head.grid, head.lambda_samples, cells)?
+                .ok()
+                .map(|c| (head.grid, c)),
+            Err(_) => None,
+        },
+        _ => None,
+    };
+    let needs = env_file::Needs {
+        basis: from_file.is_none() || !cells_first || matches!(env, Environment::Map(_)),
+        proposal: !cells_first,
+    };
+    let er = response(env, pack, path, mi, opts, needs, notes)?;
     // Monte Carlo draws from the maps' pyramid and never walks the cells.
-    let gc = match estimator {
-        crate::env::EnvEstimator::Cells => {
+    let gc = match (estimator, from_file) {
+        (crate::env::EnvEstimator::Cells, Some((grid, c))) if grid == er.grid => Some(c),
+        (crate::env::EnvEstimator::Cells, _) => {
             Some(first_frame_cells(&er, env, pack, path, mi, cells, notes)?)
         }
-        crate::env::EnvEstimator::MonteCarlo => None,
+        (crate::env::EnvEstimator::MonteCarlo, _) => None,
     };
-    eprintln!("TIMING cells {:?}", tq.elapsed());
     let m = Arc::new(crate::env::EnvMaps::new(gpu, &er, gc.as_ref())?);
-    eprintln!("TIMING upload {:?}", tq.elapsed());
     if estimator == crate::env::EnvEstimator::Cells && gpu.is_cpu() && m.nodes > CPU_CELL_NODES {
         // nodes grow about as the cells: the power of two that fits
         let fit = (cells.0 * CPU_CELL_NODES / m.nodes).max(1);
@@ -99,8 +114,9 @@ pub(super) fn maps(
 
 /// The extended-light maps of `pack` (meshes[`mi`], read from `path`) under
 /// `env`: read from the pack's `NAME.env-response.ktx2` (`sunbeam-pack
-/// --response`) when it serves this pack and environment, else built (what
-/// the build took, and why, goes to `notes`). A file that cannot be read is
+/// --response`) when it serves this pack and environment, only what `needs`
+/// asks for, else built, all of them (what the build took, and why, goes to
+/// `notes`). A file that cannot be read is
 /// an input error naming it. Also what `--export-environment` writes from.
 pub(crate) fn response(
     env: &Environment,
@@ -108,13 +124,14 @@ pub(crate) fn response(
     path: Option<&Path>,
     mi: usize,
     opts: &sunbeam_response::Options,
+    needs: env_file::Needs,
     notes: &mut Vec<String>,
 ) -> Result<sunbeam_response::env::EnvResponse> {
     let t0 = std::time::Instant::now();
     let side = path.map(env_file::sidecar_path).filter(|p| p.is_file());
     let mut stale = None;
     if let Some(side) = &side {
-        match env_file::read_for(side, &pack.manifest, env, opts)? {
+        match env_file::read_needed(side, &pack.manifest, env, opts, needs)? {
             Ok(er) => {
                 log::info!(
                     "read the environment's response maps of meshes[{mi}].pack from {} in {:.2?}",
@@ -166,6 +183,29 @@ pub(crate) fn response(
     Ok(er)
 }
 
+/// The first-frame cells of `env`'s basis for maps on `grid` with `lambdas`
+/// wavelength samples (the mesh's pack `pack`, read from `path`), `cells` =
+/// (top cut, levels below), from the pack's `NAME.env-cells.ktx2`
+/// (`sunbeam-pack --response`), or why not (None: no file). A file that
+/// cannot be read is an input error naming it.
+fn cells_from_file(
+    env: &Environment,
+    pack: &Pack,
+    path: Option<&Path>,
+    grid: &sunbeam_response::Grid,
+    lambdas: usize,
+    cells: (usize, usize),
+) -> Result<std::result::Result<GpuCells, Option<String>>> {
+    let Some(side) = path.map(cells_file::sidecar_path).filter(|p| p.is_file()) else {
+        return Ok(Err(None));
+    };
+    let basis = cells_file::basis_of(env);
+    Ok(
+        cells_file::read_set(&side, &pack.manifest, grid, lambdas, basis, cells)?
+            .map_err(|why| Some(format!("{} {why}", side.display()))),
+    )
+}
+
 /// The first-frame cells of `er` (`env`'s basis maps; meshes[`mi`]'s pack,
 /// read from `path`), `cells` = (top cut, levels below): read from the
 /// pack's `NAME.env-cells.ktx2` (`sunbeam-pack --response`) when it holds
@@ -181,26 +221,11 @@ pub(crate) fn first_frame_cells(
     cells: (usize, usize),
     notes: &mut Vec<String>,
 ) -> Result<GpuCells> {
-    let t0 = std::time::Instant::now();
-    let side = path.map(cells_file::sidecar_path).filter(|p| p.is_file());
     let lambdas = er.basis.first().map_or(0, |m| m.info.lambda_samples);
-    let basis = cells_file::basis_of(env);
-    let why = match &side {
-        Some(side) => {
-            let f = cells_file::read(side)?;
-            match f.get(&pack.manifest, &er.grid, lambdas, basis, cells) {
-                Ok(g) => {
-                    log::info!(
-                        "read the cells of meshes[{mi}].pack from {} in {:.2?}",
-                        side.display(),
-                        t0.elapsed()
-                    );
-                    return Ok(g);
-                }
-                Err(why) => Some(format!("{} {why}", side.display())),
-            }
-        }
-        None => path
+    let why = match cells_from_file(env, pack, path, &er.grid, lambdas, cells)? {
+        Ok(g) => return Ok(g),
+        Err(Some(why)) => Some(why),
+        Err(None) => path
             .filter(|p| env_file::sidecar_path(p).is_file())
             .map(|p| {
                 format!(
