@@ -90,8 +90,8 @@ pub struct Cells {
 }
 
 /// The cells as the shaders read them ([`Cells::gpu_data`]) with their
-/// counts: what the player uploads and the pipeline's cells file holds
-/// (crate::cells_file).
+/// counts: what the player uploads and the pipeline's cells file
+/// (`NAME.env-cells.ktx2`) holds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GpuCells {
     /// Cells of the top cut.

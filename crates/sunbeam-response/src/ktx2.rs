@@ -236,7 +236,7 @@ pub(crate) fn decode_texture<'a>(
 }
 
 /// The JSON under `key`, the size and the raw level of a one-level KTX2
-/// R32_UINT texture (the cells' data textures, crate::cells_file); every
+/// R32_UINT texture (the first-frame cells, `NAME.env-cells.ktx2`); every
 /// size is checked against the file length first.
 pub(crate) fn decode_r32u<'a>(
     bytes: &'a [u8],

@@ -41,7 +41,8 @@ pub struct Proposal {
 
 impl Proposal {
     /// No proposal (no levels): what a reader that draws no samples holds
-    /// (the first-frame estimator, crate::env_file::Needs).
+    /// (the first-frame estimator: the environment maps file read without
+    /// its proposal).
     pub fn none(grid: Grid) -> Proposal {
         Proposal {
             grid,

@@ -412,7 +412,7 @@ impl Renderer {
         } else {
             1
         });
-        // The pipelines compile on a second thread while the meshes' maps are
+        // The pipelines compile on another thread while the meshes' maps are
         // read and uploaded below: neither needs the other, and each is about
         // a second of an environment scene's start-up on lavapipe
         // (docs/bench/play.md "Start-up").
@@ -429,10 +429,12 @@ impl Renderer {
             let msaa = settings.msaa;
             let (globals, spectrum, stand_in) =
                 (globals.clone(), spectrum.clone(), dummy_2d.clone());
-            std::thread::Builder::new()
-                .name("sunbeam pipelines".into())
-                .spawn(
-                    move || -> Result<(wgpu::RenderPipeline, Option<cells_rate::CellsRate>)> {
+            // A rayon task (the workspace's one pool, tests/architecture.rs);
+            // a panic comes back as an error, not the pool's abort.
+            let (tx, rx) = std::sync::mpsc::channel();
+            rayon::spawn(move || {
+                let built = std::panic::catch_unwind(std::panic::AssertUnwindSafe(
+                    || -> Result<(wgpu::RenderPipeline, Option<cells_rate::CellsRate>)> {
                         let layouts: Vec<&wgpu::BindGroupLayout> = owned.iter().collect();
                         let pipeline =
                             render_pipeline(&device, &layouts, &[format], msaa, &technique)?;
@@ -444,8 +446,12 @@ impl Renderer {
                         };
                         Ok((pipeline, cells))
                     },
-                )
-                .map_err(|e| Error::internal(format!("cannot start the pipelines' thread: {e}")))?
+                ));
+                let _ = tx.send(built.unwrap_or_else(|_| {
+                    Err(Error::internal("creating the render pipelines panicked"))
+                }));
+            });
+            rx
         };
 
         let mut meshes = Vec::new();
@@ -620,8 +626,8 @@ impl Renderer {
         }
 
         let (pipeline, cells) = compiled
-            .join()
-            .map_err(|_| Error::internal("the pipelines' thread panicked"))??;
+            .recv()
+            .map_err(|_| Error::internal("the render pipelines were never built"))??;
         // `"background": "environment"`: the lighting's table and sun (or,
         // in the Lambert mode, which lights without them, the same built here).
         let background = match (&p.scene.background, &p.environment) {
