@@ -386,9 +386,9 @@ impl EnvScene {
                 &m.pyramid,
                 &m.cells,
                 [
-                    &m.views[0],
-                    &m.views[1],
-                    &m.views[2],
+                    m.views.as_ref().map_or(&self.dummy_map, |v| &v[0]),
+                    m.views.as_ref().map_or(&self.dummy_map, |v| &v[1]),
+                    m.views.as_ref().map_or(&self.dummy_map, |v| &v[2]),
                     m.sun.as_ref().unwrap_or(&self.dummy_map),
                 ],
             ),
@@ -456,7 +456,9 @@ pub(crate) struct EnvMaps {
     uniform: EnvProposalU,
     pyramid: wgpu::Buffer,
     cells: wgpu::Buffer,
-    views: [wgpu::TextureView; 3],
+    /// The basis maps' textures; None when the first frame read none
+    /// (bound as the scene's stand-in, which its shader paths never sample).
+    views: Option<[wgpu::TextureView; 3]>,
     sun: Option<wgpu::TextureView>,
     /// Nodes of the cells' tree: what one walk of them may visit.
     pub(crate) nodes: usize,
@@ -471,8 +473,8 @@ impl EnvMaps {
         let p = &r.proposal;
         let g = r.grid;
         // The first frame reads neither the proposal nor, under the sky with
-        // its cells from the pipeline, the basis maps (env_file::Needs):
-        // stand-ins then, which its shader paths never sample.
+        // its cells from the pipeline, the basis maps (env_file::Needs): the
+        // scene's stand-ins are bound instead (`bind`).
         if p.offsets.len() > MAX_LEVELS || !(r.basis.len() == 3 || r.basis.is_empty()) {
             return Err(Error::internal(format!(
                 "environment maps: {} basis maps, {} pyramid levels (the player takes 3 and up to {MAX_LEVELS})",
@@ -536,10 +538,9 @@ impl EnvMaps {
                 usage: wgpu::BufferUsages::STORAGE,
             });
         let view = |m: &sunbeam_response::Response| crate::response::response_texture(gpu, m);
-        let stand_in = || crate::response::texture_3d(gpu, [1, 1, 1], &[0; 4]);
         let views = match &r.basis[..] {
-            [a, b, c] => [view(a), view(b), view(c)],
-            _ => [stand_in(), stand_in(), stand_in()],
+            [a, b, c] => Some([view(a), view(b), view(c)]),
+            _ => None,
         };
         Ok(EnvMaps {
             uniform,
