@@ -39,8 +39,15 @@ fn env_prefiltered(d: vec3<f32>, omega: f32) -> vec3<f32> {
 // (sunbeam_response::cells::REFINE).
 const ENV_REFINE: f32 = 2.0;
 // Cells::gpu_data: floats per node before its masses (u, v, spread, first,
-// next, then the 9 masses' offsets), and "no node".
-const ENV_CELL_HEADER: u32 = 23u;
+// next, the 9 masses' offsets, then the width uu, uv, vv), and "no node".
+const ENV_CELL_HEADER: u32 = 26u;
+// Cells within this many of their widths of the horizon integrate G / cos
+// across them (cells::RIM_WIDTHS); outside the disc by less than this they
+// still count (cells::RIM_OUTSIDE); midpoints of env_rim_moments
+// (cells::RIM_POINTS).
+const ENV_RIM_WIDTHS: f32 = 5.0;
+const ENV_RIM_OUTSIDE: f32 = 0.05;
+const ENV_RIM_POINTS: u32 = 8u;
 // A cell inside the disc by less than this share straddles the horizon
 // (cells::STRADDLE).
 const ENV_CELL_STRADDLE: f32 = 0.999;
@@ -81,7 +88,12 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         if (spread > 0.0) {
             inside = env_gaussian_inside(dist, spread);
         }
-        if (inside <= 0.0 || dist <= -0.5) {
+        // near the horizon: the cell's width towards it (cells::Cells::estimate)
+        let dir = wxy / max(l, 1e-12);
+        let wq = vec3<f32>(env_cell_f32(o + 23u), env_cell_f32(o + 24u), env_cell_f32(o + 25u));
+        let sigma = sqrt(max(dir.x * dir.x * wq.x + 2.0 * dir.x * dir.y * wq.y + dir.y * dir.y * wq.z, 0.0));
+        let rim = l > 1e-9 && sigma > 0.0 && dist < ENV_RIM_WIDTHS * sigma && dist > -ENV_RIM_OUTSIDE;
+        if (!rim && (inside <= 0.0 || dist <= -0.5)) {
             continue;
         }
         var w2 = wxy;
@@ -94,13 +106,43 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         let sc = s * f32(ns - 1u);
         let k0 = min(u32(floor(sc)), ns - 2u);
         let f = sc - f32(k0);
+        let omega = max(SB_TAU * spread * spread / wi.z, 1e-9);
+        let c = env_prefiltered(wi.x * t + wi.y * b + wi.z * n, omega);
+        if (rim) {
+            // G / cos integrated across the cell (cells::rim_gain), G and
+            // the layer read where that integral puts its weight
+            let hm = env_rim_moments(dist / sigma);
+            if (!(hm.x > 0.0)) {
+                continue;
+            }
+            let x = min(sigma * hm.y / hm.x, 1.0);
+            let d = 1.0 - x;
+            let wz = max(sqrt(max(1.0 - d * d, 0.0)), 1e-6);
+            let wie = vec3<f32>(dir * d, wz);
+            let gr = env_cells_gain(wie, wr, view) * hm.x / sqrt(2.0 * sigma) * sqrt(2.0 / (2.0 - x));
+            if (!(gr > 0.0)) {
+                continue;
+            }
+            let sr = clamp((wz + wr.z) / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
+            let scr = sr * f32(ns - 1u);
+            let kr = min(u32(floor(scr)), ns - 2u);
+            let fr = scr - f32(kr);
+            let mr0 = o + ENV_CELL_HEADER + kr * 9u;
+            // a cell that straddles the horizon integrates each value about
+            // its own centroid (env_cell_rim_gain, as env_cell_inside shares it)
+            let straddles_rim = inside < ENV_CELL_STRADDLE && spread > 0.0;
+            // the three bases written out: llvmpipe counts every loop
+            // iteration of an invocation ("One walk per fragment")
+            xyz = xyz + env_cell_rim_basis(o, 0u, mr0, fr, c[0], gr, straddles_rim, dist, sigma, dir, wr, view);
+            xyz = xyz + env_cell_rim_basis(o, 1u, mr0, fr, c[1], gr, straddles_rim, dist, sigma, dir, wr, view);
+            xyz = xyz + env_cell_rim_basis(o, 2u, mr0, fr, c[2], gr, straddles_rim, dist, sigma, dir, wr, view);
+            continue;
+        }
         let gw = env_cells_gain(wi, wr, view) / wi.z;
         if (!(gw > 0.0)) {
             continue;
         }
         let straddles = inside < ENV_CELL_STRADDLE && spread > 0.0;
-        let omega = max(SB_TAU * spread * spread / wi.z, 1e-9);
-        let c = env_prefiltered(wi.x * t + wi.y * b + wi.z * n, omega);
         let m0 = o + ENV_CELL_HEADER + k0 * 9u;
         let m1 = m0 + 9u;
         var e = vec3<f32>(0.0);
@@ -120,6 +162,59 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         xyz = xyz + gw * e;
     }
     return xyz;
+}
+
+// h(a) = int_0^inf phi(y - a) y^(-1/2) dy and h1(a) (with y^(1/2)), phi the
+// standard normal density, by 8 midpoints in t = sqrt(y) (cells::rim_moments),
+// written out: Mesa's llvmpipe ends all the loops of an invocation after
+// 65,535 iterations in all, and the cells' walk needs them ("One walk per
+// fragment" in docs/LIGHTING.md).
+fn env_rim_term(t: f32, a: f32) -> vec2<f32> {
+    let y = t * t;
+    let w = exp(-0.5 * (y - a) * (y - a));
+    return vec2<f32>(w, w * y);
+}
+
+fn env_rim_moments(a: f32) -> vec2<f32> {
+    let dt = sqrt(max(a, 0.0) + 7.0) / f32(ENV_RIM_POINTS);
+    let h = env_rim_term(0.5 * dt, a) + env_rim_term(1.5 * dt, a) + env_rim_term(2.5 * dt, a)
+        + env_rim_term(3.5 * dt, a) + env_rim_term(4.5 * dt, a) + env_rim_term(5.5 * dt, a)
+        + env_rim_term(6.5 * dt, a) + env_rim_term(7.5 * dt, a);
+    return h * (2.0 * dt * 0.3989422804014327);
+}
+
+// Basis bb's XYZ of a cell at the horizon: its masses at layer mr0 (and the
+// next, mixed by fr) times the basis' coefficient cb and the rim's G / cos,
+// gr, or each mass's own (env_cell_rim_gain) when the cell straddles.
+fn env_cell_rim_basis(o: u32, bb: u32, mr0: u32, fr: f32, cb: f32, gr: f32, straddles: bool, dist: f32, sigma: f32, dir: vec2<f32>, wr: vec3<f32>, view: vec2<f32>) -> vec3<f32> {
+    let mr1 = mr0 + 9u;
+    let a0 = vec3<f32>(env_cell_f32(mr0 + 3u * bb), env_cell_f32(mr0 + 3u * bb + 1u), env_cell_f32(mr0 + 3u * bb + 2u));
+    let a1 = vec3<f32>(env_cell_f32(mr1 + 3u * bb), env_cell_f32(mr1 + 3u * bb + 1u), env_cell_f32(mr1 + 3u * bb + 2u));
+    var g3 = vec3<f32>(gr);
+    if (straddles) {
+        let q = o + 5u + 6u * bb;
+        g3 = vec3<f32>(
+            env_cell_rim_gain(dist, sigma, dir, vec2<f32>(env_cell_f32(q), env_cell_f32(q + 1u)), wr, view),
+            env_cell_rim_gain(dist, sigma, dir, vec2<f32>(env_cell_f32(q + 2u), env_cell_f32(q + 3u)), wr, view),
+            env_cell_rim_gain(dist, sigma, dir, vec2<f32>(env_cell_f32(q + 4u), env_cell_f32(q + 5u)), wr, view));
+    }
+    return cb * mix(a0, a1, fr) * g3;
+}
+
+// G / cos integrated across one mass of a cell at the horizon, about the
+// mass's own centroid (the cell's plus `off`) with the cell's width less the
+// offset, at least a quarter of it (cells::Cells::estimate's rim).
+fn env_cell_rim_gain(dist: f32, sigma: f32, dir: vec2<f32>, off: vec2<f32>, wr: vec3<f32>, view: vec2<f32>) -> f32 {
+    let po = dot(dir, off);
+    let sq = sqrt(max(sigma * sigma - po * po, sigma * sigma / 16.0));
+    let hm = env_rim_moments((dist + po) / sq);
+    if (!(hm.x > 0.0)) {
+        return 0.0;
+    }
+    let x = min(sq * hm.y / hm.x, 1.0);
+    let d = 1.0 - x;
+    let wie = vec3<f32>(dir * d, max(sqrt(max(1.0 - d * d, 0.0)), 1e-6));
+    return env_cells_gain(wie, wr, view) * hm.x / sqrt(2.0 * sq) * sqrt(2.0 / (2.0 - x));
 }
 
 // The share of one mass inside the disc for view wr: a Gaussian about the

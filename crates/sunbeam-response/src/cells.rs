@@ -58,7 +58,17 @@ pub const DEFAULT_DEPTH: usize = 4;
 /// (`--env-cells`), and what `sunbeam-pack --response` clusters by default.
 pub const FIRST_FRAME_TOP: usize = 512;
 /// Floats per node in [`Cells::gpu_data`] before its layers' masses.
-pub const GPU_HEADER: usize = 5 + 18;
+pub const GPU_HEADER: usize = 5 + 18 + 3;
+/// Leaves whose centroid lies within this many of their widths of the view's
+/// horizon take [`rim_gain`]'s integral of `G / cos` across them.
+pub const RIM_WIDTHS: f64 = 5.0;
+/// Leaves whose centroid lies outside the disc by less than this still count
+/// (through [`rim_gain`]): the maps' interpolation spreads their texels
+/// across the horizon, where `1 / cos` is largest.
+pub const RIM_OUTSIDE: f64 = 0.05;
+/// Midpoints of [`rim_moments`] (16 change no view's Y by 0.1 %; the shader
+/// writes them out).
+const RIM_POINTS: usize = 8;
 /// "No node" in [`Cells::gpu_data`]'s links.
 pub const GPU_NONE: u32 = u32::MAX;
 
@@ -77,6 +87,12 @@ pub struct Cell {
     /// Per value of `mass`: its own centroid less `uv`, over all layers
     /// (`int E (uv - centroid) / int E`), at most `2 spread` long.
     pub offsets: [[f64; 2]; 9],
+    /// The cell's extent for the horizon ([`rim_gain`]): the mass-weighted
+    /// covariance of its texels' centres in `(u, v)` (uu, uv, vv) plus, on
+    /// the diagonal, the maps' texel extents at the centroid, `(dr^2 +
+    /// (r dtheta)^2) / 12`, over which their interpolation spreads a texel
+    /// (a cell of one texel has that width).
+    pub width: [f64; 3],
 }
 
 /// The cells of one pack's maps.
@@ -191,6 +207,24 @@ impl Cells {
             }
             (c, m, (var / m).max(0.0))
         };
+        let texel_var = |c: [f64; 2]| {
+            let r = c[0].hypot(c[1]);
+            let dr = (r * r + g.r0 * g.r0).sqrt() * g.rho_scale() / (nr - 1) as f64;
+            let da = r * std::f64::consts::TAU / nt as f64;
+            (dr * dr + da * da) / 12.0
+        };
+        let width_of = |members: &[u32], c: [f64; 2], m: f64| -> [f64; 3] {
+            let mut w = [0.0; 3];
+            for &t in members {
+                let x = &texels[t as usize];
+                let (du, dv) = (x.uv[0] - c[0], x.uv[1] - c[1]);
+                w[0] += x.m * du * du;
+                w[1] += x.m * du * dv;
+                w[2] += x.m * dv * dv;
+            }
+            let t = texel_var(c);
+            [w[0] / m + t, w[1] / m, w[2] / m + t]
+        };
         let all: Vec<u32> = (0..texels.len() as u32).collect();
         let split = |members: &[u32]| -> Option<(Vec<u32>, Vec<u32>)> {
             if members.len() < 2 {
@@ -255,6 +289,7 @@ impl Cells {
                 children: None,
                 mass: Vec::new(),
                 offsets: [[0.0; 2]; 9],
+                width: [0.0; 3],
             });
             queue.push((out.len() - 1, m, 0));
         }
@@ -265,9 +300,10 @@ impl Cells {
         while q < queue.len() {
             let (id, members, d) = std::mem::take(&mut queue[q]);
             q += 1;
-            let (c, _, var) = stats(&members);
+            let (c, m, var) = stats(&members);
             out[id].uv = c;
             out[id].spread = var.sqrt();
+            out[id].width = width_of(&members, c, m);
             let halves = if d < depth && var > 0.0 {
                 split(&members)
             } else {
@@ -392,7 +428,8 @@ impl Cells {
 
     /// The nodes for the shader (shaders/environment.wgsl `env_cells`): per
     /// node `[u, v, spread, first child, next]` (links as u32 bits,
-    /// [`GPU_NONE`] for none), the 9 `offsets` (u, v each), then `n_s`
+    /// [`GPU_NONE`] for none), the 9 `offsets` (u, v each), `width` (uu, uv,
+    /// vv), then `n_s`
     /// layers of 9 masses (XYZ of `E_0, E_1, E_2`); the second child follows
     /// the first.
     ///
@@ -428,6 +465,7 @@ impl Cells {
                 f32::from_bits(nx),
             ]);
             out.extend(c.offsets.iter().flat_map(|o| o.map(|x| x as f32)));
+            out.extend(c.width.map(|x| x as f32));
             for layer in &c.mass {
                 out.extend(layer.iter().map(|&m| m as f32));
             }
@@ -468,11 +506,19 @@ impl Cells {
             } else {
                 f64::from(dist > 0.0)
             };
-            if inside <= 0.0 || dist <= -0.5 {
+            // near the horizon: the cell's width towards it
+            let l = 1.0 - dist;
+            let dir = [wxy[0] / l.max(1e-12), wxy[1] / l.max(1e-12)];
+            let sigma = (dir[0] * dir[0] * c.width[0]
+                + 2.0 * dir[0] * dir[1] * c.width[1]
+                + dir[1] * dir[1] * c.width[2])
+                .max(0.0)
+                .sqrt();
+            let rim = l > 1e-9 && sigma > 0.0 && dist < RIM_WIDTHS * sigma && dist > -RIM_OUTSIDE;
+            if !rim && (inside <= 0.0 || dist <= -0.5) {
                 continue;
             }
             // the centroid, pulled inside the disc when it is not
-            let l = 1.0 - dist;
             let k = if l > 0.999 { 0.999 / l } else { 1.0 };
             let (wx, wy) = (wxy[0] * k, wxy[1] * k);
             let wi = [wx, wy, (1.0 - wx * wx - wy * wy).max(0.0).sqrt()];
@@ -484,6 +530,36 @@ impl Cells {
             let g = masking.gain(wi, wr, skin) / wi[2];
             let omega = (std::f64::consts::TAU * c.spread * c.spread / wi[2]).max(1e-9);
             let ck = coeffs(world(wi), omega);
+            if rim {
+                // G / cos integrated across the cell ([`rim_gain`]), G and the
+                // layer read where that integral puts its weight
+                // layer read where that integral puts its weight; a cell that
+                // straddles it integrates each value about its own centroid
+                // (as [`channel_inside`] shares it)
+                if let Some((gw, wz)) = rim_gain(dist, sigma, dir, wr, masking, skin) {
+                    let s = ((wz + wr[2]) / (4.0 - r * r).max(1e-12).sqrt()).clamp(0.0, 1.0);
+                    let sc = s * (self.grid.n_s - 1) as f64;
+                    let k0 = (sc.floor() as usize).min(self.grid.n_s - 2);
+                    let f = sc - k0 as f64;
+                    let straddles = inside < STRADDLE && c.spread > 0.0;
+                    for (bb, cb) in ck.iter().enumerate() {
+                        for (a, x) in xyz.iter_mut().enumerate() {
+                            let q = 3 * bb + a;
+                            let m = c.mass[k0][q] * (1.0 - f) + c.mass[k0 + 1][q] * f;
+                            let g = if straddles {
+                                let off = c.offsets[q];
+                                let po = dir[0] * off[0] + dir[1] * off[1];
+                                let sq = (sigma * sigma - po * po).max(sigma * sigma / 16.0).sqrt();
+                                rim_gain(dist + po, sq, dir, wr, masking, skin).map_or(0.0, |v| v.0)
+                            } else {
+                                gw
+                            };
+                            *x += g * cb * m;
+                        }
+                    }
+                }
+                continue;
+            }
             let straddles = inside < STRADDLE && c.spread > 0.0;
             for (bb, cb) in ck.iter().enumerate() {
                 for (a, x) in xyz.iter_mut().enumerate() {
@@ -500,6 +576,59 @@ impl Cells {
         }
         xyz
     }
+}
+
+/// `h(a) = int_0^inf phi(y - a) y^(-1/2) dy` and `h1(a)`, the same with
+/// `y^(1/2)` (`phi` the standard normal density; `h` is a parabolic cylinder
+/// function), by [`RIM_POINTS`] midpoints in `t = sqrt(y)`, in which the
+/// integrand is smooth (`dy y^(-1/2) = 2 dt`). Hand-written: two moments of
+/// a cut Gaussian against a square root, which no maintained crate offers,
+/// and the shader (shaders/env_cells.wgsl `env_rim_moments`) computes the
+/// same sum.
+fn rim_moments(a: f64) -> (f64, f64) {
+    let t_max = (a.max(0.0) + 7.0).sqrt();
+    let dt = t_max / RIM_POINTS as f64;
+    let (mut h, mut h1) = (0.0, 0.0);
+    for k in 0..RIM_POINTS {
+        let t = (k as f64 + 0.5) * dt;
+        let y = t * t;
+        let w = 2.0 * dt * (-0.5 * (y - a) * (y - a)).exp() / std::f64::consts::TAU.sqrt();
+        h += w;
+        h1 += w * y;
+    }
+    (h, h1)
+}
+
+/// `G / cos(theta_i)` integrated across a cell near the view's horizon,
+/// times its share inside: the cell's mass along `dir` (the unit direction of
+/// its centroid's `wi_xy`) as a Gaussian of rms `sigma` in `x = 1 - |wi_xy|`
+/// about `dist`, cut at `x = 0`. Near the horizon `1 / cos = 1 / sqrt(x (2 -
+/// x))`; with `1 / sqrt(2 x)` the integral is `h(dist / sigma) / sqrt(2
+/// sigma)` ([`rim_moments`]), and `G`, the rest of `1 / cos` and the caller's
+/// layer are read once at the weighted mean `x = sigma h1 / h`. A midpoint
+/// rule at the centroid misses the integrable peak (-4 % to +2 % of a view's
+/// Y on the 5 um pack; docs/LIGHTING.md "Accuracy per view"). Returns the
+/// factor and `cos(theta_i)` at that mean, or none when nothing is inside.
+fn rim_gain(
+    dist: f64,
+    sigma: f64,
+    dir: [f64; 2],
+    wr: [f64; 3],
+    masking: Masking,
+    skin: gain::Material,
+) -> Option<(f64, f64)> {
+    let (h, h1) = rim_moments(dist / sigma);
+    // h is a sum of non-negative terms: zero (or NaN from a NaN distance)
+    // means nothing of the cell is inside
+    if h.is_nan() || h <= 0.0 {
+        return None;
+    }
+    let x = (sigma * h1 / h).min(1.0);
+    let d = 1.0 - x;
+    let wz = (1.0 - d * d).max(0.0).sqrt().max(1e-6);
+    let wi = [dir[0] * d, dir[1] * d, wz];
+    let factor = h / (2.0 * sigma).sqrt() * (2.0 / (2.0 - x)).sqrt();
+    Some((masking.gain(wi, wr, skin) * factor, wz))
 }
 
 /// A cell whose share inside the disc is below this straddles the horizon:
@@ -536,6 +665,7 @@ mod tests {
             children,
             mass: vec![[0.0; 9]; 2],
             offsets: [[0.0; 2]; 9],
+            width: [0.0; 3],
         }
     }
 

@@ -29,8 +29,10 @@ use sunbeam_pack::Manifest;
 
 /// `CellsInfo::format`.
 pub const FORMAT: &str = "sunbeam-env-cells";
-/// Format version.
-pub const VERSION: u32 = 1;
+/// Format version: 2 added each node's `width` ([`GPU_HEADER`] 26). A file
+/// of an earlier version does not serve (the player clusters instead and
+/// says so), it is not damaged.
+pub const VERSION: u32 = 2;
 /// Key of the info JSON in the KTX2 key/value data.
 pub const INFO_KEY: &str = "sunbeam.env-cells";
 /// Width of the texture (texels; WebGL2 guarantees 2048).
@@ -332,6 +334,12 @@ pub fn read_set(
         return Err(ctx(Error::input(format!(
             "{INFO_KEY}: the texture is {w} x {h}, not {WIDTH} wide"
         ))));
+    }
+    if info.format == FORMAT && info.version < VERSION {
+        return Ok(Err(format!(
+            "holds cells of an earlier layout (version {}, this reader's {VERSION}: rewrite it with sunbeam-pack --response)",
+            info.version
+        )));
     }
     info.check(w * h.max(1)).map_err(ctx)?;
     let s = match info.select(manifest, grid, lambda_samples, basis, cells) {
