@@ -232,9 +232,10 @@ fn sky_lit_sphere(masking: &str) {
 }
 
 /// Bound of the cells' first frame in [`sky_lit_sphere_settles_to_the_reference`]
-/// (docs/LIGHTING.md "The first frame"): measured p99 1.66 (mean 0.56, max
-/// 4.6; lavapipe, 2026-11-28) against the Monte Carlo's 6.15 at 256 frames,
-/// plus 25 %; 3.04 before the frame sat at the pixel centre and its partly
+/// (docs/LIGHTING.md "The first frame"): measured p99 1.51 (mean 0.38, max
+/// 4.5; lavapipe, 2026-11-29) against the Monte Carlo's 6.15 at 256 frames;
+/// the bound is 1.66 (before the rim's integral, "Accuracy per view") plus
+/// 25 %; 3.04 before the frame sat at the pixel centre and its partly
 /// covered pixels shaded their covered samples.
 const CELLS_P99: f64 = 2.1;
 
@@ -700,7 +701,9 @@ fn grazing_pixels_walk_every_cell() {
 
 /// Bound of [`grazing_pixels_walk_every_cell`]: measured p99 1.17 (mean
 /// 0.38, max 1.42 over 672 lit pixels; lavapipe, 2026-11-29), plus 25 %;
-/// with a walk per covered sample p99 20.2 (mean 0.71, max 28.6).
+/// 1.24 (mean 0.50, max 1.37) with the rim's integral, whose loops written
+/// out keep the walk under llvmpipe's limit (with them: p99 14.5); with a
+/// walk per covered sample p99 20.2 (mean 0.71, max 28.6).
 const LIMB_CELLS_P99: f64 = 1.46;
 
 /// One headless cells frame of `scene` at `--env-cells-rate rate` with
