@@ -111,15 +111,9 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         if (rim) {
             // G / cos integrated across the cell (cells::rim_gain), G and
             // the layer read where that integral puts its weight
-            let hm = env_rim_moments(dist / sigma);
-            if (!(hm.x > 0.0)) {
-                continue;
-            }
-            let x = min(sigma * hm.y / hm.x, 1.0);
-            let d = 1.0 - x;
-            let wz = max(sqrt(max(1.0 - d * d, 0.0)), 1e-6);
-            let wie = vec3<f32>(dir * d, wz);
-            let gr = env_cells_gain(wie, wr, view) * hm.x / sqrt(2.0 * sigma) * sqrt(2.0 / (2.0 - x));
+            let rg = env_rim_gain(dist, sigma, dir, wr, view);
+            let gr = rg.x;
+            let wz = rg.y;
             if (!(gr > 0.0)) {
                 continue;
             }
@@ -201,20 +195,28 @@ fn env_cell_rim_basis(o: u32, bb: u32, mr0: u32, fr: f32, cb: f32, gr: f32, stra
     return cb * mix(a0, a1, fr) * g3;
 }
 
-// G / cos integrated across one mass of a cell at the horizon, about the
-// mass's own centroid (the cell's plus `off`) with the cell's width less the
-// offset, at least a quarter of it (cells::Cells::estimate's rim).
+// G / cos integrated across a cell at the horizon, times its share inside,
+// and cos(theta_i) where that integral puts its weight (cells::rim_gain): a
+// Gaussian of rms sigma in x = 1 - |wi_xy| about dist, cut at x = 0.
+fn env_rim_gain(dist: f32, sigma: f32, dir: vec2<f32>, wr: vec3<f32>, view: vec2<f32>) -> vec2<f32> {
+    let hm = env_rim_moments(dist / sigma);
+    if (!(hm.x > 0.0)) {
+        return vec2<f32>(0.0);
+    }
+    let x = min(sigma * hm.y / hm.x, 1.0);
+    let d = 1.0 - x;
+    let wz = max(sqrt(max(1.0 - d * d, 0.0)), 1e-6);
+    let g = env_cells_gain(vec3<f32>(dir * d, wz), wr, view) * hm.x / sqrt(2.0 * sigma) * sqrt(2.0 / (2.0 - x));
+    return vec2<f32>(g, wz);
+}
+
+// env_rim_gain for one mass of a straddling cell, about the mass's own
+// centroid (the cell's plus `off`) with the cell's width less the offset, at
+// least a quarter of it.
 fn env_cell_rim_gain(dist: f32, sigma: f32, dir: vec2<f32>, off: vec2<f32>, wr: vec3<f32>, view: vec2<f32>) -> f32 {
     let po = dot(dir, off);
     let sq = sqrt(max(sigma * sigma - po * po, sigma * sigma / 16.0));
-    let hm = env_rim_moments((dist + po) / sq);
-    if (!(hm.x > 0.0)) {
-        return 0.0;
-    }
-    let x = min(sq * hm.y / hm.x, 1.0);
-    let d = 1.0 - x;
-    let wie = vec3<f32>(dir * d, max(sqrt(max(1.0 - d * d, 0.0)), 1e-6));
-    return env_cells_gain(wie, wr, view) * hm.x / sqrt(2.0 * sq) * sqrt(2.0 / (2.0 - x));
+    return env_rim_gain(dist + po, sq, dir, wr, view).x;
 }
 
 // The share of one mass inside the disc for view wr: a Gaussian about the
