@@ -95,6 +95,14 @@ pub struct Cell {
     pub width: [f64; 3],
 }
 
+impl Cell {
+    /// Value `q` of the mass between layers `k0` and `k0 + 1`, `f` the
+    /// weight of the latter.
+    fn mass_at(&self, k0: usize, f: f64, q: usize) -> f64 {
+        self.mass[k0][q] * (1.0 - f) + self.mass[k0 + 1][q] * f
+    }
+}
+
 /// The cells of one pack's maps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cells {
@@ -523,29 +531,26 @@ impl Cells {
             let (wx, wy) = (wxy[0] * k, wxy[1] * k);
             let wi = [wx, wy, (1.0 - wx * wx - wy * wy).max(0.0).sqrt()];
             let r = c.uv[0].hypot(c.uv[1]);
-            let s = ((wi[2] + wr[2]) / (4.0 - r * r).max(1e-12).sqrt()).clamp(0.0, 1.0);
-            let sc = s * (self.grid.n_s - 1) as f64;
-            let k0 = (sc.floor() as usize).min(self.grid.n_s - 2);
-            let f = sc - k0 as f64;
-            let g = masking.gain(wi, wr, skin) / wi[2];
+            // the layer (k0 and the weight of k0 + 1) at cos(theta_i) = wz
+            let layer = |wz: f64| {
+                let s = ((wz + wr[2]) / (4.0 - r * r).max(1e-12).sqrt()).clamp(0.0, 1.0);
+                let sc = s * (self.grid.n_s - 1) as f64;
+                let k0 = (sc.floor() as usize).min(self.grid.n_s - 2);
+                (k0, sc - k0 as f64)
+            };
             let omega = (std::f64::consts::TAU * c.spread * c.spread / wi[2]).max(1e-9);
             let ck = coeffs(world(wi), omega);
+            let straddles = inside < STRADDLE && c.spread > 0.0;
             if rim {
                 // G / cos integrated across the cell ([`rim_gain`]), G and the
-                // layer read where that integral puts its weight
                 // layer read where that integral puts its weight; a cell that
                 // straddles it integrates each value about its own centroid
                 // (as [`channel_inside`] shares it)
                 if let Some((gw, wz)) = rim_gain(dist, sigma, dir, wr, masking, skin) {
-                    let s = ((wz + wr[2]) / (4.0 - r * r).max(1e-12).sqrt()).clamp(0.0, 1.0);
-                    let sc = s * (self.grid.n_s - 1) as f64;
-                    let k0 = (sc.floor() as usize).min(self.grid.n_s - 2);
-                    let f = sc - k0 as f64;
-                    let straddles = inside < STRADDLE && c.spread > 0.0;
+                    let (k0, f) = layer(wz);
                     for (bb, cb) in ck.iter().enumerate() {
                         for (a, x) in xyz.iter_mut().enumerate() {
                             let q = 3 * bb + a;
-                            let m = c.mass[k0][q] * (1.0 - f) + c.mass[k0 + 1][q] * f;
                             let g = if straddles {
                                 let off = c.offsets[q];
                                 let po = dir[0] * off[0] + dir[1] * off[1];
@@ -554,23 +559,23 @@ impl Cells {
                             } else {
                                 gw
                             };
-                            *x += g * cb * m;
+                            *x += g * cb * c.mass_at(k0, f, q);
                         }
                     }
                 }
                 continue;
             }
-            let straddles = inside < STRADDLE && c.spread > 0.0;
+            let (k0, f) = layer(wi[2]);
+            let g = masking.gain(wi, wr, skin) / wi[2];
             for (bb, cb) in ck.iter().enumerate() {
                 for (a, x) in xyz.iter_mut().enumerate() {
                     let q = 3 * bb + a;
-                    let m = c.mass[k0][q] * (1.0 - f) + c.mass[k0 + 1][q] * f;
                     let share = if straddles {
                         channel_inside(c, q, wr)
                     } else {
                         inside
                     };
-                    *x += g * share * cb * m;
+                    *x += g * share * cb * c.mass_at(k0, f, q);
                 }
             }
         }
