@@ -102,10 +102,6 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         }
         let wi = vec3<f32>(w2, sqrt(max(1.0 - dot(w2, w2), 0.0)));
         let r = length(uv);
-        let s = clamp((wi.z + wr.z) / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
-        let sc = s * f32(ns - 1u);
-        let k0 = min(u32(floor(sc)), ns - 2u);
-        let f = sc - f32(k0);
         let omega = max(SB_TAU * spread * spread / wi.z, 1e-9);
         let c = env_prefiltered(wi.x * t + wi.y * b + wi.z * n, omega);
         if (rim) {
@@ -117,19 +113,16 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
             if (!(gr > 0.0)) {
                 continue;
             }
-            let sr = clamp((wz + wr.z) / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
-            let scr = sr * f32(ns - 1u);
-            let kr = min(u32(floor(scr)), ns - 2u);
-            let fr = scr - f32(kr);
-            let mr0 = o + ENV_CELL_HEADER + kr * 9u;
+            let lr = env_cell_layer(wz, wr.z, r, ns);
+            let mr0 = o + ENV_CELL_HEADER + lr.k0 * 9u;
             // a cell that straddles the horizon integrates each value about
             // its own centroid (env_cell_rim_gain, as env_cell_inside shares it)
             let straddles_rim = inside < ENV_CELL_STRADDLE && spread > 0.0;
             // the three bases written out: llvmpipe counts every loop
             // iteration of an invocation ("One walk per fragment")
-            xyz = xyz + env_cell_rim_basis(o, 0u, mr0, fr, c[0], gr, straddles_rim, dist, sigma, dir, wr, view);
-            xyz = xyz + env_cell_rim_basis(o, 1u, mr0, fr, c[1], gr, straddles_rim, dist, sigma, dir, wr, view);
-            xyz = xyz + env_cell_rim_basis(o, 2u, mr0, fr, c[2], gr, straddles_rim, dist, sigma, dir, wr, view);
+            xyz = xyz + env_cell_rim_basis(o, 0u, mr0, lr.f, c[0], gr, straddles_rim, dist, sigma, dir, wr, view);
+            xyz = xyz + env_cell_rim_basis(o, 1u, mr0, lr.f, c[1], gr, straddles_rim, dist, sigma, dir, wr, view);
+            xyz = xyz + env_cell_rim_basis(o, 2u, mr0, lr.f, c[2], gr, straddles_rim, dist, sigma, dir, wr, view);
             continue;
         }
         let gw = env_cells_gain(wi, wr, view) / wi.z;
@@ -137,12 +130,10 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
             continue;
         }
         let straddles = inside < ENV_CELL_STRADDLE && spread > 0.0;
-        let m0 = o + ENV_CELL_HEADER + k0 * 9u;
-        let m1 = m0 + 9u;
+        let ly = env_cell_layer(wi.z, wr.z, r, ns);
+        let m0 = o + ENV_CELL_HEADER + ly.k0 * 9u;
         var e = vec3<f32>(0.0);
         for (var bb = 0u; bb < 3u; bb = bb + 1u) {
-            let a0 = vec3<f32>(env_cell_f32(m0 + 3u * bb), env_cell_f32(m0 + 3u * bb + 1u), env_cell_f32(m0 + 3u * bb + 2u));
-            let a1 = vec3<f32>(env_cell_f32(m1 + 3u * bb), env_cell_f32(m1 + 3u * bb + 1u), env_cell_f32(m1 + 3u * bb + 2u));
             var share = vec3<f32>(inside);
             if (straddles) {
                 let q = o + 5u + 6u * bb;
@@ -151,7 +142,7 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
                     env_cell_inside(uv, spread, vec2<f32>(env_cell_f32(q + 2u), env_cell_f32(q + 3u)), wr),
                     env_cell_inside(uv, spread, vec2<f32>(env_cell_f32(q + 4u), env_cell_f32(q + 5u)), wr));
             }
-            e = e + c[bb] * mix(a0, a1, f) * share;
+            e = e + c[bb] * env_cell_mass(m0, bb, ly.f) * share;
         }
         xyz = xyz + gw * e;
     }
@@ -181,9 +172,6 @@ fn env_rim_moments(a: f32) -> vec2<f32> {
 // next, mixed by fr) times the basis' coefficient cb and the rim's G / cos,
 // gr, or each mass's own (env_cell_rim_gain) when the cell straddles.
 fn env_cell_rim_basis(o: u32, bb: u32, mr0: u32, fr: f32, cb: f32, gr: f32, straddles: bool, dist: f32, sigma: f32, dir: vec2<f32>, wr: vec3<f32>, view: vec2<f32>) -> vec3<f32> {
-    let mr1 = mr0 + 9u;
-    let a0 = vec3<f32>(env_cell_f32(mr0 + 3u * bb), env_cell_f32(mr0 + 3u * bb + 1u), env_cell_f32(mr0 + 3u * bb + 2u));
-    let a1 = vec3<f32>(env_cell_f32(mr1 + 3u * bb), env_cell_f32(mr1 + 3u * bb + 1u), env_cell_f32(mr1 + 3u * bb + 2u));
     var g3 = vec3<f32>(gr);
     if (straddles) {
         let q = o + 5u + 6u * bb;
@@ -192,7 +180,30 @@ fn env_cell_rim_basis(o: u32, bb: u32, mr0: u32, fr: f32, cb: f32, gr: f32, stra
             env_cell_rim_gain(dist, sigma, dir, vec2<f32>(env_cell_f32(q + 2u), env_cell_f32(q + 3u)), wr, view),
             env_cell_rim_gain(dist, sigma, dir, vec2<f32>(env_cell_f32(q + 4u), env_cell_f32(q + 5u)), wr, view));
     }
-    return cb * mix(a0, a1, fr) * g3;
+    return cb * env_cell_mass(mr0, bb, fr) * g3;
+}
+
+// The layer of the cells' masses at cos(theta_i) = wz (Cells::estimate's
+// `layer`): k0 and the weight f of k0 + 1, for a cell at radius r in (u, v).
+struct EnvCellLayer {
+    k0: u32,
+    f: f32,
+}
+
+fn env_cell_layer(wz: f32, wrz: f32, r: f32, ns: u32) -> EnvCellLayer {
+    let s = clamp((wz + wrz) / sqrt(max(4.0 - r * r, 1e-12)), 0.0, 1.0);
+    let sc = s * f32(ns - 1u);
+    let k0 = min(u32(floor(sc)), ns - 2u);
+    return EnvCellLayer(k0, sc - f32(k0));
+}
+
+// Basis bb's XYZ mass between the layer at m0 and the next, f the weight of
+// the latter (Cell::mass_at).
+fn env_cell_mass(m0: u32, bb: u32, f: f32) -> vec3<f32> {
+    let m1 = m0 + 9u;
+    let a0 = vec3<f32>(env_cell_f32(m0 + 3u * bb), env_cell_f32(m0 + 3u * bb + 1u), env_cell_f32(m0 + 3u * bb + 2u));
+    let a1 = vec3<f32>(env_cell_f32(m1 + 3u * bb), env_cell_f32(m1 + 3u * bb + 1u), env_cell_f32(m1 + 3u * bb + 2u));
+    return mix(a0, a1, f);
 }
 
 // G / cos integrated across a cell at the horizon, times its share inside,
