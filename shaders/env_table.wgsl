@@ -25,3 +25,21 @@ fn sb_env_equirect(d: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(phi / tau, acos(clamp(d.y, -1.0, 1.0)) / 3.141592653589793);
 }
 
+
+// A direction of the sun's disc about its centre c (unit; t and b unit,
+// perpendicular to c and to each other): u uniform in [0, 1) over the cap's
+// solid angle (cos_cap: the cosine of its half-angle), ph the angle around
+// the centre. The player's sun (environment.wgsl env_sun_point) and the
+// engines' (export_env.wgsl sunbeam_shade_sun) take their points here.
+fn sb_sun_disc_dir(c: vec3<f32>, t: vec3<f32>, b: vec3<f32>, cos_cap: f32, u: f32, ph: f32) -> vec3<f32> {
+    let ct = 1.0 - u * (1.0 - cos_cap);
+    let st = sqrt(max(1.0 - ct * ct, 0.0));
+    return st * (cos(ph) * t + sin(ph) * b) + ct * c;
+}
+
+// Points of the sun's disc in a first frame (a Vogel spiral: point i at
+// u = (i + 1/2) / SB_SUN_POINTS, turned by i golden angles), and the golden
+// angle: on a pack of real size a point's diffraction orders are as narrow
+// as the disc (docs/LIGHTING.md "The sun's disc in the first frame").
+const SB_SUN_POINTS: f32 = 16.0;
+const SB_GOLDEN: f32 = 2.3999631;

@@ -800,9 +800,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
 // solid angle, `ph` the angle around its centre: G times the sun's map (which
 // holds Omega_sun E_sun, EnvResponse::sun).
 fn env_sun_point(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: SbGrid, u: f32, ph: f32) -> vec3<f32> {
-    let ct = 1.0 - u * (1.0 - envg.sun_dir.w);
-    let st = sqrt(max(1.0 - ct * ct, 0.0));
-    let d = st * (cos(ph) * envg.sun_t.xyz + sin(ph) * envg.sun_b.xyz) + ct * envg.sun_dir.xyz;
+    let d = sb_sun_disc_dir(envg.sun_dir.xyz, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w, u, ph);
     let wi = vec3<f32>(dot(d, t), dot(d, b), dot(d, n));
     if (wi.z <= 0.0) {
         return vec3<f32>(0.0);
@@ -811,7 +809,7 @@ fn env_sun_point(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: Sb
     return gain(wi, wr) * env_map(env_esun, rc, gr);
 }
 
-// The first-frame estimator's sun: the mean over ENV_SUN_POINTS points of
+// The first-frame estimator's sun: the mean over SB_SUN_POINTS points of
 // its disc (a Vogel spiral, equal solid angles; turned per frame), not one
 // point per frame: on a pack of real size the orders of a point are as
 // narrow as the disc (82 um: a lobe of about 0.4 degrees, the disc 0.53),
@@ -819,25 +817,23 @@ fn env_sun_point(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: Sb
 // (docs/LIGHTING.md "The sun's disc in the first frame"). Written out:
 // llvmpipe counts loop iterations against one limit per invocation, which
 // the cells' walk needs.
-const ENV_SUN_POINTS: f32 = 16.0;
-const ENV_GOLDEN: f32 = 2.3999631;
 fn env_sun_disc(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: SbGrid) -> vec3<f32> {
     let r = SB_TAU * env_qmc(envg.frame + 1u, 19u);
-    var s = env_sun_point(t, b, n, wr, gr, 0.5 / ENV_SUN_POINTS, r);
-    s = s + env_sun_point(t, b, n, wr, gr, 1.5 / ENV_SUN_POINTS, r + 1.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 2.5 / ENV_SUN_POINTS, r + 2.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 3.5 / ENV_SUN_POINTS, r + 3.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 4.5 / ENV_SUN_POINTS, r + 4.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 5.5 / ENV_SUN_POINTS, r + 5.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 6.5 / ENV_SUN_POINTS, r + 6.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 7.5 / ENV_SUN_POINTS, r + 7.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 8.5 / ENV_SUN_POINTS, r + 8.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 9.5 / ENV_SUN_POINTS, r + 9.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 10.5 / ENV_SUN_POINTS, r + 10.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 11.5 / ENV_SUN_POINTS, r + 11.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 12.5 / ENV_SUN_POINTS, r + 12.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 13.5 / ENV_SUN_POINTS, r + 13.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 14.5 / ENV_SUN_POINTS, r + 14.0 * ENV_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 15.5 / ENV_SUN_POINTS, r + 15.0 * ENV_GOLDEN);
-    return s / ENV_SUN_POINTS;
+    var s = env_sun_point(t, b, n, wr, gr, 0.5 / SB_SUN_POINTS, r);
+    s = s + env_sun_point(t, b, n, wr, gr, 1.5 / SB_SUN_POINTS, r + 1.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 2.5 / SB_SUN_POINTS, r + 2.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 3.5 / SB_SUN_POINTS, r + 3.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 4.5 / SB_SUN_POINTS, r + 4.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 5.5 / SB_SUN_POINTS, r + 5.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 6.5 / SB_SUN_POINTS, r + 6.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 7.5 / SB_SUN_POINTS, r + 7.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 8.5 / SB_SUN_POINTS, r + 8.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 9.5 / SB_SUN_POINTS, r + 9.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 10.5 / SB_SUN_POINTS, r + 10.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 11.5 / SB_SUN_POINTS, r + 11.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 12.5 / SB_SUN_POINTS, r + 12.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 13.5 / SB_SUN_POINTS, r + 13.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 14.5 / SB_SUN_POINTS, r + 14.0 * SB_GOLDEN);
+    s = s + env_sun_point(t, b, n, wr, gr, 15.5 / SB_SUN_POINTS, r + 15.0 * SB_GOLDEN);
+    return s / SB_SUN_POINTS;
 }

@@ -160,12 +160,14 @@ fn sunbeam_shade_environment(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<
 }
 
 
-// The sky's sun from direction wi (towards a point of its disc, e.g. its
-// centre sun_dir; an engine's directional light, with its shadows), linear
-// sRGB towards wr: as the player's sun, (1 - dw) G G2 Omega E_sun read from
-// the sun's own map (the sun's spectrum: a white light tinted by its RGB
-// would not do, a diffraction colour is nearly monochromatic) plus the base
-// lit by the disc, dw * base * Omega L cos (1 - F) / pi. 0 without a sun.
+// The sky's sun about direction wi (towards its centre, sun_dir; an
+// engine's directional light, with its shadows), linear sRGB towards wr: as
+// the player's sun, (1 - dw) G G2 Omega E_sun read from the sun's own map
+// (the sun's spectrum: a white light tinted by its RGB would not do, a
+// diffraction colour is nearly monochromatic), averaged over SB_SUN_POINTS
+// points of the disc of solid angle sun_rgb.w about wi as the player's first
+// frame does (0: the point wi alone), plus the base lit by the disc, dw *
+// base * Omega L cos (1 - F) / pi at wi. 0 without a sun.
 fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     if (sunbeam_env.sun_dir.w <= 0.0) {
         return vec3<f32>(0.0);
@@ -175,13 +177,38 @@ fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr
     let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw, sunbeam.energy);
     let dw = sunbeam.warp.z;
     var diff = vec3<f32>(0.0);
-    if (wi_l.z > 0.0 && wr_l.z > 0.0 && sunbeam_env.sun_grid.x > 0.0) {
+    if (wr_l.z > 0.0 && sunbeam_env.sun_grid.x > 0.0) {
         let gr = env_map_grid(sunbeam_env.sun_grid);
-        let at = sb_resp_uvw(sb_resp_coords(-wi_l - wr_l, gr), gr);
-        let e = textureSampleLevel(env_sun_map, resp_smp, at, 0.0).xyz;
-        diff = sb_xyz_to_linear_srgb(e * sb_gain(wi_l, wr_l, skin) * sb_masking(wi_l, wr_l, skin.slope));
+        let omega = sunbeam_env.sun_rgb.w;
+        if (omega > 0.0) {
+            // a frame about the disc's centre
+            let up = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(wi.y) > 0.9);
+            let dt = normalize(cross(up, wi));
+            let db = cross(wi, dt);
+            let cos_cap = 1.0 - omega / SB_TAU;
+            for (var i = 0u; i < u32(SB_SUN_POINTS); i = i + 1u) {
+                let u = (f32(i) + 0.5) / SB_SUN_POINTS;
+                let d = sb_sun_disc_dir(wi, dt, db, cos_cap, u, f32(i) * SB_GOLDEN);
+                diff = diff + env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr);
+            }
+            diff = diff / SB_SUN_POINTS;
+        } else {
+            diff = env_sun_at(wi_l, wr_l, skin, gr);
+        }
+        diff = sb_xyz_to_linear_srgb(diff);
     }
     let cos_i = max(wi_l.z, 0.0);
     let lit = sunbeam_env.sun_rgb.rgb * cos_i * sb_base_transmission(cos_i, skin.ior, true) / ENV_PI;
     return dw * sunbeam.base.rgb * lit + (1.0 - dw) * diff;
+}
+
+// The sun's map at local incidence wi and view wr, times G and the masking
+// (XYZ; 0 for a direction below the horizon).
+fn env_sun_at(wi: vec3<f32>, wr: vec3<f32>, skin: SbSkin, gr: SbGrid) -> vec3<f32> {
+    if (wi.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let at = sb_resp_uvw(sb_resp_coords(-wi - wr, gr), gr);
+    let e = textureSampleLevel(env_sun_map, resp_smp, at, 0.0).xyz;
+    return e * sb_gain(wi, wr, skin) * sb_masking(wi, wr, skin.slope);
 }

@@ -422,7 +422,7 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
           cells: new THREE.Vector4(envCells ? envCells.nTop : 0, envCells ? envCells.nS : 2, envCells ? envCells.nodes : 0, 0),
           chain: new THREE.Vector4(env ? env.json.chain.height : 1, env ? env.json.chain.levels : 1, env ? env.json.chain.phase ?? 0 : 0, 0),
           sun_dir: sun ? new THREE.Vector4(...sun.direction, 1) : new THREE.Vector4(),
-          sun_rgb: sun ? new THREE.Vector4(...sun.rgb, 0) : new THREE.Vector4(),
+          sun_rgb: sun ? new THREE.Vector4(...sun.rgb, sun.solid_angle) : new THREE.Vector4(),
           // a mesh without its sun map: n_theta 0 (no diffraction from the sun)
           sun_grid: envCells?.sun ? new THREE.Vector4(...envCells.sunGrid) : new THREE.Vector4(0, 2, 2, 1),
           // the hot spots' taps (0: none), read through the mesh's basis maps
