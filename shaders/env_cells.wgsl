@@ -43,11 +43,11 @@ const ENV_REFINE: f32 = 2.0;
 const ENV_CELL_HEADER: u32 = 26u;
 // Cells within this many of their widths of the horizon integrate G / cos
 // across them (cells::RIM_WIDTHS); outside the disc by less than this they
-// still count (cells::RIM_OUTSIDE); midpoints of env_rim_moments
-// (cells::RIM_POINTS).
+// still count (cells::RIM_OUTSIDE); the half-width of env_rim_moments'
+// box in rms widths (cells::RIM_BOX).
 const ENV_RIM_WIDTHS: f32 = 5.0;
 const ENV_RIM_OUTSIDE: f32 = 0.05;
-const ENV_RIM_POINTS: u32 = 8u;
+const ENV_RIM_BOX: f32 = 1.7320508;
 // A cell inside the disc by less than this share straddles the horizon
 // (cells::STRADDLE).
 const ENV_CELL_STRADDLE: f32 = 0.999;
@@ -149,23 +149,16 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
     return xyz;
 }
 
-// h(a) = int_0^inf phi(y - a) y^(-1/2) dy and h1(a) (with y^(1/2)), phi the
-// standard normal density, by 8 midpoints in t = sqrt(y) (cells::rim_moments),
-// written out: Mesa's llvmpipe ends all the loops of an invocation after
-// 65,535 iterations in all, and the cells' walk needs them ("One walk per
-// fragment" in docs/LIGHTING.md).
-fn env_rim_term(t: f32, a: f32) -> vec2<f32> {
-    let y = t * t;
-    let w = exp(-0.5 * (y - a) * (y - a));
-    return vec2<f32>(w, w * y);
-}
-
+// h(a) = int_0^inf p(y - a) y^(-1/2) dy and h1(a) (with y^(1/2)), p the
+// uniform density of unit variance (cells::rim_moments: why a box), in
+// closed form.
 fn env_rim_moments(a: f32) -> vec2<f32> {
-    let dt = sqrt(max(a, 0.0) + 7.0) / f32(ENV_RIM_POINTS);
-    let h = env_rim_term(0.5 * dt, a) + env_rim_term(1.5 * dt, a) + env_rim_term(2.5 * dt, a)
-        + env_rim_term(3.5 * dt, a) + env_rim_term(4.5 * dt, a) + env_rim_term(5.5 * dt, a)
-        + env_rim_term(6.5 * dt, a) + env_rim_term(7.5 * dt, a);
-    return h * (2.0 * dt * 0.3989422804014327);
+    if (!(a + ENV_RIM_BOX > 0.0)) {
+        return vec2<f32>(0.0);
+    }
+    let hi = a + ENV_RIM_BOX;
+    let lo = max(a - ENV_RIM_BOX, 0.0);
+    return vec2<f32>((sqrt(hi) - sqrt(lo)) / ENV_RIM_BOX, (hi * sqrt(hi) - lo * sqrt(lo)) / (3.0 * ENV_RIM_BOX));
 }
 
 // Basis bb's XYZ of a cell at the horizon: its masses at layer mr0 (and the
@@ -208,7 +201,7 @@ fn env_cell_mass(m0: u32, bb: u32, f: f32) -> vec3<f32> {
 
 // G / cos integrated across a cell at the horizon, times its share inside,
 // and cos(theta_i) where that integral puts its weight (cells::rim_gain): a
-// Gaussian of rms sigma in x = 1 - |wi_xy| about dist, cut at x = 0.
+// box of rms sigma in x = 1 - |wi_xy| about dist, cut at x = 0.
 fn env_rim_gain(dist: f32, sigma: f32, dir: vec2<f32>, wr: vec3<f32>, view: vec2<f32>) -> vec2<f32> {
     let hm = env_rim_moments(dist / sigma);
     if (!(hm.x > 0.0)) {

@@ -16,6 +16,8 @@
 //!   (`sunbeam_light::hotspots`, through `sunbeam_response::hotspots`);
 //! - `LAMBDA=N`: the player's maps with `N` wavelength samples (the reference
 //!   keeps its 160);
+//! - `RATIO=1`: print each point's view cosine, estimate over reference in
+//!   X, Y and Z, and its CIEDE2000 (which channel a model loses);
 //! - `YONLY=1`: the error of luminance alone (the estimate's Y with the
 //!   reference's chromaticity);
 //! - `TEXELS=1`: also every texel as its own cell at its centre, the
@@ -347,6 +349,16 @@ fn main() {
                 }
                 let sc = |v: [f64; 3]| v.map(|c| (c / white).max(0.0));
                 de.push(colour::ciede2000_xyz(sc(x), sc(*r)));
+                if std::env::var("RATIO").is_ok() {
+                    eprintln!(
+                        "RATIO {:.4} {:.4} {:.4} {:.4} de {:.2}",
+                        wr[2],
+                        x[0] / r[0],
+                        x[1] / r[1],
+                        x[2] / r[2],
+                        de.last().unwrap()
+                    );
+                }
                 if std::env::var("YONLY").is_ok() {
                     // the same chromaticity as the reference: luminance's share
                     let k = x[1] / r[1].max(1e-30);
