@@ -16,6 +16,10 @@
 //!   (`sunbeam_light::hotspots`, through `sunbeam_response::hotspots`);
 //! - `LAMBDA=N`: the player's maps with `N` wavelength samples (the reference
 //!   keeps its 160);
+//! - `SWEEP=AZIMUTH`: instead of random points, 400 views along one azimuth
+//!   (degrees), `cos` from 0.95 to 0.3, in a fixed frame, each printed as
+//!   `SW cos Y_est Y_ref Z_est Z_ref` (steps of the estimate as the view
+//!   moves);
 //! - `RATIO=1`: print each point's view cosine, estimate over reference in
 //!   X, Y and Z, and its CIEDE2000 (which channel a model loses);
 //! - `YONLY=1`: the error of luminance alone (the estimate's Y with the
@@ -207,6 +211,19 @@ fn main() {
             let sr = (1.0 - cr * cr).sqrt();
             pts.push(((t, b, n), [sr * pr.cos(), sr * pr.sin(), cr]));
         }
+        if let Ok(az) = std::env::var("SWEEP") {
+            // views along one azimuth (degrees), cos from 0.95 to 0.3, in a fixed frame
+            let az: f64 = az.parse::<f64>().expect("SWEEP=AZIMUTH").to_radians();
+            pts.clear();
+            for k in 0..400 {
+                let cr = 0.95 - 0.65 * k as f64 / 399.0;
+                let sr = (1.0 - cr * cr).sqrt();
+                pts.push((
+                    ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]),
+                    [sr * az.cos(), sr * az.sin(), cr],
+                ));
+            }
+        }
         let sun_u = [0.5, 0.5];
         let refs: Vec<[f64; 3]> = pts
             .iter()
@@ -349,6 +366,12 @@ fn main() {
                 }
                 let sc = |v: [f64; 3]| v.map(|c| (c / white).max(0.0));
                 de.push(colour::ciede2000_xyz(sc(x), sc(*r)));
+                if std::env::var("SWEEP").is_ok() {
+                    eprintln!(
+                        "SW {:.5} {:.6} {:.6} {:.6} {:.6}",
+                        wr[2], x[1], r[1], x[2], r[2]
+                    );
+                }
                 if std::env::var("RATIO").is_ok() {
                     eprintln!(
                         "RATIO {:.4} {:.4} {:.4} {:.4} de {:.2}",
