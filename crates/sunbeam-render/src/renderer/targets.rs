@@ -270,9 +270,9 @@ impl Offscreen {
 /// at 40 x 40 change by half their value over half a pixel) but nearly
 /// linear across it, so the centre is close to the pixel's mean while a
 /// running mean whose offsets lean to one side is the image shifted by
-/// their mean: with the plain Halton sequence (mean -1/32 px at 16 frames,
-/// -1/8 px at 4) 4 accumulated first-frame estimates were CIEDE2000 p99
-/// 12.8 from the reference where one was 1.1 (docs/LIGHTING.md
+/// their mean: with the plain Halton sequence (mean -1/32 px at 16 frames)
+/// 16 accumulated first-frame estimates were CIEDE2000 p99 2.70 from a 4 x 4
+/// supersampled frame, with these offsets 0.78 (docs/LIGHTING.md
 /// "Accumulated frames").
 pub fn subpixel_jitter(k: u32) -> [f64; 2] {
     fn radical_inverse(mut i: u32, base: u32) -> f64 {
