@@ -13,7 +13,7 @@ BIN = $(TARGET_DIR)/$(PROFILE_DIR)
 # Goals of examples/Makefile for `make demo` (default: all of it).
 DEMO_GOALS ?=
 
-.PHONY: all build demo test deps clean blender-addon blender-docs-img
+.PHONY: all build demo test deps clean blender-addon blender-docs-img blender-panels-img
 
 # wgpu's GL/Wayland probing complains without a runtime dir; give tests a private one.
 XDG_RUNTIME_DIR ?= $(shell d=$${TMPDIR:-/tmp}/sunbeam-xdg-$$(id -u); mkdir -p -m 700 $$d && echo $$d)
@@ -46,6 +46,11 @@ blender-addon:
 # docs/img/blender-*.png: the add-on's test render and its hand-written reference (docs/BLENDER.md).
 blender-docs-img: deps
 	SUNBEAM_BIN='$(BIN)' SUNBEAM_BLENDER_IMG=docs/img tests/blender/run.sh RenderTest
+
+# docs/img/blender-panel-*.png: screenshots of the add-on's panels (docs/BLENDER.md), taken by
+# Blender's own executable (SUNBEAM_BLENDER, default blender) under xvfb-run; not in `make test`.
+blender-panels-img:
+	tests/blender/panel_screenshots.sh docs/img
 
 clean:
 	$(CARGO) clean
