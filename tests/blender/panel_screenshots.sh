@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Screenshots of the Blender add-on's panels for docs/BLENDER.md (`make blender-panels-img`):
 # tests/blender/panel_screenshots.py in Blender's own executable with a window on a virtual
-# display (xvfb-run). Not part of `make test`: a docs target.
+# display (xvfb-run). `make test` runs it through tests/blender/panels_test.sh.
 #   tests/blender/panel_screenshots.sh [OUT_DIR]     (default docs/img)
 # SUNBEAM_BLENDER names the executable (default: blender on PATH; Debian 12: `apt-get install
 # blender`, 3.4.1). Fails with a message when Blender or xvfb-run is missing.
