@@ -37,7 +37,7 @@ fn env_prefiltered(d: vec3<f32>, omega: f32) -> vec3<f32> {
 
 // Cells refine near the horizon while their spread times this reaches it
 // (sunbeam_response::cells::REFINE).
-const ENV_REFINE: f32 = 2.0;
+const ENV_REFINE: f32 = 3.0;
 // Cells::gpu_data: floats per node before its masses (u, v, spread, first,
 // next, the 9 masses' offsets, then the width uu, uv, vv), and "no node".
 const ENV_CELL_HEADER: u32 = 26u;
@@ -102,7 +102,8 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         }
         let wi = vec3<f32>(w2, sqrt(max(1.0 - dot(w2, w2), 0.0)));
         let r = length(uv);
-        let omega = max(SB_TAU * spread * spread / wi.z, 1e-9);
+        // the footprint: a disc of the area of the width's ellipse (cells::Cells::estimate)
+        let omega = max(SB_TAU * sqrt(max(wq.x * wq.z - wq.y * wq.y, 0.0)) / wi.z, 1e-9);
         let c = env_prefiltered(wi.x * t + wi.y * b + wi.z * n, omega);
         if (rim) {
             // G / cos integrated across the cell (cells::rim_gain), G and

@@ -48,7 +48,7 @@ pub type Frame = ([f64; 3], [f64; 3], [f64; 3]);
 
 /// Cells refine near the horizon while their spread (rms radius) times this
 /// reaches it.
-pub const REFINE: f64 = 2.0;
+pub const REFINE: f64 = 3.0;
 
 /// Cells every view visits (the top cut) in the player.
 pub const DEFAULT_TOP: usize = 256;
@@ -538,7 +538,13 @@ impl Cells {
                 let k0 = (sc.floor() as usize).min(self.grid.n_s - 2);
                 (k0, sc - k0 as f64)
             };
-            let omega = (std::f64::consts::TAU * c.spread * c.spread / wi[2]).max(1e-9);
+            // the environment averaged over the cell's footprint: a disc of
+            // the same area as its extent's ellipse (an isotropic filter; the
+            // spread's circle would blur a streak across its length's width)
+            let area = (c.width[0] * c.width[2] - c.width[1] * c.width[1])
+                .max(0.0)
+                .sqrt();
+            let omega = (std::f64::consts::TAU * area / wi[2]).max(1e-9);
             let ck = coeffs(world(wi), omega);
             let straddles = inside < STRADDLE && c.spread > 0.0;
             if rim {
