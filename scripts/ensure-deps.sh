@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Install what `make test` / `make demo` need when it is missing: Debian packages
-# (software Vulkan/GL drivers, Xvfb, OpenEXR tools, Ninja, glslang and SPIRV-Tools, Chromium) and the
+# (software Vulkan/GL drivers, Xvfb, OpenEXR tools, Ninja, glslang and SPIRV-Tools, Chromium,
+# Blender's executable and numpy for its glTF exporter: the add-on's panels and viewport) and the
 # npm packages (glTF-Validator, three.js, playwright-core) under tests/node, and Blender as a Python module
 # for the add-on's tests (scripts/ensure-bpy.sh). Idempotent; quiet when all is there.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PKGS="mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth openimageio-tools ninja-build glslang-tools spirv-tools chromium blender"
+PKGS="mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri xvfb xauth openimageio-tools ninja-build glslang-tools spirv-tools chromium blender python3-numpy"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -11,13 +11,27 @@ material, render engine Sunbeam), then, from timers so that the window has drawn
 `screen.screenshot_area` of the Properties editor on the Render, Material and Object tabs and
 a `screen.screenshot` of the window with File > Import's menu open, crops them (the editor
 down to its last panel; the menu by the pixels that changed when it opened) and writes
-OUT_DIR/blender-panel-*.png as 8-bit RGB PNGs. Then it quits; any failure exits non-zero.
+OUT_DIR/blender-panel-*.png as 8-bit RGB PNGs.
+
+Then it checks the engine's viewport (rendered shading, `sunbeam-play`): the sphere gets a real
+pack (a small synthetic one that `sunbeam-import` + `sunbeam-pack --response` write into a
+temporary folder while the panels are taken), the factory scene's lamp becomes a sun, the 3D
+Viewport is maximised (no overlays, no gizmos) and switched to 'RENDERED'; once the engine has
+drawn its frame (view_draw made a texture of a finished frame, no `sunbeam-play` runs) it takes
+`screen.screenshot_area` of the viewport, fails when the engine reported an error or when the
+sphere's disc (projected by the view) does not differ clearly from the viewport's background,
+and writes OUT_DIR/blender-viewport-rendered.png (cut to a square around the sphere). Then it
+quits; any failure exits non-zero.
 """
 
 import os
+import shutil
 import struct
+import subprocess
 import sys
 import tempfile
+import threading
+import time
 import traceback
 import zlib
 from array import array
@@ -29,6 +43,8 @@ ROOT = Path(__file__).resolve().parents[2]
 ADDON_DIR = ROOT / "integrations" / "blender"
 ADDON = "sunbeam_blender"
 SETTLE_S = 1.5  # seconds for the window to redraw after a change, before a screenshot
+VIEWPORT_TIMEOUT_S = 120  # for the engine's first viewport frame
+VIEWPORT_PNG = "blender-viewport-rendered.png"
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 if len(argv) != 1:
@@ -46,9 +62,12 @@ def fail(msg):
 
 def quit_blender():
     code = 1 if failed else 0
-    for f in TMP.iterdir():
-        f.unlink()
-    TMP.rmdir()
+    # A sunbeam-play the viewport still runs would outlive Blender: have the add-on kill it.
+    PLAY_RUNS["quit"] = True
+    t = time.monotonic()
+    while PLAY_RUNS["running"] and time.monotonic() - t < 10:
+        time.sleep(0.1)
+    shutil.rmtree(TMP, ignore_errors=True)
     # wm.quit_blender would exit 0 whatever happened; os._exit keeps the status.
     sys.stdout.flush()
     sys.stderr.flush()
@@ -124,12 +143,81 @@ def changed_box(a, b):
 
 # ---- the scene and the window ----
 
+PACK = {"path": None, "error": None, "thread": None}  # the viewport's pack, made in a thread
+ENGINE_ERRORS = []  # what the engine's viewport export and sunbeam-play runs raised
+PLAY_RUNS = {"started": 0, "running": 0, "finished": 0, "quit": False, "shown": 0}
+
+
+def make_pack():
+    """Start writing a small synthetic pack (as tests/blender/test_addon.py makes its own) with
+    the tools the add-on finds, in a thread: the panels' screenshots go on meanwhile."""
+    from sunbeam_blender import tools
+    exes = [tools.find_tool(name) for name in ("sunbeam-import", "sunbeam-pack")]
+    folder = TMP / "pack"
+    folder.mkdir()
+    cmds = [[exes[0], "synthetic:elaphe", "--synthetic-size", "32", "-o", str(folder / "skin.exr"), "-q"],
+            [exes[1], str(folder / "skin.exr"), "-o", str(folder / "skin.ktx2"), "--response", "-q"]]
+
+    def work():
+        for cmd in cmds:
+            out = subprocess.run(cmd, capture_output=True, text=True)
+            if out.returncode != 0:
+                PACK["error"] = f"{' '.join(cmd)}: exit status {out.returncode}: {out.stderr.strip()}"
+                return
+        PACK["path"] = str(folder / "skin.ktx2")
+
+    PACK["thread"] = threading.Thread(target=work, daemon=True)
+    PACK["thread"].start()
+
+
+def watch_engine():
+    """Record the errors of the engine's viewport path (its export, its sunbeam-play runs) and
+    whether a run is going on, by wrapping the two functions engine.py calls (they still run as
+    they are; the add-on reports the same errors itself)."""
+    from sunbeam_blender import engine, export
+    build_scene, preview_frame = export.build_scene, engine.preview_frame
+
+    def watched_build_scene(*args, **kwargs):
+        try:
+            return build_scene(*args, **kwargs)
+        except Exception as e:
+            ENGINE_ERRORS.append(f"viewport export: {e}")
+            raise
+
+    def watched_preview_frame(scene_json, frame, frames, cancelled):
+        PLAY_RUNS["started"] += 1
+        PLAY_RUNS["running"] += 1
+        try:
+            out = preview_frame(scene_json, frame, frames, lambda: PLAY_RUNS["quit"] or cancelled())
+            PLAY_RUNS["finished"] = time.monotonic()
+            return out
+        except engine.Cancelled:
+            raise
+        except Exception as e:
+            ENGINE_ERRORS.append(f"viewport sunbeam-play: {e}")
+            raise
+        finally:
+            PLAY_RUNS["running"] -= 1
+
+    frame_texture = engine._frame_texture
+
+    def watched_frame_texture(path):
+        texture = frame_texture(path)
+        PLAY_RUNS["shown"] += 1  # view_draw has the frame as a texture: it draws it now
+        return texture
+
+    export.build_scene, engine.preview_frame = watched_build_scene, watched_preview_frame
+    engine._frame_texture = watched_frame_texture
+
+
 def setup():
     sys.path.insert(0, str(ADDON_DIR))
     import addon_utils
     addon_utils.enable(ADDON, default_set=True, handle_error=None)
     if ADDON not in bpy.context.preferences.addons:
         raise RuntimeError(f"the add-on {ADDON} did not enable (see the messages above)")
+    make_pack()
+    watch_engine()
     # The Scales sub-panel is closed by default; open it for the picture (a click on its header
     # does the same; this script has no mouse), by registering it again without DEFAULT_CLOSED
     # before the window first draws the Object tab.
@@ -249,6 +337,171 @@ def steps():
     m = 8
     write_png(OUT / "blender-panel-import-menu.png",
               crop(b, max(0, x0 - m), max(0, y0 - m), min(w, x1 + m), min(h, y1 + m)))
+    win.event_simulate(type="ESC", value="PRESS")
+    win.event_simulate(type="ESC", value="RELEASE")
+    yield
+    yield from viewport_steps()
+
+
+# ---- the viewport's rendered mode ----
+
+def viewport_scene():
+    """The real pack on the sphere's material, the factory lamp as a sun from behind the view's
+    left shoulder, the factory camera (kept) looking at the sphere."""
+    from mathutils import Vector
+    PACK["thread"].join()
+    if PACK["error"]:
+        raise RuntimeError(f"making the viewport's pack: {PACK['error']}")
+    scene = bpy.context.scene
+    # UVs for the Scales bake (the panels' sphere has none: its pictures stay as they were).
+    import bmesh
+    bm = bmesh.new()
+    bm.loops.layers.uv.new("UVMap")
+    bmesh.ops.create_uvsphere(bm, u_segments=32, v_segments=16, radius=1.0, calc_uvs=True)
+    bm.to_mesh(bpy.data.objects["Sphere"].data)
+    bm.free()
+    bpy.data.materials["Snake Skin"].sunbeam.pack = PACK["path"]
+    cam = scene.camera
+    if cam is None:
+        raise RuntimeError("the factory scene has no camera")
+    view_dir = (Vector((0, 0, 0)) - cam.location).normalized()  # the camera looks at the origin
+    cam.rotation_euler = (-view_dir).to_track_quat("Z", "Y").to_euler()
+    lamp = next((o for o in scene.objects if o.type == "LIGHT"), None)
+    if lamp is None:
+        raise RuntimeError("the factory scene has no lamp")
+    lamp.data.type = "SUN"
+    lamp.data.energy = 4.0
+    left = view_dir.cross(Vector((0, 0, 1))).normalized() * -1.0
+    towards_sun = (-view_dir + 0.6 * left + 0.5 * Vector((0, 0, 1))).normalized()
+    lamp.rotation_euler = towards_sun.to_track_quat("Z", "Y").to_euler()  # a sun shines along -Z
+    scene.sunbeam.preview_frames = 1
+    # A black World: the factory one's grey would become a constant environment map, whose
+    # first frame on a CPU rasteriser (Mesa's, here) takes minutes.
+    world = scene.world
+    world.use_nodes = False
+    world.color = (0.0, 0.0, 0.0)
+    return cam
+
+
+def viewport_steps():
+    try:
+        import numpy  # noqa: F401
+    except ImportError:
+        raise RuntimeError("Blender's Python has no numpy, which its glTF exporter (run by the "
+                           "engine's export) needs: install it (Debian: apt-get install python3-numpy)")
+    win = window()
+    props = area_of("PROPERTIES")  # still maximised
+    with bpy.context.temp_override(window=win, area=props):
+        r = bpy.ops.screen.back_to_previous()
+    if r != {"FINISHED"}:
+        raise RuntimeError(f"screen.back_to_previous: {r}")
+    yield
+    view3d = area_of("VIEW_3D")
+    with bpy.context.temp_override(window=win, area=view3d):
+        r = bpy.ops.screen.screen_full_area()
+    if r != {"FINISHED"}:
+        raise RuntimeError(f"screen.screen_full_area (3D Viewport): {r}")
+    yield
+    cam = viewport_scene()
+    view3d = area_of("VIEW_3D")  # the maximised viewport is a new area
+    space = view3d.spaces.active
+    region = next(r for r in view3d.regions if r.type == "WINDOW")
+    rv3d = space.region_3d
+    space.overlay.show_overlays = False
+    space.show_gizmo = False
+    rv3d.view_perspective = "PERSP"
+    rv3d.view_location = (0.0, 0.0, 0.0)
+    rv3d.view_rotation = cam.rotation_euler.to_quaternion()
+    rv3d.view_distance = 4.5
+    yield
+    print(f"panel_screenshots: 3D Viewport {view3d.width} x {view3d.height}, "
+          f"its view {region.width} x {region.height}")
+    start = time.monotonic()
+    space.shading.type = "RENDERED"
+    # The engine's frame: view_draw has made a texture of a finished sunbeam-play frame and no
+    # run goes on (a run for an earlier view is cancelled by the next one).
+    while True:
+        yield 0.5
+        if ENGINE_ERRORS:
+            fail("the engine's viewport reported: " + "; ".join(ENGINE_ERRORS))
+            return
+        drawn = PLAY_RUNS["shown"] > 0
+        if drawn and PLAY_RUNS["running"] == 0:
+            break
+        if PLAY_RUNS["finished"] and not PLAY_RUNS["running"] and time.monotonic() - PLAY_RUNS["finished"] > 10:
+            fail("sunbeam-play wrote the viewport's frame but the engine did not draw it within 10 s "
+                 "(its view_draw failed? see Blender's messages above)")
+            return
+        if time.monotonic() - start > VIEWPORT_TIMEOUT_S:
+            fail(f"the engine drew no viewport frame within {VIEWPORT_TIMEOUT_S} s "
+                 f"({PLAY_RUNS['started']} sunbeam-play runs started, frames shown: {PLAY_RUNS['shown']})")
+            return
+    print(f"panel_screenshots: the viewport's frame after {time.monotonic() - start:.1f} s "
+          f"({PLAY_RUNS['started']} sunbeam-play run(s))")
+    yield  # the frame drawn
+    shot = TMP / "viewport.png"
+    with bpy.context.temp_override(window=win, area=view3d):
+        r = bpy.ops.screen.screenshot_area(filepath=str(shot))
+    if r != {"FINISHED"} or not shot.is_file():
+        fail(f"screenshot_area of the 3D Viewport: {r}")
+        return
+    if ENGINE_ERRORS:
+        fail("the engine's viewport reported: " + "; ".join(ENGINE_ERRORS))
+        return
+    w, h, rows = read_png(shot)
+    # The sphere's centre and radius in the screenshot (rows from the top): its centre and a
+    # point of its silhouette's edge projected by the view.
+    from bpy_extras.view3d_utils import location_3d_to_region_2d
+    from mathutils import Vector
+    c = location_3d_to_region_2d(region, rv3d, Vector((0, 0, 0)))
+    right = rv3d.view_rotation @ Vector((1, 0, 0))
+    e = location_3d_to_region_2d(region, rv3d, right)
+    if c is None or e is None:
+        fail("the sphere is not in the viewport's view")
+        return
+    radius = (e - c).length  # a little under the silhouette's (perspective): fine for the check
+    ox, oy = region.x - view3d.x, region.y - view3d.y  # the view in the area (from the bottom)
+    cx, cy = ox + c.x, h - 1 - (oy + c.y)
+    check_viewport(rows, w, h, cx, cy, radius, (ox, h - oy - region.height, ox + region.width, h - oy))
+    side = min(w, h, int(2.6 * radius))
+    x0 = max(0, min(w - side, int(cx - side / 2)))
+    y0 = max(0, min(h - side, int(cy - side / 2)))
+    write_png(OUT / VIEWPORT_PNG, crop(rows, x0, y0, x0 + side, y0 + side))
+
+
+def check_viewport(rows, w, h, cx, cy, radius, view_box):
+    """Fail unless the sphere's disc differs clearly from the viewport's background: the mean
+    colour of the disc's inner part against the mean of the view's pixels well outside it."""
+    bx0, by0, bx1, by1 = view_box
+    inner, outer = [], []
+    for y in range(by0, by1, 2):
+        row = rows[y]
+        for x in range(bx0, bx1, 2):
+            d = ((x - cx) ** 2 + (y - cy) ** 2) ** 0.5
+            px = row[3 * x:3 * x + 3]
+            if d < 0.7 * radius:
+                inner.append(px)
+            elif d > 1.4 * radius:
+                outer.append(px)
+    if len(inner) < 100 or len(outer) < 100:
+        fail(f"the sphere's disc ({len(inner)} samples) or the background ({len(outer)}) is "
+             "too small in the viewport's screenshot")
+        return
+
+    def mean(pxs):
+        return [sum(p[i] for p in pxs) / len(pxs) for i in range(3)]
+
+    mi, mo = mean(inner), mean(outer)
+    dist = sum((a - b) ** 2 for a, b in zip(mi, mo)) ** 0.5
+    # The disc's pixels that differ from the background's mean by more than 24 levels.
+    far = sum(1 for p in inner if sum((p[i] - mo[i]) ** 2 for i in range(3)) ** 0.5 > 24) / len(inner)
+    print(f"panel_screenshots: viewport check: the sphere's mean RGB {[round(v) for v in mi]}, "
+          f"the background's {[round(v) for v in mo]}, distance {dist:.1f} levels, "
+          f"{100 * far:.0f} % of the disc's pixels > 24 levels from the background")
+    if dist < 20 or far < 0.5:
+        fail(f"the viewport's sphere does not differ from its background (mean colour distance "
+             f"{dist:.1f} levels, want >= 20; {100 * far:.0f} % of its pixels differ, want >= 50 %): "
+             "the engine's frame was not drawn")
 
 
 def main():
@@ -264,7 +517,7 @@ def main():
 
     def tick():
         try:
-            next(gen)
+            wait = next(gen)
         except StopIteration:
             quit_blender()
             return None
@@ -273,7 +526,7 @@ def main():
             fail("a step failed")
             quit_blender()
             return None
-        return SETTLE_S
+        return SETTLE_S if wait is None else wait
 
     bpy.app.timers.register(tick, first_interval=SETTLE_S)
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Screenshots of the Blender add-on's panels for docs/BLENDER.md (`make blender-panels-img`):
+# Screenshots of the Blender add-on's panels (and of the 3D Viewport's rendered mode with the
+# Sunbeam engine, which the script checks) for docs/BLENDER.md (`make blender-panels-img`):
 # tests/blender/panel_screenshots.py in Blender's own executable with a window on a virtual
 # display (xvfb-run). `make test` runs it through tests/blender/panels_test.sh.
 #   tests/blender/panel_screenshots.sh [OUT_DIR]     (default docs/img)

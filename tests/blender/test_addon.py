@@ -715,9 +715,27 @@ class ViewportTest(unittest.TestCase):
         thread, holder = stand_in._preview
         thread.join()
         self.assertIsNone(holder["error"])
-        lit = (linear_pixels(holder["frame"]).sum(-1) > 0).sum()
-        stand_in._export_dir.cleanup()
+        px = linear_pixels(holder["frame"])
+        lit = (px.sum(-1) > 0).sum()
+        # what view_draw uploads as the frame's texture (bottom row first, A = 1), against
+        # Blender's own EXR reader
+        w, h, data = engine.exr.read_rgba_bottom_up(holder["frame"])
+        rgba = np.asarray(data, dtype=np.float64).reshape(h, w, 4)
+        np.testing.assert_allclose(rgba[..., :3], px, rtol=1e-6, atol=1e-9)
+        self.assertTrue((rgba[..., 3] == 1.0).all())
         self.assertGreater(lit, 400)
+        # a preview still running when Blender quits (atexit) or the add-on is disabled is
+        # cancelled, its sunbeam-play killed: one of a million frames would outlive Blender
+        stand_in._start_preview(*engine.viewport_camera(looking_through(cam, 48, 48)), 1000000)
+        thread, holder = stand_in._preview
+        time.sleep(1.0)
+        self.assertTrue(thread.is_alive())
+        start = time.monotonic()
+        engine._stop_previews()
+        self.assertFalse(thread.is_alive())
+        self.assertLess(time.monotonic() - start, 5.0)
+        self.assertIsNone(holder["frame"])
+        stand_in._export_dir.cleanup()
 
     def test_cancel_kills_the_child(self):
         from sunbeam_blender import tools

@@ -7,6 +7,7 @@ Blender's own engines cannot draw the material (EEVEE has no custom shading code
 no custom closures), so the engine hands the scene to Sunbeam the way external renderers do.
 """
 
+import atexit
 import math
 import os
 import tempfile
@@ -21,7 +22,21 @@ from . import export, exr, tools
 from .tools import Cancelled, SunbeamError
 
 
-VIEWPORT_IMAGE = "Sunbeam Viewport"
+# The viewport's running previews, thread -> holder: when Blender quits or the add-on is
+# disabled they are cancelled (tools.run kills the child), or a sunbeam-play would outlive it.
+_PREVIEWS = {}
+
+
+def _stop_previews():
+    running = list(_PREVIEWS.items())
+    for _, holder in running:
+        holder["cancel"] = True
+    for thread, _ in running:
+        thread.join(timeout=5.0)
+    _PREVIEWS.clear()
+
+
+atexit.register(_stop_previews)
 
 
 def _is_square(n):
@@ -30,18 +45,12 @@ def _is_square(n):
 
 
 def _frame_texture(path):
-    """A GPU texture of the linear EXR at `path`, through one reused image data-block (it has no
-    users, so it is not saved with the file)."""
-    image = bpy.data.images.get(VIEWPORT_IMAGE)
-    if image is None:
-        image = bpy.data.images.load(path)
-        image.name = VIEWPORT_IMAGE
-    else:
-        image.filepath = path
-        image.reload()
-    texture = gpu.texture.from_image(image)
-    image.pixels[0]  # read the file now: the temporary folder goes after this draw
-    return texture
+    """A GPU texture of the linear EXR at `path`, made from its pixels directly: view_draw may
+    not write to Blender's data (an image data-block's name or file path raises "Writing to ID
+    classes in this context is not allowed"), so no image data-block is involved."""
+    width, height, data = exr.read_rgba_bottom_up(path)
+    buffer = gpu.types.Buffer("FLOAT", len(data), data)
+    return gpu.types.GPUTexture((width, height), format="RGBA32F", data=buffer)
 
 
 class SunbeamRenderEngine(bpy.types.RenderEngine):
@@ -164,9 +173,12 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
                 pass
             except SunbeamError as e:
                 holder["error"] = str(e)
+            finally:
+                _PREVIEWS.pop(thread, None)
 
         thread = threading.Thread(target=work, daemon=True)
         self._preview = (thread, holder)
+        _PREVIEWS[thread] = holder
         thread.start()
 
     def _cancel_preview(self):
@@ -197,9 +209,13 @@ class SunbeamRenderEngine(bpy.types.RenderEngine):
                     self.report({"ERROR"}, holder["error"])
                     self.update_stats("Sunbeam", holder["error"])
                 elif holder["frame"]:
-                    self._texture = _frame_texture(holder["frame"])
+                    try:
+                        self._texture = _frame_texture(holder["frame"])
+                        self.update_stats("Sunbeam", "Preview done")
+                    except (OSError, ValueError) as e:
+                        self.report({"ERROR"}, f"Viewport: {e}")
+                        self.update_stats("Sunbeam", f"Viewport: {e}")
                     os.remove(holder["frame"])
-                    self.update_stats("Sunbeam", "Preview done")
         if self._texture is None:
             return
         gpu.state.blend_set("ALPHA_PREMULT")
@@ -254,6 +270,7 @@ def register():
 
 
 def unregister():
+    _stop_previews()
     bpy.utils.unregister_class(SunbeamRenderEngine)
     for panel in get_panels():
         panel.COMPAT_ENGINES.discard("SUNBEAM")

@@ -10,6 +10,7 @@ the standard library is available inside the add-on, so the few lines of the for
 
 import os
 import struct
+from array import array
 
 
 def _attr(name, kind, payload):
@@ -46,9 +47,10 @@ def write_rgb(path, width, height, rows):
     os.replace(tmp, path)
 
 
-def read_rgb(path):
-    """(width, height, pixels) of an uncompressed float B, G, R scanline EXR; pixels is a flat
-    list of (r, g, b) tuples, top row first. Anything else raises ValueError naming the file."""
+def _scanlines(path):
+    """(width, height, lines) of an uncompressed float B, G, R scanline EXR: each line (top row
+    first) a tuple of its B, G and R floats, channel after channel. Anything else raises
+    ValueError naming the file."""
     with open(path, "rb") as f:
         data = f.read()
     if data[:4] != b"\x76\x2f\x31\x01":
@@ -73,9 +75,28 @@ def read_rgb(path):
     width, height = x1 - x0 + 1, y1 - y0 + 1
     unpack_line = struct.Struct(f"<{3 * width}f").unpack_from
     offsets = struct.unpack_from(f"<{height}Q", data, pos)
+    return width, height, [unpack_line(data, offset + 8) for offset in offsets]
+
+
+def read_rgb(path):
+    """(width, height, pixels) of an uncompressed float B, G, R scanline EXR; pixels is a flat
+    list of (r, g, b) tuples, top row first. Anything else raises ValueError naming the file."""
+    width, height, lines = _scanlines(path)
     pixels = []
-    for offset in offsets:
-        line = unpack_line(data, offset + 8)
+    for line in lines:
         b, g, r = line[:width], line[width:2 * width], line[2 * width:]
         pixels.extend(zip(r, g, b))
     return width, height, pixels
+
+
+def read_rgba_bottom_up(path):
+    """(width, height, data) of the same files for a GPU texture: data an array of 32-bit
+    floats, R, G, B, A = 1 per pixel, bottom row first (OpenGL's order). Slice assignment keeps
+    the interleaving in C: a viewport-sized frame takes a fraction of a second."""
+    width, height, lines = _scanlines(path)
+    data = array("f", [1.0]) * (4 * width * height)
+    row = 4 * width
+    for j, line in enumerate(reversed(lines)):
+        for k, channel in enumerate((2, 1, 0)):  # R, G, B from the B, G, R channels
+            data[j * row + k:(j + 1) * row:4] = array("f", line[channel * width:(channel + 1) * width])
+    return width, height, data
