@@ -20,8 +20,10 @@ Viewport is maximised (no overlays, no gizmos) and switched to 'RENDERED'; once 
 drawn its frame (view_draw made a texture of a finished frame, no `sunbeam-play` runs) it takes
 `screen.screenshot_area` of the viewport, fails when the engine reported an error or when the
 sphere's disc (projected by the view) does not differ clearly from the viewport's background,
-and writes OUT_DIR/blender-viewport-rendered.png (cut to a square around the sphere). Then it
-quits; any failure exits non-zero.
+and writes OUT_DIR/blender-viewport-rendered.png (cut to a square around the sphere). Last, F12
+in the UI: `render.render` invoked (the engine in Blender's render job thread), failing unless
+the job completes with no error report and the Render Result's sphere is lit. Then it quits;
+any failure exits non-zero.
 """
 
 import os
@@ -467,6 +469,133 @@ def viewport_steps():
     x0 = max(0, min(w - side, int(cx - side / 2)))
     y0 = max(0, min(h - side, int(cy - side / 2)))
     write_png(OUT / VIEWPORT_PNG, crop(rows, x0, y0, x0 + side, y0 + side))
+    yield from f12_steps(win, view3d, space, cam)
+
+
+# ---- F12 in the UI: the engine's render() in Blender's render job thread ----
+
+def watch_render():
+    """Record what the engine's final render does: each render() call, the exceptions it
+    raises and the errors it reports (engine.py turns SunbeamError / OSError into
+    self.report({'ERROR'}, ...)), and whether Blender's render job completed or was cancelled."""
+    from sunbeam_blender import engine
+    cls = engine.SunbeamRenderEngine
+    render = cls.render
+
+    class Reporting:
+        """The engine as render() sees it, its report() recorded (an RNA function: the class's
+        attribute cannot be replaced)."""
+
+        def __init__(self, eng):
+            self._eng = eng
+
+        def __getattr__(self, name):
+            return getattr(self._eng, name)
+
+        def report(self, type, message):
+            if {"ERROR", "ERROR_INVALID_INPUT", "ERROR_OUT_OF_MEMORY"} & set(type):
+                RENDER["errors"].append(f"the engine reported: {message}")
+            return self._eng.report(type, message)
+
+    def watched_render(self, depsgraph):
+        RENDER["calls"] += 1
+        RENDER["thread"] = threading.current_thread() is not threading.main_thread()
+        try:
+            return render(Reporting(self), depsgraph)
+        except Exception as e:
+            RENDER["errors"].append(f"render() raised {type(e).__name__}: {e}")
+            raise
+
+    cls.render = watched_render
+
+    def done(key):
+        def handler(*_):
+            RENDER[key] = True
+        return handler
+
+    bpy.app.handlers.render_complete.append(done("complete"))
+    bpy.app.handlers.render_cancel.append(done("cancel"))
+
+
+RENDER = {"calls": 0, "thread": None, "errors": [], "complete": False, "cancel": False}
+F12_SIZE = (64, 48)
+F12_SAMPLES = 4
+F12_TIMEOUT_S = 120
+
+
+def f12_steps(win, view3d, space, cam):
+    """F12 as in the UI: render.render('INVOKE_DEFAULT') from the window, which runs the
+    engine's render() in Blender's render job thread and opens the render view; then the Render
+    Result must show the sphere lit at its projected centre."""
+    space.shading.type = "SOLID"  # no preview runs meanwhile
+    t = time.monotonic()
+    while PLAY_RUNS["running"] and time.monotonic() - t < 30:
+        yield 0.5
+    scene = bpy.context.scene
+    scene.render.resolution_x, scene.render.resolution_y = F12_SIZE
+    scene.render.resolution_percentage = 100
+    scene.render.use_lock_interface = True  # as docs/BLENDER.md advises
+    scene.render.image_settings.file_format = "PNG"
+    scene.sunbeam.samples = F12_SAMPLES
+    watch_render()
+    yield
+    region = next(r for r in view3d.regions if r.type == "WINDOW")
+    start = time.monotonic()
+    with bpy.context.temp_override(window=win, area=view3d, region=region):
+        r = bpy.ops.render.render("INVOKE_DEFAULT")
+    if r != {"RUNNING_MODAL"}:
+        fail(f"render.render('INVOKE_DEFAULT') (F12): {r}")
+        return
+    while True:
+        yield 0.5
+        ended = RENDER["complete"] or RENDER["cancel"]
+        if ended and not bpy.app.is_job_running("RENDER"):
+            break
+        if time.monotonic() - start > F12_TIMEOUT_S:
+            fail(f"F12: the render job did not end within {F12_TIMEOUT_S} s (render() called "
+                 f"{RENDER['calls']} time(s), job running: {bpy.app.is_job_running('RENDER')})")
+            return
+    print(f"panel_screenshots: F12 render job ended after {time.monotonic() - start:.1f} s: "
+          f"{'completed' if RENDER['complete'] else 'cancelled'}, render() called {RENDER['calls']} "
+          f"time(s), in a thread other than the main one: {RENDER['thread']}")
+    if RENDER["cancel"] or not RENDER["complete"]:
+        fail("F12: the render job was cancelled (render_cancel), not completed")
+    if RENDER["calls"] != 1 or not RENDER["thread"]:
+        fail(f"F12: the engine's render() ran {RENDER['calls']} time(s), in the job thread: "
+             f"{RENDER['thread']} (want once, in the job thread)")
+    if RENDER["errors"]:
+        fail("F12: " + "; ".join(RENDER["errors"]))
+        return
+    result = bpy.data.images.get("Render Result")
+    if result is None:
+        fail("F12: no 'Render Result' image")
+        return
+    png = TMP / "f12.png"
+    result.save_render(filepath=str(png), scene=scene)
+    if not png.is_file():
+        fail("F12: Render Result's save_render wrote nothing")
+        return
+    w, h, rows = read_png(png)
+    if (w, h) != F12_SIZE:
+        fail(f"F12: the Render Result is {w} x {h}, not {F12_SIZE[0]} x {F12_SIZE[1]}")
+        return
+    from bpy_extras.object_utils import world_to_camera_view
+    from mathutils import Vector
+    c = world_to_camera_view(scene, cam, Vector((0, 0, 0)))  # from the bottom left, 0..1
+    cx, cy = int(round(c.x * w)), int(round((1.0 - c.y) * h))
+
+    def mean(x0, y0, n=8):
+        vals = [v for y in range(y0, y0 + n) for v in rows[y][3 * x0:3 * (x0 + n)]]
+        return sum(vals) / len(vals)
+
+    centre = mean(cx - 4, cy - 4)
+    corners = [mean(0, 0), mean(w - 8, 0), mean(0, h - 8), mean(w - 8, h - 8)]
+    print(f"panel_screenshots: F12 check: Render Result {w} x {h}, {F12_SAMPLES} samples; the "
+          f"sphere's centre at ({cx}, {cy}): mean of its 8 x 8 pixels {centre:.1f}, the corners' "
+          f"{', '.join(f'{v:.1f}' for v in corners)} (0..255, the view transform applied)")
+    if centre < max(corners) + 15:
+        fail(f"F12: the Render Result's sphere is not lit (centre {centre:.1f}, corners up to "
+             f"{max(corners):.1f}; want the centre >= 15 levels above every corner)")
 
 
 def check_viewport(rows, w, h, cx, cy, radius, view_box):

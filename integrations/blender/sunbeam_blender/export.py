@@ -10,6 +10,7 @@ import json
 import math
 import os
 import struct
+import threading
 from array import array
 
 import bpy
@@ -393,29 +394,59 @@ def _export_glb(depsgraph, obj, path):
 
     The scene and view layer come from `depsgraph`, not from bpy.context, which a final
     render's thread may not have: they are passed to the exporter by a context override, and
-    the selection it exports is set (and restored) on that view layer."""
+    the selection it exports is set (and restored) on that view layer. The exporter needs a
+    window (it sets the window's scene) and the active object, which the job thread of an F12
+    render in Blender's UI lacks, so there it runs on the main thread (a timer) and the render
+    waits for it."""
     scene, view_layer = depsgraph.scene, depsgraph.view_layer
-    selected = [o for o in view_layer.objects if o.select_get(view_layer=view_layer)]
-    try:
-        for o in selected:
-            o.select_set(False, view_layer=view_layer)
-        obj.select_set(True, view_layer=view_layer)
+
+    def export():
+        selected = [o for o in view_layer.objects if o.select_get(view_layer=view_layer)]
         try:
-            with bpy.context.temp_override(scene=scene, view_layer=view_layer):
-                bpy.ops.export_scene.gltf(
-                    filepath=path, export_format="GLB", use_selection=True, export_apply=True,
-                    export_yup=True, export_texcoords=True, export_normals=True,
-                    export_materials="NONE", export_cameras=False, export_lights=False,
-                    export_animations=False, export_skins=False, export_morph=False,
-                    export_extras=False, will_save_settings=False)
-        except RuntimeError as e:
-            raise SunbeamError(f"Object '{obj.name}': glTF export: {e}") from None
-    finally:
-        obj.select_set(False, view_layer=view_layer)
-        for o in selected:
-            o.select_set(True, view_layer=view_layer)
+            for o in selected:
+                o.select_set(False, view_layer=view_layer)
+            obj.select_set(True, view_layer=view_layer)
+            try:
+                with bpy.context.temp_override(scene=scene, view_layer=view_layer):
+                    bpy.ops.export_scene.gltf(
+                        filepath=path, export_format="GLB", use_selection=True, export_apply=True,
+                        export_yup=True, export_texcoords=True, export_normals=True,
+                        export_materials="NONE", export_cameras=False, export_lights=False,
+                        export_animations=False, export_skins=False, export_morph=False,
+                        export_extras=False, will_save_settings=False)
+            except RuntimeError as e:
+                raise SunbeamError(f"Object '{obj.name}': glTF export: {e}") from None
+        finally:
+            obj.select_set(False, view_layer=view_layer)
+            for o in selected:
+                o.select_set(True, view_layer=view_layer)
+
+    if threading.current_thread() is threading.main_thread() or bpy.app.background:
+        export()
+    else:
+        _on_main_thread(export)
     if not os.path.isfile(path):
         raise SunbeamError(f"Object '{obj.name}': the glTF exporter wrote nothing")
+
+
+def _on_main_thread(fn, timeout_s=600.0):
+    """Run `fn` in Blender's main thread (a one-shot timer) and wait for it; its exception is
+    raised here."""
+    done, box = threading.Event(), {}
+
+    def run():
+        try:
+            fn()
+        except BaseException as e:  # noqa: B036 - handed to the waiting thread
+            box["error"] = e
+        done.set()
+        return None
+
+    bpy.app.timers.register(run, first_interval=0.0)
+    if not done.wait(timeout_s):
+        raise SunbeamError(f"the glTF export did not run on Blender's main thread within {timeout_s:.0f} s")
+    if "error" in box:
+        raise box["error"]
 
 
 def bake(depsgraph, job, tmp, index, cancelled, out=None, warnings=None):
