@@ -36,6 +36,7 @@ test: deps
 	$(CARGO) build $(CARGO_FLAGS) --workspace --all-targets
 	$(CARGO) test $(CARGO_FLAGS) --workspace --no-fail-fast
 	SUNBEAM_BIN='$(BIN)' tests/blender/run.sh
+	tests/blender/panels_test.sh
 
 # The Blender add-on as an installable zip (docs/BLENDER.md), byte-identical for the same sources.
 BLENDER_ZIP ?= target/blender/sunbeam_blender.zip
@@ -48,7 +49,8 @@ blender-docs-img: deps
 	SUNBEAM_BIN='$(BIN)' SUNBEAM_BLENDER_IMG=docs/img tests/blender/run.sh RenderTest
 
 # docs/img/blender-panel-*.png: screenshots of the add-on's panels (docs/BLENDER.md), taken by
-# Blender's own executable (SUNBEAM_BLENDER, default blender) under xvfb-run; not in `make test`.
+# Blender's own executable (SUNBEAM_BLENDER, default blender) under xvfb-run; `make test` takes
+# them again and compares (tests/blender/panels_test.sh).
 blender-panels-img:
 	tests/blender/panel_screenshots.sh docs/img
 
