@@ -20,7 +20,8 @@ pub const MAX_LEVELS: usize = 16;
 /// Proposal samples per pixel per frame (the sun and the diffuse part take one each).
 pub const DEFAULT_ENV_SAMPLES: u32 = 1;
 
-/// Cells of the first-frame estimator's top cut (`--env-cells`), twice the
+/// Cells of the first-frame estimator's top cut (`--env-cells`) for a patch
+/// under 10 um (from 10 um: [`sunbeam_response::cells::first_frame_top`]), twice the
 /// CPU twin's [`sunbeam_response::cells::DEFAULT_TOP`]. On a 64 x 64 sphere
 /// (5 um pack, masked; the first frame 4 x 4 supersampled against two
 /// 64-sample reference seeds, 2026-11-27) the interior's CIEDE2000 p99 at
@@ -28,6 +29,18 @@ pub const DEFAULT_ENV_SAMPLES: u32 = 1;
 /// 1.66 under studio.exr and 2.58 / 1.98 / 1.20 under night.exr, at about
 /// 0.55 / 1 / 1.6 times the time (docs/LIGHTING.md "How many cells").
 pub const DEFAULT_ENV_CELLS: u64 = sunbeam_response::cells::FIRST_FRAME_TOP as u64;
+/// The cells' (top cut, levels) for `pack`: the top cut asked for, or the
+/// pack's own (`sunbeam_response::cells::first_frame_top_for`, from its
+/// patch's size).
+pub fn pack_cells(cells: (Option<usize>, usize), pack: &sunbeam_pack::Pack) -> (usize, usize) {
+    (
+        cells
+            .0
+            .unwrap_or_else(|| sunbeam_response::cells::first_frame_top_for(&pack.manifest)),
+        cells.1,
+    )
+}
+
 /// Levels kept below the top cut for views whose horizon a cell reaches.
 pub const ENV_CELLS_DEPTH: usize = sunbeam_response::cells::DEFAULT_DEPTH;
 /// The environment's hot spots as at most this many lights (`--env-hot-spots`).

@@ -53,15 +53,15 @@ fn f16_levels(levels: &[(usize, usize, Vec<f32>)]) -> Vec<(usize, usize, Vec<u16
 }
 
 /// Write the environment's files for `p` into `dir` (created if missing);
-/// `cells`: the top cut's cells and the levels below it (as the player's
-/// `--env-cells`); `hot_spots`: how a map's hot spots become lights (as the
+/// `cells`: the top cut's cells (none: each pack's own) and the levels below
+/// it (as the player's `--env-cells`); `hot_spots`: how a map's hot spots become lights (as the
 /// player's `--env-hot-spots`, `--env-hot-threshold`; the chain is then the
 /// rest).
 /// Returns the files written and notes (maps built).
 pub fn export(
     p: &Prepared,
     opts: &sunbeam_response::Options,
-    cells: (usize, usize),
+    cells: (Option<usize>, usize),
     hot_spots: sunbeam_light::hotspots::SplitOptions,
     dir: &Path,
 ) -> Result<(Vec<PathBuf>, Vec<String>)> {
@@ -155,6 +155,7 @@ pub fn export(
             sunbeam_response::env_file::Needs::ALL,
             &mut notes,
         )?;
+        let cells = crate::env::pack_cells(cells, pack);
         let c = environment::first_frame_cells(&er, &env, pack, path, mi, cells, &mut notes)?;
         let mut bits: Vec<u32> = c.data.iter().map(|v| v.to_bits()).collect();
         let w = CELLS_WIDTH.min(bits.len().max(1));

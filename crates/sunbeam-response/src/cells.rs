@@ -55,8 +55,35 @@ pub const DEFAULT_TOP: usize = 256;
 /// Levels below the top cut kept for views whose horizon a cell reaches.
 pub const DEFAULT_DEPTH: usize = 4;
 /// The top cut of the player's first frame and the engines' export
-/// (`--env-cells`), and what `sunbeam-pack --response` clusters by default.
+/// (`--env-cells`), and what `sunbeam-pack --response` clusters by default,
+/// for a patch smaller than [`LARGE_PATCH_M`] ([`first_frame_top`]).
 pub const FIRST_FRAME_TOP: usize = 512;
+/// The same for a patch of [`LARGE_PATCH_M`] or more.
+pub const FIRST_FRAME_TOP_LARGE: usize = 768;
+/// The patch size (its longer side) from which [`first_frame_top`] is
+/// [`FIRST_FRAME_TOP_LARGE`].
+pub const LARGE_PATCH_M: f64 = 10e-6;
+
+/// The top cut for a pack whose patch's longer side is `patch_m` metres:
+/// [`FIRST_FRAME_TOP`] below [`LARGE_PATCH_M`], [`FIRST_FRAME_TOP_LARGE`]
+/// from it. Measured against the quadrature at single shading points
+/// (benches/cells.rs, sky, CIEDE2000 p99, 2026-12-01): the thesis' 5 um
+/// patch 0.35 at 512 cells, 0.27 at 768 (1.44x the nodes: not worth it);
+/// a 20 um scan 4.85 at 512, 4.24 at 640, 1.78 at 768, 0.99 at 1024; its
+/// first frame p99 2.26 at 512, 1.57 at 768 (docs/LIGHTING.md "How many
+/// cells").
+pub fn first_frame_top(patch_m: f64) -> usize {
+    if patch_m >= LARGE_PATCH_M {
+        FIRST_FRAME_TOP_LARGE
+    } else {
+        FIRST_FRAME_TOP
+    }
+}
+
+/// [`first_frame_top`] for `manifest`'s pack.
+pub fn first_frame_top_for(manifest: &sunbeam_pack::Manifest) -> usize {
+    first_frame_top(manifest.patch.lx_m.max(manifest.patch.ly_m))
+}
 /// Floats per node in [`Cells::gpu_data`] before its layers' masses.
 pub const GPU_HEADER: usize = 5 + 18 + 3;
 /// Leaves whose centroid lies within this many of their widths of the view's

@@ -105,9 +105,11 @@ pub(crate) struct Cli {
     pub(crate) response_budget: usize,
     /// The first-frame cells written with --response beside the environment's
     /// maps as NAME.env-cells.ktx2, for these `sunbeam-play --env-cells` counts
-    /// (comma-separated, each 1..=4096; docs/PACK_FORMAT.md "Cells file"): the
-    /// player and the engines' export cluster any other count at start.
-    #[arg(long, value_name = "N[,N...]", value_delimiter = ',', default_values_t = [sunbeam_response::cells::FIRST_FRAME_TOP as u64], value_parser = clap::value_parser!(u64).range(1..=4096))]
+    /// (comma-separated, each 1..=4096; default: the player's default for
+    /// this pack, 512 for a patch under 10 um, 768 from it; docs/PACK_FORMAT.md
+    /// "Cells file"): the player and the engines' export cluster any other
+    /// count at start.
+    #[arg(long, value_name = "N[,N...]", value_delimiter = ',', value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub(crate) response_cells: Vec<u64>,
     /// Print a JSON report on stdout.
     #[arg(long)]

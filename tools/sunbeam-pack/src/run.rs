@@ -170,11 +170,19 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             let e = sunbeam_response::env_file::build(&pack, sky.as_ref(), &ro);
             let t_env = t.elapsed().as_secs_f64();
             let t = Instant::now();
-            let counts: Vec<(usize, usize)> = cli
-                .response_cells
-                .iter()
-                .map(|&n| (n as usize, sunbeam_response::cells::DEFAULT_DEPTH))
-                .collect();
+            let depth = sunbeam_response::cells::DEFAULT_DEPTH;
+            let counts: Vec<(usize, usize)> = if cli.response_cells.is_empty() {
+                // the player's default for this pack
+                vec![(
+                    sunbeam_response::cells::first_frame_top_for(&pack.manifest),
+                    depth,
+                )]
+            } else {
+                cli.response_cells
+                    .iter()
+                    .map(|&n| (n as usize, depth))
+                    .collect()
+            };
             let c = sunbeam_response::cells_file::build(&e, &counts);
             Some((r, t_point, e, t_env, c, t.elapsed().as_secs_f64()))
         }

@@ -153,3 +153,46 @@ fn bad_response_budget_is_a_usage_error() {
     }
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// Without `--response-cells` the cells file holds the player's default for
+/// the pack (docs/LIGHTING.md "How many cells"): 768 cells for a patch of
+/// 10 um or more, 512 below.
+#[test]
+fn the_default_cells_follow_the_patchs_size() {
+    let d = tmpdir("default-cells");
+    for (name, dx, want) in [("small", 25e-9, 512), ("large", 300e-9, 768)] {
+        // 40 x 32 texels: 1 um, or 12 um at 300 nm
+        let (w, h) = (40usize, 32usize);
+        let z: Vec<f64> = (0..w * h)
+            .map(|i| 150e-9 * ((i % w) as f64 * 0.9).sin())
+            .collect();
+        let f = HeightField::new(w, h, dx, dx, z).unwrap();
+        let hp = d.join(format!("{name}.exr"));
+        sunbeam_field::io::write(&hp, &f).unwrap();
+        let out = d.join(format!("{name}.ktx2"));
+        let (code, stdout, stderr) = pack(&[
+            hp.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--response",
+            "--response-lambda",
+            "16",
+            "--json",
+            "-q",
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        let cells =
+            sunbeam_response::cells_file::read(&out.with_extension("env-cells.ktx2")).unwrap();
+        let counts: Vec<usize> = cells.info.sets.iter().map(|s| s.cells).collect();
+        assert_eq!(counts, [want, want], "{name}");
+        let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        assert!(
+            report["response"]["cells"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|c| c["cells"] == want),
+            "{report}"
+        );
+    }
+}

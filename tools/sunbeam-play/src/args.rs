@@ -77,10 +77,11 @@ pub(crate) struct Cli {
     #[arg(long, value_enum, default_value_t = EnvEstimatorArg::Auto)]
     pub(crate) env_estimator: EnvEstimatorArg,
     /// Environment scenes, `--env-estimator cells`: cells every view visits
-    /// (1..4096; more: closer to the reference, slower; docs/LIGHTING.md
-    /// "How many cells").
-    #[arg(long, default_value_t = sunbeam_render::env::DEFAULT_ENV_CELLS, value_parser = clap::value_parser!(u64).range(1..=4096))]
-    pub(crate) env_cells: u64,
+    /// (1..4096; more: closer to the reference, slower; default: each pack's
+    /// own, 512 for a patch under 10 um, 768 from it; docs/LIGHTING.md "How
+    /// many cells").
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=4096))]
+    pub(crate) env_cells: Option<u64>,
     /// Environment scenes, `--env-estimator cells`: the map's hot spots (its
     /// lamps, softboxes) as at most this many small lights through the maps,
     /// the rest for the cells (0..=256; 0: none; docs/LIGHTING.md "The first

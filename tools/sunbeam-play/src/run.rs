@@ -133,7 +133,10 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
         env_hot_spots: cli.env_hot_spots as usize,
         env_hot_threshold: cli.env_hot_threshold,
         env_cells_rate: cli.env_cells_rate,
-        env_cells: (cli.env_cells as usize, sunbeam_render::env::ENV_CELLS_DEPTH),
+        env_cells: (
+            cli.env_cells.map(|n| n as usize),
+            sunbeam_render::env::ENV_CELLS_DEPTH,
+        ),
         ..Default::default()
     })
 }
@@ -215,7 +218,19 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
         }
         .into();
         if st.env_estimator == EnvEstimator::Cells {
-            report["env_cells"] = st.env_cells.0.into();
+            // each pack's top cut (the first pack's as the number)
+            let counts: Vec<usize> = prepared
+                .meshes
+                .iter()
+                .filter_map(|(_, m)| m.pack.as_ref())
+                .map(|p| sunbeam_render::env::pack_cells(st.env_cells, p).0)
+                .collect();
+            if let Some(&first) = counts.first() {
+                report["env_cells"] = first.into();
+                if counts.iter().any(|&c| c != first) {
+                    report["env_cells_per_pack"] = counts.into();
+                }
+            }
         }
     }
     if let Some((line, c)) = sunbeam_frame::environment_clamped_warning(&prepared) {

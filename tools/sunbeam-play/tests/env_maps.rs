@@ -182,3 +182,60 @@ fn the_pipelines_cells_are_read_clustered_when_missing_refused_when_damaged() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(!d.join("bad.exr").exists());
 }
+
+/// The default count follows the pack (docs/LIGHTING.md "How many cells"):
+/// a patch of 10 um or more takes 768 cells, a smaller one 512, in the
+/// pipeline's cells file (`sunbeam-pack --response` with no
+/// `--response-cells`) and in the player alike, so the player reads the file
+/// and clusters nothing.
+#[test]
+fn the_default_cells_follow_the_patchs_size() {
+    if !gpu_available() {
+        return;
+    }
+    let d = scratch("play-env-cells-default");
+    let small = pack(&d, "x", "xenopeltis");
+    // 512 px of 20 nm: 10.24 um
+    let h = d.join("big.exr");
+    common::ok(Command::new(common::tool("sunbeam-import")).args([
+        "synthetic:xenopeltis",
+        "--synthetic-size",
+        "512",
+        "--synthetic-pixel",
+        "20nm",
+        "-q",
+        "-o",
+        h.to_str().unwrap(),
+    ]));
+    let big = d.join("big.ktx2");
+    common::ok(
+        Command::new(common::tool("sunbeam-pack"))
+            .arg(&h)
+            .arg("-o")
+            .arg(&big)
+            .args(["--response", "-q"]),
+    );
+    for (p, want) in [(&small, 512), (&big, 768)] {
+        let o = Command::new(BIN)
+            .args(["--mesh", "builtin:sphere", "--pack"])
+            .arg(p)
+            .args([
+                "--headless",
+                "--size",
+                "16x16",
+                "--env-estimator",
+                "cells",
+                "--json",
+                "-o",
+            ])
+            .arg(d.join("f.exr"))
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert!(o.status.success(), "{err}");
+        assert!(!err.contains(CLUSTERED), "{p:?}: clustered at start: {err}");
+        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(r["env_cells"], want, "{p:?}: {r}");
+    }
+}

@@ -59,7 +59,7 @@ pub(super) fn maps(
     path: Option<&Path>,
     mi: usize,
     opts: &sunbeam_response::Options,
-    cells: (usize, usize),
+    cells: (Option<usize>, usize),
     estimator: crate::env::EnvEstimator,
     built: &mut BuiltMaps,
     notes: &mut Vec<String>,
@@ -69,6 +69,7 @@ pub(super) fn maps(
     if let Some((_, m)) = built.iter().find(|(k, _)| *k == key) {
         return Ok(m.clone());
     }
+    let cells = crate::env::pack_cells(cells, pack);
     // The first frame with the pipeline's cells: under the sky it needs no
     // basis map (its sun has its own map, the sky no hot spots) and never the
     // proposal, so only the sun's map is read (docs/bench/play.md "Start-up").

@@ -183,9 +183,10 @@ pub struct Settings {
     pub env_samples: u32,
     /// Environment: the first-frame cells or progressive Monte Carlo.
     pub env_estimator: crate::env::EnvEstimator,
-    /// Environment, cells estimator: the top cut's cells and the levels kept
-    /// below it (sunbeam_response::cells).
-    pub env_cells: (usize, usize),
+    /// Environment, cells estimator: the top cut's cells (none: each pack's
+    /// own, `sunbeam_response::cells::first_frame_top_for`) and the levels
+    /// kept below it (sunbeam_response::cells).
+    pub env_cells: (Option<usize>, usize),
     /// Environment, cells estimator: the map's hot spots pulled out as at most
     /// this many lights (sunbeam_light::hotspots; 0: none).
     pub env_hot_spots: usize,
@@ -227,7 +228,7 @@ impl Default for Settings {
             env_samples: crate::env::DEFAULT_ENV_SAMPLES,
             env_estimator: crate::env::EnvEstimator::default(),
             env_cells: (
-                sunbeam_response::cells::DEFAULT_TOP,
+                Some(sunbeam_response::cells::DEFAULT_TOP),
                 sunbeam_response::cells::DEFAULT_DEPTH,
             ),
             env_hot_spots: crate::env::DEFAULT_ENV_HOT_SPOTS,
