@@ -45,6 +45,7 @@ ROOT = Path(__file__).resolve().parents[2]
 ADDON_DIR = ROOT / "integrations" / "blender"
 ADDON = "sunbeam_blender"
 SETTLE_S = 1.5  # seconds for the window to redraw after a change, before a screenshot
+HIGHLIGHT_TRIES = 6  # pointer moves onto the import menu's last entry before giving up
 VIEWPORT_TIMEOUT_S = 120  # for the engine's first viewport frame
 VIEWPORT_PNG = "blender-viewport-rendered.png"
 
@@ -326,14 +327,24 @@ def steps():
         fail("File > Import: the menu did not appear in the screenshot")
         return
     # Move the pointer onto the add-on's entry, the last one, which highlights it (Blender's
-    # window coordinates count from the bottom).
+    # window coordinates count from the bottom). A busy machine may draw the menu before it
+    # takes the move (CI once got the menu without the highlight): move again and take the
+    # screenshot again until the entry's rows differ from the menu's first picture.
     x0, y0, x1, y1 = box
-    win.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x0 + 80, y=h - (y1 - 16))
-    yield
+    _, _, menu = read_png(first)
+    entry = range(max(y0, y1 - 24), y1 - 8)
     after = TMP / "after.png"
-    with bpy.context.temp_override(window=win):
-        bpy.ops.screen.screenshot(filepath=str(after))
-    w, h, b = read_png(after)
+    for attempt in range(HIGHLIGHT_TRIES):
+        win.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x0 + 80 + attempt % 2, y=h - (y1 - 16))
+        yield
+        with bpy.context.temp_override(window=win):
+            bpy.ops.screen.screenshot(filepath=str(after))
+        w, h, b = read_png(after)
+        if any(b[y] != menu[y] for y in entry):
+            print(f"panel_screenshots: import menu entry highlighted after {attempt + 1} pointer move(s)")
+            break
+    else:
+        fail(f"File > Import: the add-on's entry was not highlighted after {HIGHLIGHT_TRIES} pointer moves")
     box = changed_box(a, b)
     x0, y0, x1, y1 = box
     m = 8
