@@ -87,8 +87,19 @@ pub fn ridges(d: &Path) {
 }
 
 /// render.mjs on the scene file `scene`: the linear frame (also written as
-/// `d`/NAME.exr and NAME.png).
+/// `d`/NAME.exr and NAME.png), 4 x 4 supersampled (render.mjs's default).
 pub fn threejs_frame(render: &Path, d: &Path, scene: &Path, name: &str) -> LinearImage {
+    threejs_frame_at(render, d, scene, name, 4)
+}
+
+/// [`threejs_frame`] at `--supersample K`.
+pub fn threejs_frame_at(
+    render: &Path,
+    d: &Path,
+    scene: &Path,
+    name: &str,
+    supersample: u32,
+) -> LinearImage {
     let (png, exr) = (d.join(format!("{name}.png")), d.join(format!("{name}.exr")));
     run_ok(
         Command::new("node")
@@ -98,6 +109,7 @@ pub fn threejs_frame(render: &Path, d: &Path, scene: &Path, name: &str) -> Linea
             .arg(&png)
             .arg("--exr")
             .arg(&exr)
+            .args(["--supersample", &supersample.to_string()])
             .env("SUNBEAM_PLAY", tool("sunbeam-play")),
     );
     assert!(png.is_file());
@@ -131,10 +143,11 @@ pub fn reference_frame_at(scene: &Path, out: &Path, samples: u32) -> LinearImage
 /// `ref_scene` (written into `d` as NAME.json and NAME-ref.json): the
 /// difference over lit pixels.
 pub fn measure(render: &Path, d: &Path, scene: &str, ref_scene: &str, name: &str) -> ColourDiff {
-    measure_at(render, d, scene, ref_scene, name, 16)
+    measure_at(render, d, scene, ref_scene, name, 16, 4)
 }
 
-/// [`measure`] with the reference at `samples` per pixel.
+/// [`measure`] with the reference at `samples` per pixel and render.mjs at
+/// `--supersample supersample`.
 pub fn measure_at(
     render: &Path,
     d: &Path,
@@ -142,12 +155,13 @@ pub fn measure_at(
     ref_scene: &str,
     name: &str,
     samples: u32,
+    supersample: u32,
 ) -> ColourDiff {
     let s = d.join(format!("{name}.json"));
     std::fs::write(&s, scene).unwrap();
     let rs = d.join(format!("{name}-ref.json"));
     std::fs::write(&rs, ref_scene).unwrap();
-    let a = threejs_frame(render, d, &s, name);
+    let a = threejs_frame_at(render, d, &s, name, supersample);
     let r = reference_frame_at(&rs, &d.join(format!("{name}-ref.exr")), samples);
     let c = compare_linear(&a, &r).unwrap();
     eprintln!("three.js {name}: {c}");
