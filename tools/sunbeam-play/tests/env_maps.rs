@@ -195,14 +195,15 @@ fn the_default_cells_follow_the_patchs_size() {
     }
     let d = scratch("play-env-cells-default");
     let small = pack(&d, "x", "xenopeltis");
-    // 512 px of 20 nm: 10.24 um
+    // 256 px of 40 nm: 10.24 um (a quarter of the pack's time of 512 px
+    // of 20 nm; the count follows the patch's size, not its pixels)
     let h = d.join("big.exr");
     common::ok(Command::new(common::tool("sunbeam-import")).args([
         "synthetic:xenopeltis",
         "--synthetic-size",
-        "512",
+        "256",
         "--synthetic-pixel",
-        "20nm",
+        "40nm",
         "-q",
         "-o",
         h.to_str().unwrap(),
