@@ -79,10 +79,23 @@ pub fn d65_y_norm(range_nm: (u32, u32)) -> f64 {
 /// The colour integral at 1 nm: `sum R(l) S(l) cmf(l) / sum S(l) ybar(l)` over
 /// `range_nm` (inclusive), `r` called with the wavelength in metres. `R = 1`
 /// gives the D65 white point of that range with `Y = 1` exactly.
-pub fn integrate_xyz_1nm(range_nm: (u32, u32), mut r: impl FnMut(f64) -> f64) -> [f64; 3] {
+pub fn integrate_xyz_1nm(range_nm: (u32, u32), r: impl FnMut(f64) -> f64) -> [f64; 3] {
+    integrate_xyz_nm_step(range_nm, 1, r)
+}
+
+/// [`integrate_xyz_1nm`] over every `step_nm`-th row of the 1 nm tables
+/// (`lo, lo + step, ...` up to `hi`; step 1 is [`integrate_xyz_1nm`]): the
+/// normaliser sums the same rows, so `R = 1` still gives `Y = 1` exactly. For a
+/// reflectance smooth at the step's scale (the reference's adaptive step,
+/// docs/EVAL.md "Wavelength step").
+pub fn integrate_xyz_nm_step(
+    range_nm: (u32, u32),
+    step_nm: u32,
+    mut r: impl FnMut(f64) -> f64,
+) -> [f64; 3] {
     let mut acc = [0.0f64; 3];
     let mut norm = 0.0;
-    for nm in range_nm.0..=range_nm.1 {
+    for nm in (range_nm.0..=range_nm.1).step_by(step_nm.max(1) as usize) {
         let s = d65_nm(nm);
         let c = cmf_nm(nm);
         norm += s * c[1];

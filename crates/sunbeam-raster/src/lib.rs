@@ -47,6 +47,11 @@ pub struct Options {
     /// of `sunbeam_optics::cie::integrate_xyz_1nm` over 380..=780 nm; Some(n) = the
     /// n midpoint samples the player uses (`spectral::Samples::uniform`).
     pub lambda_samples: Option<usize>,
+    /// With `lambda_samples` None: the step of the reference sum in nm (1 = every
+    /// row of the 1 nm tables); None = [`shade::wavelength_step_nm`]'s, from 1
+    /// nm where R varies fast to 5 nm where it cannot (docs/EVAL.md
+    /// "Wavelength step").
+    pub lambda_step_nm: Option<u32>,
     /// Tone curve after exposure (the scene's `exposure`).
     pub curve: ToneCurve,
     /// Worker threads (0 = available parallelism). The image does not depend on it.

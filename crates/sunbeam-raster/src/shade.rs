@@ -5,6 +5,7 @@
 //! n = normalize(N), t = normalize(T - n (n.T)), b = n x t
 //! wi = light direction, wr = normalize(eye - p); local d' = (d.t, d.b, d.n)
 //! diffraction XYZ = G(wi', wr') * sum_l R_U(u, v, w, l) weight(l)   (0 unless wi'.z > 0 and wr'.z > 0)
+//! (l every 1 to 5 nm by where R varies: [`wavelength_step_nm`])
 //! rgb += intensity * ( dw * base * max(wi'.z, 0) (1 - F(th_i)) + (1 - dw) * M_srgb XYZ )
 //! ```
 //! with `(u, v, w) = -wi' - wr'`, `G` the mesh's skin's (absolute by default,
@@ -60,10 +61,48 @@ pub fn frame(normal: [f64; 3], tangent: [f64; 3]) -> Option<([f64; 3], [f64; 3],
     Some((t, cross(n, t), n))
 }
 
+/// The reference's wavelength step at `(u, v, w)` (docs/EVAL.md "Wavelength
+/// step"): the largest of 5, 4, 2 and 1 nm
+/// over which R moves by at most half a cycle of its fastest variation at the
+/// shortest wavelength. R is the power of an amplitude sampled on the pack's
+/// frequency lattice at `kappa = u L / lambda` bins, whose window is one patch
+/// wide, so R varies at most once per bin, and of `exp(i t h)` with `|h| <= 1`,
+/// `t = 2 pi |w| H / lambda`, so at most once per `pi` of `t`. A step `dl`
+/// moves them by `kappa dl / lambda` bins and `t dl / lambda`: half a cycle at
+/// 380 nm is `dl = lmin^2 / (2 (max(|u| Lx, |v| Ly) + 2 |w| H))`. Real-size
+/// packs (20 um and up) keep the 1 nm sum at large `|u|`; a 5 um patch's
+/// first orders get 5 nm. The tiled model keeps 1 nm everywhere: its orders
+/// are Gaussians as narrow as the coherence length is long (0.01 bins for
+/// a 5 um patch at 65 um), far below 1 nm (5 nm moved one by CIEDE2000
+/// 0.059).
+pub fn wavelength_step_nm(m: &sunbeam_pack::manifest::Manifest, u: f64, v: f64, w: f64) -> u32 {
+    if m.model != sunbeam_pack::manifest::Model::Window {
+        return 1;
+    }
+    let lmin = cie::DEFAULT_RANGE_NM.0 as f64 * 1e-9;
+    let len = (u.abs() * m.bin_scale_m[0]).max(v.abs() * m.bin_scale_m[1])
+        + 2.0 * w.abs() * m.height_half_range_m;
+    let step_nm = 0.5 * lmin * lmin / len / 1e-9;
+    if !step_nm.is_finite() {
+        return if len > 0.0 { 1 } else { WAVELENGTH_STEPS_NM[0] };
+    }
+    WAVELENGTH_STEPS_NM
+        .into_iter()
+        .find(|&s| s as f64 <= step_nm)
+        .unwrap_or(1)
+}
+
+/// The steps [`wavelength_step_nm`] picks from, largest first: each divides
+/// the 400 nm of 380..=780, so every step sums rows that include both ends;
+/// none above the CIE's own 5 nm tables, where D65's lines would shift the
+/// white (10 nm moves a grazing mirror's colour by CIEDE2000 0.055).
+const WAVELENGTH_STEPS_NM: [u32; 4] = [5, 4, 2, 1];
+
 /// The reference shader of a prepared scene.
 pub struct Shader<'a> {
     p: &'a Prepared,
     samples: Option<Samples>,
+    lambda_step_nm: Option<u32>,
     tone: ToneMap,
 }
 
@@ -74,6 +113,7 @@ impl<'a> Shader<'a> {
             samples: opts
                 .lambda_samples
                 .map(|n| Samples::uniform(n, cie::DEFAULT_RANGE_NM)),
+            lambda_step_nm: opts.lambda_step_nm,
             tone: ToneMap {
                 exposure_ev: p.scene.exposure,
                 curve: opts.curve,
@@ -92,7 +132,12 @@ impl<'a> Shader<'a> {
         let (u, v, w) = (-wi[0] - wr[0], -wi[1] - wr[1], -wi[2] - wr[2]);
         let r = |l: f64| pack.shading_reflectance(u, v, w, l);
         let xyz = match &self.samples {
-            None => cie::integrate_xyz_1nm(cie::DEFAULT_RANGE_NM, r),
+            None => {
+                let step = self
+                    .lambda_step_nm
+                    .unwrap_or_else(|| wavelength_step_nm(&pack.manifest, u, v, w));
+                cie::integrate_xyz_nm_step(cie::DEFAULT_RANGE_NM, step, r)
+            }
             Some(s) => s.integrate(r),
         };
         let mat = &self.p.meshes[mi].1;

@@ -246,6 +246,11 @@ pub(crate) struct RenderArgs {
     /// docs/LIGHTING.md "The reference's estimator".
     #[arg(long, default_value = "quadrature", value_parser = clap::builder::PossibleValuesParser::new(["quadrature", "monte-carlo"]))]
     pub(crate) env_estimator: String,
+    /// Wavelength step of the colour integral under point lights, in nm (1: every
+    /// row of the 1 nm CIE tables; default: from 1 to 5 nm by how fast the
+    /// pack's R can vary there, docs/EVAL.md "Wavelength step").
+    #[arg(long, value_name = "NM", value_parser = clap::value_parser!(u32).range(1..=10))]
+    pub(crate) lambda_step: Option<u32>,
     /// A turntable of N frames: the camera orbits the target about its `up`
     /// axis (lights and environment stay); -o FILE.png is an animated PNG.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=720))]

@@ -56,6 +56,7 @@ pub fn run(a: &crate::args::RenderArgs, quiet: bool) -> Result<()> {
         .unwrap_or(if scene.environment.is_some() { 16 } else { 1 });
     let opts = sunbeam_raster::Options {
         samples,
+        lambda_step_nm: a.lambda_step,
         seed: a.seed[0],
         estimator: match a.env_estimator.as_str() {
             "monte-carlo" => sunbeam_raster::environment::EnvEstimator::MonteCarlo,
