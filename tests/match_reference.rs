@@ -211,7 +211,7 @@ fn lambert_mode_is_the_closed_form() {
 /// A front-lit sphere filling the frame, shaded with a synthetic snake-skin ridge
 /// field (443 nm tall, 1.55 um period, rough) of `n^2` pixels of `pixel` metres:
 /// the player (response map, MSAA, footprint filter) against the anti-aliased
-/// CPU reference (`--samples 16`, 1 nm colour integral), both in linear light,
+/// CPU reference (`--samples 16`, the 1 nm tables every 1-5 nm), both in linear light,
 /// CIEDE2000 over lit pixels (issue 11: anti-aliased p99 < 1, max < 5; the
 /// player's own 1x frame p99 < 2).
 fn response_map_at_scale(name: &str, n: usize, pixel: f64) {

@@ -6,8 +6,9 @@
 //! XYZ = integral R S [xbar, ybar, zbar] dlambda / integral S ybar dlambda
 //! ```
 //!
-//! evaluated as a sum at 1 nm steps (the reference) so that `R = 1` gives the
-//! D65 white with `Y = 1` exactly.
+//! evaluated as a sum over the 1 nm rows (the reference; every `step`-th row
+//! where R is smooth enough: [`integrate_xyz_nm_step`]) so that `R = 1` gives
+//! the D65 white with `Y = 1` exactly.
 
 use crate::cie_data;
 
