@@ -286,20 +286,38 @@ fn ninja_and_make_plan_the_same_environments() {
     }
 }
 
-/// Process group of a process, from /proc (Linux).
+/// Process group and state of a process, from /proc (Linux).
 fn pgrp_of(pid: &str) -> Option<u32> {
-    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
-    // "pid (comm) state ppid pgrp ...": fields after the last ')'.
-    stat.rsplit_once(')')?
-        .1
-        .split_whitespace()
-        .nth(2)?
-        .parse()
-        .ok()
+    stat_of(pid).map(|(pgrp, _)| pgrp)
 }
 
-/// SIGKILL every process of the group `pgid` (make and the tool it runs), one by
-/// one by id; never our own group.
+/// `(pgrp, state)` of a process from /proc/PID/stat ("pid (comm) state ppid
+/// pgrp ...": fields after the last ')').
+fn stat_of(pid: &str) -> Option<(u32, char)> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let mut f = stat.rsplit_once(')')?.1.split_whitespace();
+    let state = f.next()?.chars().next()?;
+    let pgrp = f.nth(1)?.parse().ok()?;
+    Some((pgrp, state))
+}
+
+/// Live (not zombie) processes of the group `pgid`.
+fn group_members(pgid: u32) -> Vec<String> {
+    std::fs::read_dir("/proc")
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.bytes().all(|b| b.is_ascii_digit()))
+        .filter(|n| matches!(stat_of(n), Some((g, st)) if g == pgid && st != 'Z'))
+        .collect()
+}
+
+/// SIGKILL the process group `pgid` (make and the tools it runs) with one
+/// signal to the group (`kill -KILL -- -PGID`), never our own group, and wait
+/// until none of it runs. One signal reaches every member, and a fork racing
+/// with it fails; a kill per listed process missed the child make forked
+/// between the listing and its own death (a pack ran on, and its temp file
+/// appeared during the rerun: CI, 2026-12-02).
 fn kill_group(pgid: u32) {
     let own = pgrp_of("self");
     assert_ne!(
@@ -307,16 +325,18 @@ fn kill_group(pgid: u32) {
         Some(pgid),
         "refusing to kill the test's own process group"
     );
-    let pids: Vec<String> = std::fs::read_dir("/proc")
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.bytes().all(|b| b.is_ascii_digit()))
-        .filter(|n| pgrp_of(n) == Some(pgid))
-        .collect();
-    for pid in pids {
-        let _ = Command::new("kill").args(["-KILL", &pid]).status();
+    let _ = Command::new("kill")
+        .args(["-KILL", "--", &format!("-{pgid}")])
+        .status();
+    let t = Instant::now();
+    while !group_members(pgid).is_empty() && t.elapsed() < Duration::from_secs(10) {
+        std::thread::sleep(Duration::from_millis(10));
     }
+    let left = group_members(pgid);
+    assert!(
+        left.is_empty(),
+        "processes of group {pgid} still run: {left:?}"
+    );
 }
 
 fn ktx2_complete(path: &Path) -> bool {
