@@ -78,6 +78,8 @@ pub fn run(a: &crate::args::RenderArgs, quiet: bool) -> Result<()> {
         "tool": "sunbeam-eval render",
         "output": a.output.display().to_string(),
         "samples": samples,
+        // null: the adaptive step (docs/EVAL.md "Wavelength step")
+        "lambda_step_nm": a.lambda_step,
     });
     if let Some((line, c)) = sunbeam_raster::environment_clamped_warning(&prepared) {
         if !quiet {

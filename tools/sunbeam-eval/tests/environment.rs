@@ -303,3 +303,37 @@ fn real_hdri_negatives_are_counted_and_warned_once() {
     assert!(!String::from_utf8_lossy(&o.stderr).contains("warning"));
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `--lambda-step NM` (docs/EVAL.md "Wavelength step"): the `--json` report
+/// names the step (null: the adaptive one); 0 and 11 are usage errors (exit
+/// 1, DESIGN.md's codes) naming the flag, with no output.
+#[test]
+fn lambda_step_is_reported_and_checked() {
+    let d = std::env::temp_dir().join(format!("sb-eval-step-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let s = d.join("sky.json");
+    std::fs::write(
+        &s,
+        scene(r#"{ "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 120, "turbidity": 3 }, "intensity": 1 }"#),
+    )
+    .unwrap();
+    for (extra, want) in [
+        (vec!["--lambda-step", "2"], serde_json::json!(2)),
+        (vec![], serde_json::Value::Null),
+    ] {
+        let mut args = vec!["--samples", "1", "--json"];
+        args.extend(extra);
+        let o = render(&s, &d.join("ok.png"), &args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(r["lambda_step_nm"], want, "{r}");
+    }
+    for bad in ["0", "11"] {
+        let out = d.join(format!("bad-{bad}.png"));
+        let o = render(&s, &out, &["--lambda-step", bad]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "--lambda-step {bad}: {err}");
+        assert!(err.contains("--lambda-step"), "{err}");
+        assert!(!out.exists(), "--lambda-step {bad} wrote {}", out.display());
+    }
+}
