@@ -9,6 +9,7 @@
 
 mod common;
 
+use common::pack_of;
 use std::f64::consts::PI;
 use std::sync::{Arc, OnceLock};
 use sunbeam_common::rng::SplitMix64;
@@ -16,8 +17,7 @@ use sunbeam_light::{daylight, sky::Sky, EnvMap, Environment};
 use sunbeam_optics::colour;
 use sunbeam_optics::gain::Material;
 use sunbeam_optics::masking::Masking;
-use sunbeam_pack::build::{BuildOptions, FieldRef};
-use sunbeam_pack::Pack;
+use sunbeam_pack::{Model, Pack};
 use sunbeam_raster::environment::EnvShader;
 use sunbeam_response::env::{build_env, EnvResponse, Frame};
 use sunbeam_response::{Options, Proposal, Response};
@@ -33,22 +33,18 @@ fn ridges(n: usize, dx: f64, period: f64, amp: f64) -> Vec<f64> {
         .collect()
 }
 
-fn pack_of(n: usize, dx: f64, data: &[f64]) -> Arc<Pack> {
-    let f = FieldRef {
-        width: n,
-        height: n,
-        dx,
-        dy: dx,
-        data,
-    };
-    Arc::new(sunbeam_pack::build(f, &BuildOptions::default(), &mut |_, _| {}).unwrap())
-}
-
 /// The 3.2 um, 1.3 um period ridge patch of docs/LIGHTING.md "Noise".
 fn ridge_pack() -> Arc<Pack> {
     static P: OnceLock<Arc<Pack>> = OnceLock::new();
-    P.get_or_init(|| pack_of(32, 0.1e-6, &ridges(32, 0.1e-6, 1.3e-6, 0.3e-6)))
-        .clone()
+    P.get_or_init(|| {
+        pack_of(
+            32,
+            0.1e-6,
+            &ridges(32, 0.1e-6, 1.3e-6, 0.3e-6),
+            Model::Window,
+        )
+    })
+    .clone()
 }
 
 fn sky() -> Environment {
@@ -135,8 +131,13 @@ fn r_maps(pack: &Pack, env: &Environment, o: &Options) -> Vec<Response> {
 /// `R` maps' integral (measured 0.990 of the light).
 #[test]
 fn parseval_the_maps_integrate_to_the_light() {
-    let flat = pack_of(32, 0.2e-6, &[0.0; 32 * 32]);
-    let ridge = pack_of(48, 0.125e-6, &ridges(48, 0.125e-6, 2.0e-6, 0.1e-6));
+    let flat = pack_of(32, 0.2e-6, &[0.0; 32 * 32], Model::Window);
+    let ridge = pack_of(
+        48,
+        0.125e-6,
+        &ridges(48, 0.125e-6, 2.0e-6, 0.1e-6),
+        Model::Window,
+    );
     let want_sky = daylight::basis_xyz().map(|b| b[1]);
     let w = -1.2;
     for (name, pack) in [("flat", flat), ("ridge", ridge)] {

@@ -8,13 +8,13 @@
 
 mod common;
 
-use common::{narrow_flat_pack, Kirchhoff};
+use common::{narrow_flat_pack, pack_of, Kirchhoff};
 use std::f64::consts::PI;
 use std::sync::Arc;
 use sunbeam_light::{sky::Sky, EnvMap, Environment};
 use sunbeam_optics::truth::{Params, Truth};
 use sunbeam_optics::{cie, colour, gain};
-use sunbeam_pack::{build::BuildOptions, FieldRef, Model, Pack};
+use sunbeam_pack::Model;
 use sunbeam_raster::environment::{EnvEstimator, EnvShader, Frame};
 use sunbeam_raster::{compare_linear, fixtures, render_prepared_linear, LinearImage, Options};
 
@@ -27,21 +27,6 @@ fn ridges(n: usize, dx: f64, period: f64, amp: f64) -> Vec<f64> {
             0.5 * amp * (1.0 + (2.0 * PI * (i * dx) / period + 0.3 * (0.7 * j).sin()).sin())
         })
         .collect()
-}
-
-fn pack_of(n: usize, dx: f64, data: &[f64], model: Model) -> Arc<Pack> {
-    let f = FieldRef {
-        width: n,
-        height: n,
-        dx,
-        dy: dx,
-        data,
-    };
-    let opts = BuildOptions {
-        model,
-        ..BuildOptions::default()
-    };
-    Arc::new(sunbeam_pack::build(f, &opts, &mut |_, _| {}).unwrap())
 }
 
 /// The estimator's mean XYZ over `m` samples at one shading point (frame `f`,

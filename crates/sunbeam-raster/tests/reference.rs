@@ -298,7 +298,7 @@ fn lens_shift_matches_a_pinhole_model() {
 /// would save little (the tiled model keeps 1 nm).
 #[test]
 fn adaptive_wavelength_step_matches_the_1nm_sum() {
-    use sunbeam_pack::{build::BuildOptions, FieldRef, Model};
+    use sunbeam_pack::Model;
     let (n, dx) = (256usize, 20e-9);
     let data: Vec<f64> = (0..n * n)
         .map(|k| {
@@ -311,18 +311,7 @@ fn adaptive_wavelength_step_matches_the_1nm_sum() {
     let mut worst: f64 = 0.0;
     let (mut steps, mut points) = (0u64, 0u64);
     for model in [Model::Window, Model::Tiled] {
-        let f = FieldRef {
-            width: n,
-            height: n,
-            dx,
-            dy: dx,
-            data: &data,
-        };
-        let opts = BuildOptions {
-            model,
-            ..BuildOptions::default()
-        };
-        let pack = Arc::new(sunbeam_pack::build(f, &opts, &mut |_, _| {}).unwrap());
+        let pack = common::pack_of(n, dx, &data, model);
         let mut p = fixtures::prepared(scene.clone(), mesh.clone(), Some(pack.clone()));
         p.meshes[0].1.skin = sunbeam_optics::gain::Material::RELATIVE;
         let adaptive = shade::Shader::new(&p, &Options::default());

@@ -31,9 +31,10 @@ fn scene(env: &str) -> String {
     )
 }
 
-#[test]
-fn sky_scene_renders_and_bad_environments_are_refused() {
-    let d = std::env::temp_dir().join(format!("sb-eval-env-{}", std::process::id()));
+/// A scratch folder `sb-eval-TAG-PID` holding `sky.json`: [`scene`] under
+/// the sky (sun at 35 degrees): the folder and the scene file.
+fn sky_scene_in(tag: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+    let d = std::env::temp_dir().join(format!("sb-eval-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     let s = d.join("sky.json");
     std::fs::write(
@@ -41,6 +42,12 @@ fn sky_scene_renders_and_bad_environments_are_refused() {
         scene(r#"{ "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 120, "turbidity": 3 }, "intensity": 1 }"#),
     )
     .unwrap();
+    (d, s)
+}
+
+#[test]
+fn sky_scene_renders_and_bad_environments_are_refused() {
+    let (d, s) = sky_scene_in("env");
     let (a, b) = (d.join("a.exr"), d.join("b.exr"));
     for out in [&a, &b] {
         let o = render(&s, out, &[MC, MC_NAME, "--samples", "4", "--seed", "7"]);
@@ -309,14 +316,7 @@ fn real_hdri_negatives_are_counted_and_warned_once() {
 /// 1, DESIGN.md's codes) naming the flag, with no output.
 #[test]
 fn lambda_step_is_reported_and_checked() {
-    let d = std::env::temp_dir().join(format!("sb-eval-step-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    let s = d.join("sky.json");
-    std::fs::write(
-        &s,
-        scene(r#"{ "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 120, "turbidity": 3 }, "intensity": 1 }"#),
-    )
-    .unwrap();
+    let (d, s) = sky_scene_in("step");
     for (extra, want) in [
         (vec!["--lambda-step", "2"], serde_json::json!(2)),
         (vec![], serde_json::Value::Null),

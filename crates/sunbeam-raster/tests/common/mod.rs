@@ -108,6 +108,28 @@ impl Kirchhoff {
     }
 }
 
+/// The pack of an `n x n` height field of `dx` (metres) under `model`, the
+/// other build options at their defaults.
+pub fn pack_of(
+    n: usize,
+    dx: f64,
+    data: &[f64],
+    model: sunbeam_pack::Model,
+) -> std::sync::Arc<sunbeam_pack::Pack> {
+    let f = sunbeam_pack::FieldRef {
+        width: n,
+        height: n,
+        dx,
+        dy: dx,
+        data,
+    };
+    let opts = sunbeam_pack::build::BuildOptions {
+        model,
+        ..sunbeam_pack::build::BuildOptions::default()
+    };
+    std::sync::Arc::new(sunbeam_pack::build(f, &opts, &mut |_, _| {}).unwrap())
+}
+
 /// A flat patch whose lobe is narrow (`sigma_u` about 0.0015 at 550 nm): the
 /// furnace's `F(theta)` is the narrow-lobe limit of `int G R A / l^2 dw`;
 /// a lobe `sigma_u` wide adds about `(G / cos(theta_i))'' sigma_u^2 / 2`,
