@@ -15,7 +15,10 @@
 //!
 //! Level `m` has `w / 2^m x h / 2^m` texels (down to 2 x 1); texel `(i, j)`
 //! of level `m` is the solid-angle-weighted mean of its four children. Cost:
-//! one pass over the table (a 2048 x 1024 map: about 30 ms on one core).
+//! one pass over the table, rows in parallel (a 4096 x 2048 map: see
+//! crates/sunbeam-light/benches/env_tables.rs and docs/bench/hdri.md).
+
+use rayon::prelude::*;
 
 /// The chain: level 0 is the table itself, `[c0, c1, c2, 0]` per texel.
 #[derive(Debug, Clone)]
@@ -48,24 +51,19 @@ impl Prefiltered {
                 let t1 = std::f64::consts::PI * (j + 1) as f64 / ph as f64;
                 t0.cos() - t1.cos()
             };
+            let weights: Vec<f64> = (0..ph).map(weight).collect();
             let mut out = vec![0.0f32; nw * nh * 4];
-            for y in 0..nh {
-                let rows: Vec<usize> = if y + 1 == nh {
-                    (2 * y..ph).collect()
-                } else {
-                    vec![2 * y, 2 * y + 1]
-                };
+            // Output rows in parallel (each texel is its own mean, summed in a
+            // fixed order: the chain does not depend on the thread count).
+            out.par_chunks_mut(nw * 4).enumerate().for_each(|(y, row)| {
+                let rows = 2 * y..if y + 1 == nh { ph } else { 2 * y + 2 };
                 for x in 0..nw {
-                    let cols: Vec<usize> = if x + 1 == nw {
-                        (2 * x..pw).collect()
-                    } else {
-                        vec![2 * x, 2 * x + 1]
-                    };
+                    let cols = 2 * x..if x + 1 == nw { pw } else { 2 * x + 2 };
                     let mut acc = [0.0f64; 4];
                     let mut wsum = 0.0;
-                    for &j in &rows {
-                        let wj = weight(j);
-                        for &i in &cols {
+                    for j in rows.clone() {
+                        let wj = weights[j];
+                        for i in cols.clone() {
                             let o = 4 * (j * pw + i);
                             for (a, v) in acc.iter_mut().zip(&prev[o..o + 4]) {
                                 *a += wj * *v as f64;
@@ -73,12 +71,11 @@ impl Prefiltered {
                             wsum += wj;
                         }
                     }
-                    let o = 4 * (y * nw + x);
                     for c in 0..4 {
-                        out[o + c] = (acc[c] / wsum) as f32;
+                        row[4 * x + c] = (acc[c] / wsum) as f32;
                     }
                 }
-            }
+            });
             levels.push((nw, nh, out));
         }
         Prefiltered { levels, phase: 0.0 }
