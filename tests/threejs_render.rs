@@ -147,6 +147,15 @@ fn bad_scenes_exit_non_zero_with_the_field_named() {
     );
     let o = Command::new("node").arg(&render).output().unwrap();
     assert_eq!(o.status.code(), Some(1));
+    // --msaa takes 1 or 4 (a usage error otherwise, before the scene is read).
+    let o = Command::new("node")
+        .arg(&render)
+        .arg(&s)
+        .args(["-o", "x.png", "--msaa", "2"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--msaa"));
     // A light's colour and the lens shift are checked, naming the field.
     for (bad, field) in [
         (

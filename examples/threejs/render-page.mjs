@@ -14,7 +14,7 @@ THREE.ColorManagement.enabled = false;
 
 window.sunbeamRender = async (job) => {
   try {
-    const { scene: desc, meshes, size, supersample: k, glsl, env: envJob } = job;
+    const { scene: desc, meshes, size, supersample: k, msaa = 1, glsl, env: envJob } = job;
     const [w, h] = size;
     const W = w * k, H = h * k;
     const canvas = document.createElement('canvas');
@@ -97,7 +97,10 @@ window.sunbeamRender = async (job) => {
     if (desc.background === 'environment') root.add(environmentBackground(exported, environment, camera, desc.exposure));
     root.updateMatrixWorld(true);
     updateSunbeamUniforms(root, camera);
-    const rt = new THREE.WebGLRenderTarget(W, H, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true });
+    // msaa > 1: a multisampled target, resolved (averaged) before the read.
+    const rt = new THREE.WebGLRenderTarget(W, H, {
+      type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true, samples: msaa > 1 ? msaa : 0,
+    });
     renderer.setRenderTarget(rt);
     const bg = Array.isArray(desc.background) ? desc.background : [0, 0, 0];
     renderer.setClearColor(new THREE.Color(bg[0] * scale, bg[1] * scale, bg[2] * scale), 1);

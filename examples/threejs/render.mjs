@@ -1,7 +1,7 @@
 // Render a Sunbeam scene file (docs/SCENE.md) with three.js in headless
 // Chromium, as a browser would draw it:
 //
-//   node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K]
+//   node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N]
 //
 // - the material is sunbeam-three.mjs: the GLSL ES that
 //   `sunbeam-play --export-shader glsl-es` writes from the player's WGSL
@@ -16,7 +16,11 @@
 //   K = 4) and box-filtered in linear light (a pixel is the average over its
 //   area), then written as PNG (exposure, clip at 1, sRGB curve: what
 //   sunbeam-eval render and sunbeam-play write) and, with --exr, as a linear
-//   OpenEXR (exposure applied, no tone curve) for comparisons.
+//   OpenEXR (exposure applied, no tone curve) for comparisons;
+// - --msaa N (1 or 4, default 1) renders that target with N samples per
+//   texel, as a page with `antialias: true` draws its canvas: coverage at N
+//   samples, the material shaded once per texel at the centroid of the
+//   covered samples (docs/ENGINES.md "The baked snake under the sky").
 //
 // Needs three and playwright-core next to it (node_modules) and Debian's
 // chromium (CHROMIUM or /usr/bin/chromium; playwright gives it a fresh
@@ -33,7 +37,7 @@ const here = dirname(fileURLToPath(import.meta.url));
 
 function usage(msg) {
   if (msg) console.error(`render.mjs: error: ${msg}`);
-  console.error('usage: node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--glsl FILE]');
+  console.error('usage: node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--glsl FILE]');
   process.exit(1);
 }
 
@@ -44,7 +48,7 @@ function fail(code, msg) {
 
 // ---- arguments -----------------------------------------------------------------
 const args = process.argv.slice(2);
-const opt = { supersample: 4 };
+const opt = { supersample: 4, msaa: 1 };
 for (let i = 0; i < args.length; i++) {
   const a = args[i];
   const next = () => (i + 1 < args.length ? args[++i] : usage(`${a} needs a value`));
@@ -57,6 +61,9 @@ for (let i = 0; i < args.length; i++) {
   } else if (a === '--supersample') {
     opt.supersample = Number(next());
     if (!Number.isInteger(opt.supersample) || opt.supersample < 1 || opt.supersample > 8) usage('--supersample: 1..8');
+  } else if (a === '--msaa') {
+    opt.msaa = Number(next());
+    if (opt.msaa !== 1 && opt.msaa !== 4) usage('--msaa: 1 or 4');
   } else if (a === '--glsl') opt.glsl = next();
   else if (a === '-h' || a === '--help') usage();
   else if (a.startsWith('-')) usage(`unknown option ${a}`);
@@ -255,7 +262,7 @@ try {
   p.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
   await p.goto(`${base}/render.html`);
   await p.waitForFunction(() => window.sunbeamRender !== undefined, null, { timeout: 60000 });
-  const job = { scene, meshes, size, supersample: opt.supersample, glsl, env };
+  const job = { scene, meshes, size, supersample: opt.supersample, msaa: opt.msaa, glsl, env };
   pixels = await p.evaluate((j) => window.sunbeamRender(j), job);
 } catch (e) {
   fail(4, `rendering in Chromium failed: ${e.message}${problems.length ? `\n${problems.join('\n')}` : ''}`);
@@ -349,4 +356,4 @@ function exrBytes() {
   return Buffer.concat([header, table, lines]);
 }
 if (opt.exr) atomicWrite(opt.exr, exrBytes());
-console.error(`render.mjs: wrote ${opt.output}${opt.exr ? ` and ${opt.exr}` : ''} (${w}x${h}, ${opt.supersample}x${opt.supersample} samples per pixel, ${pixels.renderer})`);
+console.error(`render.mjs: wrote ${opt.output}${opt.exr ? ` and ${opt.exr}` : ''} (${w}x${h}, ${opt.supersample}x${opt.supersample} samples per pixel${opt.msaa > 1 ? `, ${opt.msaa}x MSAA` : ''}, ${pixels.renderer})`);

@@ -262,11 +262,17 @@ in vec3 normal;
 in vec3 sbOrient;
 in vec4 sbTangent; // a mesh with scale maps (addScaleAttributes): the glTF TANGENT
 in vec2 sbUv;      // and the maps' TEXCOORD; (0, 0, 0, 1) and (0, 0) otherwise
-out vec3 vWorld;
-out vec3 vNormal;
-out vec3 vOrient;
-out vec4 vTangent;
-out vec2 vUv;
+// centroid: under MSAA (a canvas with antialias: true) a partly covered
+// pixel is shaded once, and at its centre the attributes would be
+// extrapolated past the triangle; at the covered samples' centroid they are
+// not (the baked snake under the sky at 4x MSAA: CIEDE2000 p99 inside 9.8
+// without, 2.2 with; docs/ENGINES.md). Without MSAA it is the centre. The
+// material takes no derivatives of them, which centroid would make coarse.
+centroid out vec3 vWorld;
+centroid out vec3 vNormal;
+centroid out vec3 vOrient;
+centroid out vec4 vTangent;
+centroid out vec2 vUv;
 void main() {
   vec4 w = modelMatrix * vec4(position, 1.0);
   vWorld = w.xyz;
@@ -288,11 +294,11 @@ uniform int sbHasMap;
 uniform int sbDisplay;                 // 1: clip at 1 and sRGB-encode (drawing to a canvas)
 uniform int sbEnvOn;                   // 1: lit by an environment (parseEnvironment)
 uniform uint sbScales;                 // 0: no scale maps; else 16 + the wrap bits (shaders/export_scales.wgsl)
-in vec3 vWorld;
-in vec3 vNormal;
-in vec3 vOrient;
-in vec4 vTangent;
-in vec2 vUv;
+centroid in vec3 vWorld;
+centroid in vec3 vNormal;
+centroid in vec3 vOrient;
+centroid in vec4 vTangent;
+centroid in vec2 vUv;
 layout(location = 0) out vec4 fragColor;
 void main() {
   // The player's frame (shaders/material.wgsl sb_frame: t orthogonalised
