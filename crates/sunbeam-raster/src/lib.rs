@@ -21,6 +21,7 @@
 //! `LinearImage`, their comparison) are `sunbeam_frame`'s, shared with the
 //! player; they are re-exported here.
 
+pub mod converge;
 mod env_cache;
 pub mod environment;
 pub mod lobe_sampler;
@@ -112,7 +113,7 @@ pub fn render_linear(scene: &Scene, opts: &Options) -> Result<LinearImage> {
 pub fn render_prepared_linear(p: &Prepared, opts: &Options) -> Result<LinearImage> {
     let p = &bounded(p);
     if let Some(env) = &p.environment {
-        return render_environment(p, env.clone(), opts);
+        return render_environment_at(p, env.clone(), opts, None);
     }
     let s = samples_side(opts.samples)?;
     let [w, h] = opts.size.unwrap_or(p.scene.size);
@@ -142,11 +143,14 @@ const BAND_FRAGMENTS: usize = 4 << 20;
 /// rasterised at `s x s` per pixel, each sample at a point of its stratum drawn
 /// from the seed (stratified jitter); every sub-pixel sample is shaded with the
 /// point lights (as without an environment) plus one environment sample
-/// ([`environment::EnvShader::sample`]).
-fn render_environment(
+/// ([`environment::EnvShader::sample`]). With `open`, only the pixels marked
+/// there are rendered (the others are 0, and bands without one are skipped):
+/// [`converge`]'s later rounds.
+fn render_environment_at(
     p: &Prepared,
     env: Arc<sunbeam_light::Environment>,
     opts: &Options,
+    open: Option<&[bool]>,
 ) -> Result<LinearImage> {
     let s = samples_side(opts.samples)?;
     let [w, h] = opts.size.unwrap_or(p.scene.size);
@@ -172,12 +176,22 @@ fn render_environment(
     let mut y0 = 0;
     while y0 < h {
         let y1 = (y0 + band).min(h);
+        let band_open = |y: u32| {
+            open.is_none_or(|o| o[(y * w) as usize..((y + 1) * w) as usize].contains(&true))
+        };
+        if !(y0..y1).any(band_open) {
+            y0 = y1;
+            continue;
+        }
         let gbuf = raster::rasterise_rows_at(p, sw, sh, y0 * s..y1 * s, positions);
         let rows = &mut out.rgb[(y0 * w) as usize..(y1 * w) as usize];
         for_rows(rows, w as usize, opts.threads, |jr, row| {
             let y = y0 as usize + jr;
             for (x, px) in row.iter_mut().enumerate() {
                 let pixel = (y * w as usize + x) as u64;
+                if open.is_some_and(|o| !o[pixel as usize]) {
+                    continue;
+                }
                 let uniforms = environment::pixel_uniforms(opts.seed, pixel, n);
                 let mut acc = [0.0; 3];
                 // Under the quadrature, the covered samples are shaded

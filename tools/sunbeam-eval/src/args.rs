@@ -240,6 +240,17 @@ pub(crate) struct RenderArgs {
     /// more than once, the frame is the mean of the seeds' frames in linear light.
     #[arg(long, default_values_t = [1u64], action = clap::ArgAction::Append)]
     pub(crate) seed: Vec<u64>,
+    /// A converged reference under an `environment`: each pixel gets finer sub-pixel
+    /// grids (4x --samples per level) and more seeds until its estimated CIEDE2000
+    /// error is at most DE (docs/EVAL.md "A converged reference"); seeds drawn from --seed.
+    #[arg(long, value_name = "DE", value_parser = positive, conflicts_with = "turntable")]
+    pub(crate) converge: Option<f64>,
+    /// With --converge: the finest grid, in samples per pixel (a square number).
+    #[arg(long, value_name = "N", default_value_t = 16384, requires = "converge")]
+    pub(crate) max_samples: u32,
+    /// With --converge: the most seeds a pixel gets at the finest grid.
+    #[arg(long, value_name = "N", default_value_t = 12, requires = "converge", value_parser = clap::value_parser!(u32).range(3..=4096))]
+    pub(crate) max_seeds: u32,
     /// How an `environment` is integrated: `quadrature` (default: the sum over
     /// the pack's extended-light maps, no direction noise) or `monte-carlo`
     /// (the pack's R per wavelength and direction, the independent check);

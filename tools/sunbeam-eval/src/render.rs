@@ -87,19 +87,61 @@ pub fn run(a: &crate::args::RenderArgs, quiet: bool) -> Result<()> {
         }
         report["environment_negatives_zeroed"] = serde_json::json!({"values": c.values, "texels": c.texels, "min": c.min, "bound": c.bound});
     }
-    render_frame(a, &prepared, &opts)?;
+    if let Some(c) = render_frame(a, &prepared, &opts)? {
+        report["converge"] = serde_json::json!({
+            "de": a.converge, "max_samples": a.max_samples, "max_seeds": a.max_seeds,
+            "rounds": c.rounds, "samples_mean": c.samples_mean, "samples_max": c.samples_max,
+            "open": c.open, "estimate_p99": c.estimate_p99, "estimate_max": c.estimate_max,
+        });
+        if c.open > 0 && !quiet {
+            eprintln!(
+                "sunbeam-eval: warning: {} pixels are still above --converge {} at --max-samples {} and --max-seeds {} (estimated max {:.3})",
+                c.open,
+                a.converge.unwrap_or_default(),
+                a.max_samples,
+                a.max_seeds,
+                c.estimate_max
+            );
+        }
+    }
     if a.json {
         println!("{report}");
     }
     Ok(())
 }
 
-/// Render and write the frame (with `--compare`, print the difference).
+/// Render and write the frame (with `--compare`, print the difference); with
+/// `--converge`, what the converged render did.
 fn render_frame(
     a: &crate::args::RenderArgs,
     prepared: &sunbeam_raster::Prepared,
     opts: &sunbeam_raster::Options,
-) -> Result<()> {
+) -> Result<Option<sunbeam_raster::converge::Converged>> {
+    // The reference first: a bad file fails before the render.
+    let reference = match &a.compare {
+        Some(r) => Some((r, sunbeam_raster::LinearImage::read_exr(r)?)),
+        None => None,
+    };
+    let reference = reference.as_ref().map(|(r, img)| (r.as_path(), img));
+    if let Some(de) = a.converge {
+        if a.seed.len() > 1 {
+            return Err(Error::usage(
+                "--converge takes one --seed (it draws its rounds' seeds from it)",
+            ));
+        }
+        let c = sunbeam_raster::converge::render_converged(
+            prepared,
+            opts,
+            sunbeam_raster::converge::Converge {
+                de,
+                max_samples: a.max_samples,
+                max_seeds: a.max_seeds,
+                ..Default::default()
+            },
+        )?;
+        write_linear(a, &c.image, opts, reference)?;
+        return Ok(Some(c));
+    }
     // The frame in linear light: one seed's, or the mean of several seeds'.
     let linear = || -> Result<sunbeam_raster::LinearImage> {
         let mut frames = vec![sunbeam_raster::render_prepared_linear(prepared, opts)?];
@@ -116,26 +158,47 @@ fn render_frame(
         .output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    if let Some(refp) = &a.compare {
-        let reference = sunbeam_raster::LinearImage::read_exr(refp)?;
-        let lin = linear()?;
-        let d = sunbeam_raster::compare_linear(&lin, &reference)
-            .map_err(|e| e.context(refp.display()))?;
-        if exr {
-            lin.write_exr(&a.output)?;
-        } else {
-            lin.display(opts.curve).write_png(&a.output)?;
-        }
-        println!("{d}");
-        return Ok(());
+    if reference.is_some() {
+        write_linear(a, &linear()?, opts, reference)?;
+        return Ok(None);
     }
     if exr {
-        linear()?.write_exr(&a.output)
+        linear()?.write_exr(&a.output)?;
     } else if a.seed.len() > 1 {
-        linear()?.display(opts.curve).write_png(&a.output)
+        linear()?.display(opts.curve).write_png(&a.output)?;
     } else {
-        sunbeam_raster::render_prepared(prepared, opts).write_png(&a.output)
+        sunbeam_raster::render_prepared(prepared, opts).write_png(&a.output)?;
     }
+    Ok(None)
+}
+
+/// Write a linear frame to `-o` (EXR as it is, PNG through the display
+/// transform); with `--compare` (its path and image), print its difference
+/// from the reference.
+fn write_linear(
+    a: &crate::args::RenderArgs,
+    lin: &sunbeam_raster::LinearImage,
+    opts: &sunbeam_raster::Options,
+    reference: Option<(&std::path::Path, &sunbeam_raster::LinearImage)>,
+) -> Result<()> {
+    let d = match reference {
+        Some((path, img)) => {
+            Some(sunbeam_raster::compare_linear(lin, img).map_err(|e| e.context(path.display()))?)
+        }
+        None => None,
+    };
+    if a.output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        lin.write_exr(&a.output)?;
+    } else {
+        lin.display(opts.curve).write_png(&a.output)?;
+    }
+    if let Some(d) = d {
+        println!("{d}");
+    }
+    Ok(())
 }
 
 /// The camera's eye turned by `deg` degrees about the axis `up` through `target`

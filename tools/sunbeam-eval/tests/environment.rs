@@ -337,3 +337,91 @@ fn lambda_step_is_reported_and_checked() {
         assert!(!out.exists(), "--lambda-step {bad} wrote {}", out.display());
     }
 }
+
+/// `--converge DE` (docs/EVAL.md "A converged reference"): the report says
+/// what it did; the frame is the plain frame where one round's estimate
+/// suffices; bad combinations are usage errors (exit 1) with no output.
+#[test]
+fn converge_reports_and_refuses_bad_combinations() {
+    let (d, s) = sky_scene_in("converge");
+    let out = d.join("c.exr");
+    // The quadrature on the diffuse sphere: inside, the seeds give the same
+    // value (the pixels close after the first level); at the silhouette the
+    // sub-pixel positions differ (those go up).
+    let o = render(
+        &s,
+        &out,
+        &[
+            "--samples",
+            "4",
+            "--converge",
+            "0.5",
+            "--max-samples",
+            "64",
+            "--max-seeds",
+            "4",
+            "--json",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let c = &report["converge"];
+    eprintln!("{c}");
+    let (mean, max) = (
+        c["samples_mean"].as_f64().unwrap(),
+        c["samples_max"].as_u64().unwrap(),
+    );
+    // Every pixel took at least the first level's 3 rounds of 4 samples, the
+    // open ones 3 rounds of 16 and then up to 4 of 64: 12 + 48 + 256.
+    assert!(
+        mean >= 12.0 && max > 12 && max <= 316 && mean < max as f64,
+        "{c}"
+    );
+    assert!(c["rounds"].as_u64().unwrap() >= 4, "{c}");
+    assert!(c["estimate_p99"].as_f64().unwrap() > 0.0, "{c}");
+    let open = c["open"].as_u64().unwrap();
+    let warned = String::from_utf8_lossy(&o.stderr).contains("still above --converge");
+    assert_eq!(
+        open > 0,
+        warned,
+        "{c}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(out.is_file());
+
+    let none = d.join("none.exr");
+    let plain = d.join("plain.json");
+    std::fs::write(
+        &plain,
+        r#"{ "camera": { "eye": [0, 0.5, 2.5], "target": [0, 0, 0] },
+  "meshes": [ { "mesh": "builtin:sphere" } ], "size": [12, 12] }"#,
+    )
+    .unwrap();
+    for (scene, extra, says) in [
+        (
+            &s,
+            vec!["--converge", "0.5", "--seed", "1", "--seed", "2"],
+            "one --seed",
+        ),
+        (
+            &s,
+            vec!["--converge", "0.5", "--samples", "16", "--max-samples", "4"],
+            "--max-samples",
+        ),
+        (
+            &s,
+            vec!["--converge", "0.5", "--max-samples", "99"],
+            "square",
+        ),
+        (&s, vec!["--converge", "0"], "positive"),
+        (&s, vec!["--max-samples", "64"], "--converge"),
+        (&plain, vec!["--converge", "0.5"], "no environment"),
+    ] {
+        let o = render(scene, &none, &extra);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{extra:?}: {err}");
+        assert!(err.contains(says), "{extra:?}: {err}");
+        assert!(!none.exists(), "{extra:?} wrote output");
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
