@@ -183,7 +183,16 @@ fn render_environment_at(
             y0 = y1;
             continue;
         }
-        let gbuf = raster::rasterise_rows_at(p, sw, sh, y0 * s..y1 * s, positions);
+        // Later rounds of a converged frame rasterise their open pixels only.
+        let gbuf = match open {
+            None => raster::rasterise_rows_at(p, sw, sh, y0 * s..y1 * s, positions),
+            Some(o) => {
+                let keep = |i: i64, j: i64| {
+                    o[(j / s as i64) as usize * w as usize + (i / s as i64) as usize]
+                };
+                raster::rasterise_rows_where(p, sw, sh, y0 * s..y1 * s, positions, Some(&keep))
+            }
+        };
         let rows = &mut out.rgb[(y0 * w) as usize..(y1 * w) as usize];
         for_rows(rows, w as usize, opts.threads, |jr, row| {
             let y = y0 as usize + jr;

@@ -118,6 +118,25 @@ pub fn rasterise_rows_at(
     rows: std::ops::Range<u32>,
     at: Positions,
 ) -> Vec<Fragment> {
+    rasterise_rows_where(p, w, h, rows, at, None)
+}
+
+/// Which samples [`rasterise_rows_where`] rasterises: `keep(i, j)` for the
+/// sample in column `i`, row `j` of the `w x h` G-buffer.
+pub type Keep<'a> = &'a (dyn Fn(i64, i64) -> bool + Sync);
+
+/// [`rasterise_rows_at`] at the samples `keep` admits only (all with
+/// `None`); the others stay empty (`mesh` None, depth 1, no position):
+/// the converged reference's later rounds, which shade a few pixels of a
+/// finely sampled frame.
+pub fn rasterise_rows_where(
+    p: &Prepared,
+    w: u32,
+    h: u32,
+    rows: std::ops::Range<u32>,
+    at: Positions,
+    keep: Option<Keep>,
+) -> Vec<Fragment> {
     let vp = p.scene.camera.view_proj(w, h);
     let mut buf = vec![
         Fragment {
@@ -149,7 +168,7 @@ pub fn rasterise_rows_at(
                     w,
                     h,
                     &rows,
-                    at,
+                    (at, keep),
                     (mi as u32, mesh, scales),
                     idx,
                     &t,
@@ -165,6 +184,9 @@ pub fn rasterise_rows_at(
                 (k % w as usize) as i64,
                 (k / w as usize) as i64 + rows.start as i64,
             );
+            if keep.is_some_and(|keep| !keep(i, j)) {
+                continue;
+            }
             let o = at.offset(i, j);
             let (x, y) = (
                 (i * ONE + o[0]) as f64 / ONE as f64,
@@ -183,7 +205,7 @@ fn raster_triangle(
     w: u32,
     h: u32,
     rows: &std::ops::Range<u32>,
-    at: Positions,
+    (at, keep): (Positions, Option<Keep>),
     (mi, mesh, scales): (u32, &crate::Mesh, Option<&sunbeam_frame::MeshScales>),
     idx: [usize; 3],
     t: &[ClipVert; 3],
@@ -244,6 +266,9 @@ fn raster_triangle(
         .min(rows.end as i64 - 1);
     for j in j0..=j1 {
         for i in i0..=i1 {
+            if keep.is_some_and(|keep| !keep(i, j)) {
+                continue;
+            }
             let o = at.offset(i, j);
             let (px, py) = (i * ONE + o[0], j * ONE + o[1]);
             let e = [0, 1, 2].map(|k| edge(edges[k].0, edges[k].1, px, py));
