@@ -216,8 +216,11 @@ pub fn render_converged(p: &Prepared, opts: &Options, c: Converge) -> Result<Con
         }
         level_samples *= 4;
     }
-    let lit: Vec<usize> = (0..n).filter(|&i| acc[i].estimate().is_some()).collect();
-    let mut est: Vec<f64> = lit.iter().filter_map(|&i| acc[i].estimate()).collect();
+    // Each lit pixel's (samples, estimate).
+    let lit: Vec<(u64, f64)> = (0..n)
+        .filter_map(|i| acc[i].estimate().map(|e| (samples[i], e)))
+        .collect();
+    let mut est: Vec<f64> = lit.iter().map(|&(_, e)| e).collect();
     let stats = crate::diff::stats(&mut est);
     let mut image = LinearImage::new(w, h);
     for (px, m) in image.rgb.iter_mut().zip(&acc) {
@@ -226,7 +229,7 @@ pub fn render_converged(p: &Prepared, opts: &Options, c: Converge) -> Result<Con
     Ok(Converged {
         image,
         rounds,
-        samples_mean: lit.iter().map(|&i| samples[i] as f64).sum::<f64>() / lit.len().max(1) as f64,
+        samples_mean: lit.iter().map(|&(k, _)| k as f64).sum::<f64>() / lit.len().max(1) as f64,
         samples_max: samples.iter().copied().max().unwrap_or(0),
         open: open.iter().filter(|&&o| o).count(),
         estimate_p99: if stats.pixels > 0 { stats.p99 } else { 0.0 },

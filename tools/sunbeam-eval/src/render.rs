@@ -158,14 +158,8 @@ fn render_frame(
         .output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    if reference.is_some() {
+    if reference.is_some() || exr || a.seed.len() > 1 {
         write_linear(a, &linear()?, opts, reference)?;
-        return Ok(None);
-    }
-    if exr {
-        linear()?.write_exr(&a.output)?;
-    } else if a.seed.len() > 1 {
-        linear()?.display(opts.curve).write_png(&a.output)?;
     } else {
         sunbeam_raster::render_prepared(prepared, opts).write_png(&a.output)?;
     }
