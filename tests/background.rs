@@ -213,12 +213,9 @@ fn player_background_matches_reference_with(gpu: &sunbeam_render::Gpu, shift: [f
     }
 }
 
-/// The sky (its table in the player, its model in the reference), the sun's
-/// disc in view (14 degrees above the view direction): the player's frame
-/// against the reference's, the pixels near the horizon apart.
-#[test]
-fn player_sky_background_matches_reference() {
-    let Some(gpu) = gpu::gpu() else { return };
+/// [`scene`] under a sky whose sun's disc is in view (14 degrees above the
+/// view direction), the horizon crossing the frame.
+fn sky_scene() -> Prepared {
     let mut p = scene();
     let env = sunbeam_scene::Environment {
         sky: Some(sunbeam_scene::Sky {
@@ -233,23 +230,23 @@ fn player_sky_background_matches_reference() {
     p.scene.environment = Some(env);
     p.environment =
         Some(sunbeam_frame::load_environment(p.scene.environment.as_ref().unwrap()).unwrap());
-    let reference = sunbeam_raster::render_prepared(
-        &p,
-        &Options {
-            samples: 64,
-            ..Default::default()
-        },
-    );
-    let frame = sunbeam_render::render_headless(&gpu, &p, &Settings::default(), None, 64).unwrap();
-    let d = sunbeam_frame::compare(&frame, &reference).unwrap();
-    // The table holds the sky at its texels' centres (0.7 degree rows): the
-    // horizon's row, where the sky model is steepest, is compared apart.
+    p
+}
+
+/// CIEDE2000 of `frame` against `reference` (display values), over the pixels
+/// whose corners all see the sky 1.5 degrees or more from the horizon, and
+/// over the pixels within 1.5 degrees of it.
+fn sky_and_horizon(
+    p: &Prepared,
+    frame: &sunbeam_frame::Image,
+    reference: &sunbeam_frame::Image,
+) -> (sunbeam_frame::ColourDiff, sunbeam_frame::ColourDiff) {
     let (mut d_sky, mut d_horizon) = (Vec::new(), Vec::new());
     for (k, (a, b)) in frame.rgb.iter().zip(&reference.rgb).enumerate() {
         let (x, y) = ((k as u32 % W) as f64, (k as u32 / W) as f64);
         let near_horizon = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
             .iter()
-            .any(|(dx, dy)| camera_ray(&p, x + dx, y + dy)[1].abs() < 1.5f64.to_radians().sin());
+            .any(|(dx, dy)| camera_ray(p, x + dx, y + dy)[1].abs() < 1.5f64.to_radians().sin());
         let e = sunbeam_optics::colour::ciede2000_xyz(
             sunbeam_frame::image::display_to_xyz(*a),
             sunbeam_frame::image::display_to_xyz(*b),
@@ -260,12 +257,48 @@ fn player_sky_background_matches_reference() {
             d_sky.push(e)
         }
     }
-    let (s, h) = (
+    (
         sunbeam_frame::diff::stats(&mut d_sky),
         sunbeam_frame::diff::stats(&mut d_horizon),
-    );
-    eprintln!("player sky background: {s}; within 1.5 degrees of the horizon {h}; whole frame {d}");
-    assert!(s.pixels > (W * H * 3 / 4) as usize);
-    assert!(s.p99 < 0.5, "{s}");
-    assert!(h.p99 < 3.0, "{h}");
+    )
 }
+
+/// The sky (its table in the player, its model in the reference) against a
+/// 1024-sample reference, the pixels within 1.5 degrees of the horizon (the
+/// sky's bright edge over the ground) apart: one frame (no accumulation) and
+/// 64 accumulated frames. Every frame averages 16 rays over the pixel's box
+/// without the frames' jitter, so both are that box. Measured on lavapipe
+/// (2026-12-02), both: p99 0.105 on the sky, 0.749 near the horizon (mean
+/// 0.143). With one ray per pixel (the pass before) one frame read 0.531 and
+/// 34.6 (mean 8.9), the horizon a step a pixel high, and 64 jittered frames
+/// 0.092 and 1.76, the jitter sequence's own coverage of the horizon.
+#[test]
+fn player_sky_background_is_the_pixels_mean() {
+    let Some(gpu) = gpu::gpu() else { return };
+    let p = sky_scene();
+    let reference = sunbeam_raster::render_prepared(
+        &p,
+        &Options {
+            samples: 1024,
+            ..Default::default()
+        },
+    );
+    for frames in [1, 64] {
+        let frame =
+            sunbeam_render::render_headless(&gpu, &p, &Settings::default(), None, frames).unwrap();
+        let (s, h) = sky_and_horizon(&p, &frame, &reference);
+        eprintln!(
+            "player sky background, {frames} frame(s): {s}; within 1.5 degrees of the horizon {h}"
+        );
+        assert!(s.pixels > (W * H * 3 / 4) as usize, "{s}");
+        assert!(h.pixels >= W as usize, "{h}");
+        assert!(s.p99 < SKY_P99, "{frames} frame(s): {s}");
+        assert!(h.p99 < HORIZON_P99, "{frames} frame(s): {h}");
+    }
+}
+
+/// Bounds of [`player_sky_background_is_the_pixels_mean`], away from the
+/// horizon and within 1.5 degrees of it: the measured 0.105 and 0.749 plus a third (the horizon's
+/// bound is below the 1.76 of 64 jittered rays).
+const SKY_P99: f64 = 0.14;
+const HORIZON_P99: f64 = 1.0;

@@ -651,8 +651,8 @@ export function sceneCamera(scene, aspect) {
 
 /**
  * `"background": "environment"` (docs/SCENE.md): a full-screen triangle,
- * drawn first, showing the environment along each pixel's view ray as the
- * player's background pass does: the exported sb_env_texel (the texel of the
+ * drawn first, showing the environment averaged over 16 view rays across each
+ * pixel as the player's background pass does: the exported sb_env_texel (the texel of the
  * coefficient table holding the direction: table.ktx2, or level 0 of the
  * chain when there are no hot spots; its columns start chain.phase turns
  * after phi = 0) times
@@ -681,10 +681,23 @@ uniform int sbDisplay;
 uniform highp sampler2D sbChain;
 in vec2 vNdc;
 layout(location = 0) out vec4 fragColor;
-void main() {
-  vec4 p = sbInvViewProj * vec4(vNdc, 1.0, 1.0);
+vec3 sbBackgroundAt(vec2 ndc) {
+  vec4 p = sbInvViewProj * vec4(ndc, 1.0, 1.0);
   vec3 d = normalize(p.xyz / p.w - sbEye);
-  vec3 c = sbBasisToRgb * sb_env_texel(sbChain, sbTable.x, sbTable.y, sbPhase, d) * sbExposure;
+  return sbBasisToRgb * sb_env_texel(sbChain, sbTable.x, sbTable.y, sbPhase, d);
+}
+void main() {
+  // 16 rays over the pixel's square (a Hammersley set: one in every 1/16-wide
+  // row and column), the box the reference's sub-pixel samples average, as
+  // the player's background pass takes it
+  vec2 px = dFdx(vNdc), py = dFdy(vNdc);
+  vec3 c = vec3(0.0);
+  for (int k = 0; k < 16; k++) {
+    int r = ((k & 1) << 3) | ((k & 2) << 1) | ((k & 4) >> 1) | ((k & 8) >> 3);
+    vec2 o = (vec2(float(k), float(r)) + 0.5) / 16.0 - 0.5;
+    c += sbBackgroundAt(vNdc + o.x * px + o.y * py);
+  }
+  c = c / 16.0 * sbExposure;
   if (sbDisplay == 1) {
     c = clamp(c, 0.0, 1.0);
     c = mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));

@@ -53,8 +53,6 @@ pub(super) struct Background {
 pub(super) struct BgFrame<'a> {
     pub camera: &'a Camera,
     pub size: [u32; 2],
-    /// Sub-pixel offset of the frame (pixels, x right, y down).
-    pub jitter: [f64; 2],
     pub exposure_scale: f32,
     pub curve: u32,
     pub output: u32,
@@ -184,10 +182,9 @@ impl Background {
     /// Upload a frame's uniforms.
     pub(super) fn update(&self, gpu: &Gpu, f: &BgFrame) {
         let [w, h] = f.size.map(|v| v.max(1));
+        // No sub-pixel jitter: every frame averages the pixel's box itself
+        // (shaders/background.wgsl), so a running mean is that box too.
         let (o, rx, ry) = f.camera.ray_basis(w, h);
-        // The frame's image is shifted by the jitter: NDC x + 2 jx / w, y - 2 jy / h.
-        let (jx, jy) = (2.0 * f.jitter[0] / w as f64, -2.0 * f.jitter[1] / h as f64);
-        let o: [f64; 3] = std::array::from_fn(|k| o[k] - jx * rx[k] - jy * ry[k]);
         let v4 = |a: [f64; 3]| [a[0] as f32, a[1] as f32, a[2] as f32, 0.0];
         let v = BgGlobals {
             ray_o: v4(o),

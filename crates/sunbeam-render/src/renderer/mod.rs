@@ -784,7 +784,6 @@ impl Renderer {
                 &background::BgFrame {
                     camera: &state.camera,
                     size: [w, h],
-                    jitter,
                     exposure_scale: g.exposure_scale,
                     curve: g.curve,
                     output: g.output,
