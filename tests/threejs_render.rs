@@ -508,6 +508,58 @@ const STUDIO_P99: f64 = 1.7;
 /// pixel (the pass before; 2026-12-02, SwiftShader); plus 25 %.
 const BACKGROUND_P99: f64 = 1.4;
 
+/// `"background": "environment"` under the sky with its sun in view (8
+/// degrees above the view direction; a far sphere): three.js draws the sky
+/// and the sun's disc as the reference does. The disc is smaller than a
+/// pixel, so its light is checked as the sum over the 5 x 5 pixels around
+/// the reference's brightest. Measured (2026-12-02, SwiftShader): the sum
+/// 0.99999 of the reference's, p99 0.10, max 2.02; without the sun in the
+/// background (the pass before) the sum 0.0086 and max 115 (p99 still 0.10:
+/// the disc lies in two pixels). Exposure -3 keeps the disc's radiance
+/// within half floats (the player's offscreen target saturates near 65,504).
+#[test]
+fn threejs_draws_the_sky_and_its_sun_behind() {
+    let d = scratch("threejs-sun-behind");
+    let Some(render) = example(&d) else { return };
+    ridges(&d);
+    let scene = r#"{ "camera": { "eye": [0, 0, 20], "target": [0, 0, 0], "fov_y_deg": 35 },
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1 } ],
+  "environment": { "sky": { "sun_elevation_deg": 8, "sun_azimuth_deg": 270 } },
+  "background": "environment", "exposure": -3, "size": [40, 40] }"#;
+    let c = measure_at(&render, &d, scene, scene, "sun-behind", 256, 4);
+    assert!(
+        c.p99 < 0.5 && c.max < 5.0,
+        "three.js sky and sun behind: {c}"
+    );
+    let t = LinearImage::read_exr(&d.join("sun-behind.exr")).unwrap();
+    let r = LinearImage::read_exr(&d.join("sun-behind-ref.exr")).unwrap();
+    let y = |p: [f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let w = r.width as usize;
+    let brightest = (0..r.rgb.len())
+        .max_by(|&a, &b| y(r.rgb[a]).total_cmp(&y(r.rgb[b])))
+        .unwrap();
+    let (bx, by) = (brightest % w, brightest / w);
+    let block = |im: &LinearImage| -> f64 {
+        let mut s = 0.0;
+        for j in by.saturating_sub(2)..(by + 3).min(im.height as usize) {
+            for i in bx.saturating_sub(2)..(bx + 3).min(w) {
+                s += y(im.rgb[j * w + i]);
+            }
+        }
+        s
+    };
+    let ratio = block(&t) / block(&r);
+    eprintln!(
+        "the sun's 5 x 5 pixels: three.js / reference {ratio:.5} (brightest at {bx}, {by}: {:.1})",
+        y(r.rgb[brightest])
+    );
+    assert!(y(r.rgb[brightest]) > 100.0, "the sun's disc is not in view");
+    assert!(
+        (ratio - 1.0).abs() < 0.02,
+        "the sun's light behind: {ratio}"
+    );
+}
+
 /// The baked snake under the sky (issue 26: three.js on the snake, sky),
 /// three.js against the reference (about 50 s on 2 cores: the snake is the
 /// issue's second scene, so CI runs it).

@@ -656,7 +656,7 @@ export function sceneCamera(scene, aspect) {
  * coefficient table holding the direction: table.ktx2, or level 0 of the
  * chain when there are no hot spots; its columns start chain.phase turns
  * after phi = 0) times
- * basis_to_rgb, times 2^exposure. `camera` is the scene camera (a moving
+ * basis_to_rgb, plus the sky's sun inside its disc, times 2^exposure. `camera` is the scene camera (a moving
  * camera: update the uniforms sbInvViewProj and sbEye per frame). `display`:
  * clip and sRGB-encode, as sunbeamMaterial's (drawing to a canvas).
  */
@@ -664,6 +664,7 @@ export function environmentBackground(exportedGlsl, environment, camera, exposur
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array([-1, -1, 0, 3, -1, 0, -1, 3, 0]), 3));
   const m = environment.basisToRgb;
+  const sun = environment.json.sun;
   const material = new THREE.RawShaderMaterial({
     glslVersion: THREE.GLSL3,
     vertexShader: `precision highp float;
@@ -679,12 +680,17 @@ uniform float sbPhase;
 uniform float sbExposure;
 uniform int sbDisplay;
 uniform highp sampler2D sbChain;
+uniform vec4 sbSunDir;
+uniform vec3 sbSunRadiance;
 in vec2 vNdc;
 layout(location = 0) out vec4 fragColor;
 vec3 sbBackgroundAt(vec2 ndc) {
   vec4 p = sbInvViewProj * vec4(ndc, 1.0, 1.0);
   vec3 d = normalize(p.xyz / p.w - sbEye);
-  return sbBasisToRgb * sb_env_texel(sbChain, sbTable.x, sbTable.y, sbPhase, d);
+  vec3 c = sbBasisToRgb * sb_env_texel(sbChain, sbTable.x, sbTable.y, sbPhase, d);
+  // the sky's sun: its disc (w: the cosine of its angular radius; 2 without a sun)
+  if (dot(d, sbSunDir.xyz) >= sbSunDir.w) c += sbSunRadiance;
+  return c;
 }
 void main() {
   // 16 rays over the pixel's square (a Hammersley set: one in every 1/16-wide
@@ -714,6 +720,9 @@ void main() {
       sbExposure: { value: Math.pow(2, exposure) },
       sbDisplay: { value: display ? 1 : 0 },
       sbChain: { value: environment.table },
+      // environment.json `sun`: `rgb` is its Omega L, `solid_angle` Omega = 2 pi (1 - cos r)
+      sbSunDir: { value: sun ? new THREE.Vector4(...sun.direction, 1 - sun.solid_angle / (2 * Math.PI)) : new THREE.Vector4(0, 1, 0, 2) },
+      sbSunRadiance: { value: sun ? new THREE.Vector3(...sun.rgb.map((v) => v / sun.solid_angle)) : new THREE.Vector3() },
     },
     depthTest: false,
     depthWrite: false,
