@@ -533,7 +533,7 @@ fn threejs_draws_the_sky_and_its_sun_behind() {
     );
     let t = LinearImage::read_exr(&d.join("sun-behind.exr")).unwrap();
     let r = LinearImage::read_exr(&d.join("sun-behind-ref.exr")).unwrap();
-    let y = |p: [f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let y = sunbeam_frame::linear::luminance;
     let w = r.width as usize;
     let brightest = (0..r.rgb.len())
         .max_by(|&a, &b| y(r.rgb[a]).total_cmp(&y(r.rgb[b])))
