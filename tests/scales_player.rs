@@ -216,3 +216,105 @@ fn player_applies_the_scale_maps_as_the_reference() {
         "without the maps {d0}, with {d}: the scene does not show the scales"
     );
 }
+
+/// The whole scaled snake as the demo bakes it (`sunbeam-bake
+/// --generate-snake --scales`, default detail and scale parameters), seen
+/// from the front and above as tests/threejs_render.rs' snake scene, under
+/// one point light, 128 x 64: issue 27's "< 1 for the player under a point
+/// light, silhouettes included". The scales are about 1.5 pixels long here
+/// and the body 8-10 pixels thick, so nearly half the lit pixels touch the
+/// silhouette (`interior_pixels`' complement). The player at 8 x 8 (4x
+/// MSAA and its footprint filter, each sub-pixel box-filtered) against the
+/// reference at 256 samples per pixel, both at the player's 48 wavelength
+/// samples. Bounds in [`WHOLE_P99`].
+#[test]
+fn player_shades_the_whole_scaled_snake_silhouettes_included() {
+    let Some(gpu) = gpu() else { return };
+    let dir = sunbeam::scratch("scales_player_whole");
+    let glb = dir.join("snake-scales.glb");
+    sunbeam::run_ok(
+        std::process::Command::new(sunbeam::tool("sunbeam-bake"))
+            .args(["--generate-snake", "--scales", "-q", "-o"])
+            .arg(&glb),
+    );
+    let (mesh, scales) = sunbeam_frame::load_mesh_with_scales(&glb).unwrap();
+    let scales = scales.expect("the baked snake has scale maps");
+    let mut s = sunbeam_scene::Scene::default_lit(
+        glb.clone(),
+        Some("pack".into()),
+        mesh.bounds(),
+        sunbeam_scene::DefaultLighting::Point,
+    );
+    s.camera.eye = [0.0, 0.3, 1.0];
+    s.camera.target = [0.0, 0.0, 0.0];
+    s.camera.fov_y_deg = 35.0;
+    let l: [f64; 3] = [-0.35, 0.6, 0.72];
+    let n = l.iter().map(|v| v * v).sum::<f64>().sqrt();
+    s.lights[0].direction = l.map(|v| v / n);
+    s.meshes[0].base_color = [0.05; 3];
+    s.meshes[0].diffuse_weight = 0.2;
+    s.exposure = 4.64;
+    s.size = [128, 64];
+    let pack = Arc::new(ridge_pack(160, 31e-9));
+    let mut p = fixtures::prepared(s, mesh, Some(pack));
+    p.meshes[0].1.scales = Some(Arc::new(scales));
+    let out = std::env::var("SUNBEAM_SCALES_OUT").ok().map(PathBuf::from);
+    if let Some(d) = &out {
+        std::fs::create_dir_all(d).unwrap();
+    }
+    let t = std::time::Instant::now();
+    let reference = sunbeam_raster::render_prepared_linear(
+        &p,
+        &Options {
+            samples: 256,
+            lambda_samples: Some(sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let t_cpu = t.elapsed();
+    let st = Settings::default();
+    let t = std::time::Instant::now();
+    let player = sunbeam_render::render_headless_linear(&gpu, &p, &st, None, 1, 8).unwrap();
+    let t_gpu = t.elapsed();
+    let four = sunbeam_render::render_headless_linear(&gpu, &p, &st, None, 1, 4).unwrap();
+    let mut plain = p.clone();
+    plain.meshes[0].1.scales = None;
+    let without = sunbeam_render::render_headless_linear(&gpu, &plain, &st, None, 1, 8).unwrap();
+    keep(out.as_deref(), "whole-reference", &reference);
+    keep(out.as_deref(), "whole-player", &player);
+    diagnose(out.as_deref(), "whole", &player, &reference);
+
+    // All lit pixels, and the ring that touches the silhouette apart.
+    let split = |a: &LinearImage| {
+        let d = sunbeam_frame::linear::compare_regions(a, &reference).unwrap();
+        (d.all, d.edge)
+    };
+    let (all, edge) = split(&player);
+    let (all4, edge4) = split(&four);
+    let (all0, _) = split(&without);
+    eprintln!(
+        "whole scaled snake (128 x 64, point light): player 8 x 8 all {all}, silhouette ring {edge}; 4 x 4 all {all4}, ring {edge4}; 8 x 8 without the maps {all0} (reference {t_cpu:.2?}, player {t_gpu:.2?})"
+    );
+    assert!(
+        edge.pixels > 150 && all.pixels > 400,
+        "the frame shows little silhouette: all {all}, ring {edge}"
+    );
+    assert!(all.p99 < WHOLE_P99, "player, all lit pixels: {all}");
+    assert!(edge.p99 < WHOLE_P99, "player, the silhouette ring: {edge}");
+    // The maps matter here: ignoring them is far off (the checks above can
+    // fail). At this distance a scale spans few pixels, so the maps' effect
+    // is smaller than in the close-up: measured p99 4.99, mean 12.6 times.
+    assert!(
+        all0.p99 > 2.0 * WHOLE_P99 && all0.mean > 5.0 * all.mean,
+        "without the maps {all0}, with {all}: the scene does not show the scales"
+    );
+}
+
+/// Bound of [`player_shades_the_whole_scaled_snake_silhouettes_included`]:
+/// the issue's 1 (the player under a point light, silhouettes included).
+/// Measured (lavapipe, 2026-12-02): all lit pixels p99 0.631 (mean 0.103,
+/// max 0.85 over 574 px), the ring 0.714 (271 px); at 4 x 4 the ring is
+/// 2.01 (max 3.79), so 8 x 8 it is (docs/bench/play.md "The whole scaled
+/// snake, silhouettes included").
+const WHOLE_P99: f64 = 1.0;

@@ -221,6 +221,42 @@ pub fn compare_linear(a: &LinearImage, reference: &LinearImage) -> Result<Colour
     Ok(stats(&mut d))
 }
 
+/// [`compare_linear`] over all lit pixels, and split into the interior of
+/// the lit area ([`interior_pixels`] of the reference) and the rest, the
+/// edge: the pixels next to a silhouette, where sub-pixel coverage and
+/// grazing views dominate (`sunbeam-eval diff`, docs/EVAL.md "diff").
+#[derive(Debug, Clone, PartialEq)]
+pub struct RegionDiff {
+    pub all: ColourDiff,
+    pub interior: ColourDiff,
+    pub edge: ColourDiff,
+}
+
+/// [`RegionDiff`] of `a` against `reference` (same size).
+pub fn compare_regions(a: &LinearImage, reference: &LinearImage) -> Result<RegionDiff> {
+    let d = per_pixel_de(a, reference)?;
+    let mut inner = vec![false; d.len()];
+    for i in interior_pixels(&[reference]) {
+        inner[i] = true;
+    }
+    let (mut all, mut interior, mut edge) = (Vec::new(), Vec::new(), Vec::new());
+    for (v, &is_inner) in d.iter().zip(&inner) {
+        if let Some(v) = *v {
+            all.push(v);
+            if is_inner {
+                interior.push(v);
+            } else {
+                edge.push(v);
+            }
+        }
+    }
+    Ok(RegionDiff {
+        all: stats(&mut all),
+        interior: stats(&mut interior),
+        edge: stats(&mut edge),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -243,6 +279,29 @@ mod tests {
         assert_eq!(d.rgb[0][0], 2.5);
         assert_eq!(d.rgb[1][0], 4.5);
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn regions_split_interior_and_edge() {
+        // 4 x 3 lit reference: interior (1, 1) and (2, 1); `a` off by a
+        // factor 2 at (1, 1) (interior) and at (0, 0) (edge) only.
+        let mut r = LinearImage::new(4, 3);
+        for p in &mut r.rgb {
+            *p = [0.5, 0.5, 0.5];
+        }
+        let mut a = r.clone();
+        a.rgb[5] = [1.0, 1.0, 1.0];
+        a.rgb[0] = [1.0, 1.0, 1.0];
+        let d = compare_regions(&a, &r).unwrap();
+        assert_eq!(
+            (d.all.pixels, d.interior.pixels, d.edge.pixels),
+            (12, 2, 10)
+        );
+        assert!(d.interior.max > 10.0 && d.edge.max > 10.0, "{d:?}");
+        assert_eq!(d.all.max, d.interior.max);
+        let whole = compare_linear(&a, &r).unwrap();
+        assert_eq!(whole, d.all);
+        assert!((d.interior.mean - d.interior.max / 2.0).abs() < 1e-12);
     }
 
     #[test]

@@ -9,8 +9,7 @@
 use serde_json::json;
 use std::path::Path;
 use sunbeam_common::Result;
-use sunbeam_raster::diff::stats;
-use sunbeam_raster::linear::{interior_pixels, per_pixel_de};
+use sunbeam_raster::linear::{compare_regions, per_pixel_de};
 use sunbeam_raster::{Image, LinearImage};
 
 /// Black (0) through red to yellow (at `scale` and above); unlit pixels dark blue.
@@ -42,22 +41,10 @@ pub(crate) fn run(
             ),
         ));
     }
-    let d = per_pixel_de(&a, &r)?;
-    let interior = interior_pixels(&[&r]);
-    let mut is_interior = vec![false; d.len()];
-    for &i in &interior {
-        is_interior[i] = true;
-    }
-    let mut all: Vec<f64> = d.iter().flatten().copied().collect();
-    let mut inner: Vec<f64> = interior.iter().filter_map(|&i| d[i]).collect();
-    let mut edge: Vec<f64> = d
-        .iter()
-        .zip(&is_interior)
-        .filter(|(_, &int)| !int)
-        .filter_map(|(v, _)| *v)
-        .collect();
-    let (all, inner, edge) = (stats(&mut all), stats(&mut inner), stats(&mut edge));
+    let regions = compare_regions(&a, &r)?;
+    let (all, inner, edge) = (regions.all, regions.interior, regions.edge);
     if let Some(path) = heatmap {
+        let d = per_pixel_de(&a, &r)?;
         let mut im = Image::new(a.width, a.height);
         for (px, v) in im.rgb.iter_mut().zip(&d) {
             *px = heat(*v, scale);
