@@ -57,6 +57,26 @@ fn scaled_snake(dir: &Path, ridge_jitter: u32) -> PathBuf {
 /// the frame), lit from the upper left, in absolute reflectance with the
 /// exposure and base of tests/gpu's ridge sphere.
 fn scene(glb: &Path, pack: Arc<sunbeam_pack::Pack>) -> Prepared {
+    with_scales(glb, pack, |s| {
+        s.camera.target = [0.0, -0.085, 0.02];
+        s.camera.eye = [0.0, -0.104, 0.077];
+        s.camera.fov_y_deg = 30.0;
+        s.lights[0].direction = [-0.35, -0.45, 0.82];
+        s.meshes[0].diffuse_weight = 0.1;
+        s.size = [SIZE, SIZE];
+        let f0 = sunbeam_optics::gain::f0(sunbeam_optics::gain::DEFAULT_IOR);
+        s.exposure -= f0.log2();
+        s.meshes[0].base_color = s.meshes[0].base_color.map(|c| c * f0);
+    })
+}
+
+/// The scene of the baked mesh `glb` with its scale maps and `pack`: the
+/// default point-lit scene, then `set`.
+fn with_scales(
+    glb: &Path,
+    pack: Arc<sunbeam_pack::Pack>,
+    set: impl FnOnce(&mut sunbeam_scene::Scene),
+) -> Prepared {
     let (mesh, scales) = sunbeam_frame::load_mesh_with_scales(glb).unwrap();
     let scales = scales.expect("the baked snake has scale maps");
     let mut s = sunbeam_scene::Scene::default_lit(
@@ -65,15 +85,7 @@ fn scene(glb: &Path, pack: Arc<sunbeam_pack::Pack>) -> Prepared {
         mesh.bounds(),
         sunbeam_scene::DefaultLighting::Point,
     );
-    s.camera.target = [0.0, -0.085, 0.02];
-    s.camera.eye = [0.0, -0.104, 0.077];
-    s.camera.fov_y_deg = 30.0;
-    s.lights[0].direction = [-0.35, -0.45, 0.82];
-    s.meshes[0].diffuse_weight = 0.1;
-    s.size = [SIZE, SIZE];
-    let f0 = sunbeam_optics::gain::f0(sunbeam_optics::gain::DEFAULT_IOR);
-    s.exposure -= f0.log2();
-    s.meshes[0].base_color = s.meshes[0].base_color.map(|c| c * f0);
+    set(&mut s);
     let mut p = fixtures::prepared(s, mesh, Some(pack));
     p.meshes[0].1.scales = Some(Arc::new(scales));
     p
@@ -237,27 +249,19 @@ fn player_shades_the_whole_scaled_snake_silhouettes_included() {
             .args(["--generate-snake", "--scales", "-q", "-o"])
             .arg(&glb),
     );
-    let (mesh, scales) = sunbeam_frame::load_mesh_with_scales(&glb).unwrap();
-    let scales = scales.expect("the baked snake has scale maps");
-    let mut s = sunbeam_scene::Scene::default_lit(
-        glb.clone(),
-        Some("pack".into()),
-        mesh.bounds(),
-        sunbeam_scene::DefaultLighting::Point,
-    );
-    s.camera.eye = [0.0, 0.3, 1.0];
-    s.camera.target = [0.0, 0.0, 0.0];
-    s.camera.fov_y_deg = 35.0;
-    let l: [f64; 3] = [-0.35, 0.6, 0.72];
-    let n = l.iter().map(|v| v * v).sum::<f64>().sqrt();
-    s.lights[0].direction = l.map(|v| v / n);
-    s.meshes[0].base_color = [0.05; 3];
-    s.meshes[0].diffuse_weight = 0.2;
-    s.exposure = 4.64;
-    s.size = [128, 64];
     let pack = Arc::new(ridge_pack(160, 31e-9));
-    let mut p = fixtures::prepared(s, mesh, Some(pack));
-    p.meshes[0].1.scales = Some(Arc::new(scales));
+    let p = with_scales(&glb, pack, |s| {
+        s.camera.eye = [0.0, 0.3, 1.0];
+        s.camera.target = [0.0, 0.0, 0.0];
+        s.camera.fov_y_deg = 35.0;
+        let l: [f64; 3] = [-0.35, 0.6, 0.72];
+        let n = l.iter().map(|v| v * v).sum::<f64>().sqrt();
+        s.lights[0].direction = l.map(|v| v / n);
+        s.meshes[0].base_color = [0.05; 3];
+        s.meshes[0].diffuse_weight = 0.2;
+        s.exposure = 4.64;
+        s.size = [128, 64];
+    });
     let out = std::env::var("SUNBEAM_SCALES_OUT").ok().map(PathBuf::from);
     if let Some(d) = &out {
         std::fs::create_dir_all(d).unwrap();
