@@ -41,7 +41,8 @@ pub fn render_headless(
 ) -> Result<Image> {
     let [w, h] = size.unwrap_or(p.scene.size);
     let r = Renderer::new(gpu, p, settings, OFFSCREEN_FORMAT)?;
-    let target = Offscreen::new(gpu, &r, w, h)?;
+    let mut target = Offscreen::new(gpu, &r, w, h)?;
+    target.plan_frames(frames.max(1));
     let state = FrameState::from_scene(p);
     for _ in 1..frames.max(1) {
         target.draw(gpu, &r, &state)?;
@@ -62,7 +63,8 @@ pub fn render_headless_linear(
     let [w, h] = size.unwrap_or(p.scene.size);
     let k = supersample.max(1);
     let r = Renderer::new(gpu, p, settings, OFFSCREEN_FORMAT)?;
-    let target = Offscreen::new(gpu, &r, w * k, h * k)?;
+    let mut target = Offscreen::new(gpu, &r, w * k, h * k)?;
+    target.plan_frames(frames.max(1));
     let state = FrameState::from_scene(p);
     for _ in 1..frames.max(1) {
         target.draw(gpu, &r, &state)?;

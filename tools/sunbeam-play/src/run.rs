@@ -331,7 +331,8 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             }
             report["setup_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
             let k = cli.supersample.max(1);
-            let target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;
+            let mut target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;
+            target.plan_frames(cli.frames.unwrap_or(1).max(1));
             let state = sunbeam_render::FrameState::from_scene(&prepared);
             let t = std::time::Instant::now();
             for _ in 1..cli.frames.unwrap_or(1).max(1) {

@@ -38,7 +38,8 @@ pub mod uniforms;
 pub use baselines::term_table;
 pub use cells_rate::DEFAULT_CELLS_RATE;
 pub use targets::{
-    colour_view, depth_view, depth_view_ms, subpixel_jitter, Offscreen, OFFSCREEN_FORMAT,
+    colour_view, depth_view, depth_view_ms, lattice_jitter, subpixel_jitter, Offscreen,
+    OFFSCREEN_FORMAT,
 };
 
 use crate::gpu::Gpu;
@@ -698,7 +699,8 @@ impl Renderer {
 
     /// [`Renderer::update`] with the image shifted by `jitter` pixels (x
     /// right, y down): the progressive sum's frames each take another
-    /// sub-pixel position ([`subpixel_jitter`]), so the settled frame is the
+    /// sub-pixel position ([`subpixel_jitter`], or [`lattice_jitter`] for a
+    /// sum of planned length), so the settled frame is the
     /// average over each pixel's area, as a camera sees it (and as the
     /// reference's stratified sub-pixel samples are), not the shading at its
     /// centre.
