@@ -42,12 +42,10 @@ pub fn render_headless(
     let [w, h] = size.unwrap_or(p.scene.size);
     let r = Renderer::new(gpu, p, settings, OFFSCREEN_FORMAT)?;
     let mut target = Offscreen::new(gpu, &r, w, h)?;
-    target.plan_frames(frames.max(1));
     let state = FrameState::from_scene(p);
-    for _ in 1..frames.max(1) {
-        target.draw(gpu, &r, &state)?;
-    }
-    target.render(gpu, &r, &state)
+    Ok(target
+        .render_frames_linear(gpu, &r, &state, frames)?
+        .display(r.curve()))
 }
 
 /// Render one frame offscreen in linear light, `supersample` x the size in each
@@ -64,12 +62,10 @@ pub fn render_headless_linear(
     let k = supersample.max(1);
     let r = Renderer::new(gpu, p, settings, OFFSCREEN_FORMAT)?;
     let mut target = Offscreen::new(gpu, &r, w * k, h * k)?;
-    target.plan_frames(frames.max(1));
     let state = FrameState::from_scene(p);
-    for _ in 1..frames.max(1) {
-        target.draw(gpu, &r, &state)?;
-    }
-    Ok(target.render_linear(gpu, &r, &state)?.downsample(k))
+    Ok(target
+        .render_frames_linear(gpu, &r, &state, frames)?
+        .downsample(k))
 }
 
 /// Frame times of a headless run, milliseconds (each frame waited for).

@@ -332,13 +332,11 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             report["setup_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
             let k = cli.supersample.max(1);
             let mut target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;
-            target.plan_frames(cli.frames.unwrap_or(1).max(1));
             let state = sunbeam_render::FrameState::from_scene(&prepared);
             let t = std::time::Instant::now();
-            for _ in 1..cli.frames.unwrap_or(1).max(1) {
-                target.draw(&gpu, &r, &state)?;
-            }
-            let img = target.render_linear(&gpu, &r, &state)?.downsample(k);
+            let img = target
+                .render_frames_linear(&gpu, &r, &state, cli.frames.unwrap_or(1))?
+                .downsample(k);
             report["render_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
             if r.progressive() {
                 // The environment's Monte Carlo frames, averaged (the settled frame).

@@ -72,8 +72,8 @@ pub struct Offscreen {
     padded_row: u32,
     /// The running sum of a progressive renderer (environment scenes).
     acc: Option<crate::accum::Accumulator>,
-    /// The length of the sum when it is known in advance (a headless run's
-    /// `--frames`): its frames then take the points of one lattice
+    /// The length of the sum when it is known in advance
+    /// ([`Offscreen::render_frames_linear`]): its frames then take the points of one lattice
     /// ([`lattice_jitter`]) instead of the open-ended sequence.
     planned: Option<u32>,
 }
@@ -137,12 +137,25 @@ impl Offscreen {
         })
     }
 
-    /// The progressive sum will be `n` frames long (a headless run): its
-    /// frames take the offsets of an `n`-point lattice over the pixel
-    /// ([`lattice_jitter`]), so their mean is a midpoint rule of the pixel's
-    /// area; frames past `n` fall back to [`subpixel_jitter`].
-    pub fn plan_frames(&mut self, n: u32) {
+    /// Render `n` frames (at least one) and read back the last in linear
+    /// light: for a progressive renderer the mean of the `n` frames, whose
+    /// length is known here, so they take the offsets of an `n`-point
+    /// lattice over the pixel ([`lattice_jitter`]) and their mean is a
+    /// midpoint rule of the pixel's area (frames drawn later, past `n`,
+    /// fall back to [`subpixel_jitter`]). What a headless run renders.
+    pub fn render_frames_linear(
+        &mut self,
+        gpu: &Gpu,
+        r: &Renderer,
+        state: &FrameState,
+        n: u32,
+    ) -> Result<LinearImage> {
+        let n = n.max(1);
         self.planned = Some(n);
+        for _ in 1..n {
+            self.draw(gpu, r, state)?;
+        }
+        self.render_linear(gpu, r, state)
     }
 
     /// Frames in the progressive sum (0 for a renderer that does not accumulate).
@@ -351,6 +364,8 @@ pub fn lattice_jitter(k: u32, n: u32) -> [f64; 2] {
 /// integer nearest n (sqrt 5 - 1) / 2 that is prime to `n` (so every row
 /// holds one point), searched outwards.
 fn fibonacci_generator(n: u32) -> u32 {
+    // Written out: the standard library has no gcd, and six lines do not
+    // justify a dependency (num-integer) for this crate.
     fn gcd(a: u32, b: u32) -> u32 {
         if b == 0 {
             a
@@ -395,9 +410,11 @@ mod jitter_tests {
                 want.sort();
                 got.sort();
                 assert_eq!(got, want, "{n}");
-                assert!(pts.iter().all(|p| p
-                    .iter()
-                    .all(|v| (((v + 0.5) * m as f64 - 0.5).fract()).abs() < 1e-9)));
+                let off_centre = |v: f64| {
+                    let x = (v + 0.5) * m as f64 - 0.5;
+                    (x - x.round()).abs()
+                };
+                assert!(pts.iter().all(|p| p.iter().all(|&v| off_centre(v) < 1e-9)));
             } else {
                 for axis in 0..2 {
                     let mut rows: Vec<i64> = pts
