@@ -450,13 +450,17 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
         // of 2048 cells were cut short, darkening the partly covered pixels
         // of grazing views (docs/LIGHTING.md "One walk per fragment").
         if (envg.estimator == 0u) {
-            if (g.msaa >= 4u && n_cov < 4u) {
+            if (g.msaa >= 4u && (n_cov < 4u || mat.scales_on == 1u)) {
+                // (a mesh with scale maps too, as the point lights: the
+                // sun's orders jump at the scales' borders)
                 var acc = vec3<f32>(0.0);
                 var at = vec2<f32>(0.0);
                 var k = 0.0;
+                // each sample stands for a quarter of the pixel
+                let sample_fp = env_footprint_times(env_fp, 0.5);
                 for (var j = 0u; j < 4u; j = j + 1u) {
                     if (((covered >> j) & 1u) == 1u) {
-                        let sj = env_shade_carried_nowalk(in, da, msaa_position(j), base, dw, diffract, env_fp);
+                        let sj = env_shade_carried_nowalk(in, da, msaa_position(j), base, dw, diffract, sample_fp);
                         acc = acc + sj.xyz;
                         at = at + sj.w * msaa_position(j);
                         k = k + sj.w;

@@ -34,6 +34,12 @@ fn env_no_footprint() -> EnvFootprint {
     return EnvFootprint(z, z, z, z, z, z, z, z);
 }
 
+// The footprint fp scaled by k along both axes (a sample that stands for a
+// part of the pixel).
+fn env_footprint_times(fp: EnvFootprint, k: f32) -> EnvFootprint {
+    return EnvFootprint(k * fp.tx, k * fp.ty, k * fp.bx, k * fp.by, k * fp.nx, k * fp.ny, k * fp.wrx, k * fp.wry);
+}
+
 // XYZ of the hot spots at local view wr, frame (t, b, n), read at one point
 // of each tap's (u, v, w) (the export; the player without a footprint).
 fn env_hotspots(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {

@@ -43,3 +43,18 @@ fn sb_sun_disc_dir(c: vec3<f32>, t: vec3<f32>, b: vec3<f32>, cos_cap: f32, u: f3
 // as the disc (docs/LIGHTING.md "The sun's disc in the first frame").
 const SB_SUN_POINTS: f32 = 16.0;
 const SB_GOLDEN: f32 = 2.3999631;
+
+// Where in the pixel sun point i is read (env_sun_disc): an offset in
+// [-1/2, 1/2]^2 pixels, ((9 i mod 16 + 1/2) / 16, (13 i mod 16 + 1/2) / 16)
+// less one half: one point in every sixteenth of the pixel's rows and of
+// its columns (9 and 13 are prime to 16), and rank-1 lattices against the
+// point's index, so that the disc's radius (which grows with i) lines up
+// with neither axis of the pixel (offsets (i + 1/2) / 16 along x read the
+// disc's rim only at the pixel's right side: three.js' sky-lit sphere p99
+// 0.70 against 0.53 with no footprint, docs/LIGHTING.md "The sun over the
+// pixel").
+fn sb_sun_pixel_offset(i: u32) -> vec2<f32> {
+    let x = f32((9u * i) % 16u) + 0.5;
+    let y = f32((13u * i) % 16u) + 0.5;
+    return vec2<f32>(x, y) / SB_SUN_POINTS - vec2<f32>(0.5);
+}

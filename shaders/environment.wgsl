@@ -708,11 +708,13 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     }
     let gr = env_grid();
     var xyz = vec3<f32>(0.0);
+    // The pixel's footprint for the sharp lights (the hot spots, the sun's
+    // disc); a point under `--no-footprint`.
+    var hot_fp = env_no_footprint();
+    if (envg.hot_footprint == 1u) {
+        hot_fp = fp;
+    }
     if (envg.estimator == 0u) {
-        var hot_fp = env_no_footprint();
-        if (envg.hot_footprint == 1u) {
-            hot_fp = fp;
-        }
         xyz = env_cells_pixel(t, b, n, wr, clip, dist, walk) + env_hotspots_footprint(t, b, n, wr, hot_fp);
     } else {
     // The first frame after a reset (every frame while the view moves) is the
@@ -786,7 +788,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     }
     if (envg.has_sun == 1u && envp.has_sun == 1u) {
         if (envg.estimator == 0u) {
-            xyz = xyz + env_sun_disc(t, b, n, wr, gr);
+            xyz = xyz + env_sun_disc(t, b, n, wr, gr, hot_fp);
         } else {
             // Uniform on the disc (Sky::sample_sun).
             let u = env_qmc(envg.frame + 1u, 17u);
@@ -800,12 +802,23 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
 // solid angle, `ph` the angle around its centre: G times the sun's map (which
 // holds Omega_sun E_sun, EnvResponse::sun).
 fn env_sun_point(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: SbGrid, u: f32, ph: f32) -> vec3<f32> {
+    return env_sun_point_fp(t, b, n, wr, gr, u, ph, vec2<f32>(0.0), env_no_footprint());
+}
+
+// As env_sun_point, the map read at offset o (in pixels, within the pixel's
+// square) across the pixel's footprint fp: the point's (u, v, w) = -wi - wr
+// moves with the frame and the view as a hot spot's tap does
+// (env_hotspots_footprint). G and the masking, smooth over the pixel, at the
+// centre.
+fn env_sun_point_fp(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: SbGrid, u: f32, ph: f32, o: vec2<f32>, fp: EnvFootprint) -> vec3<f32> {
     let d = sb_sun_disc_dir(envg.sun_dir.xyz, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w, u, ph);
     let wi = vec3<f32>(dot(d, t), dot(d, b), dot(d, n));
     if (wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    let rc = sb_resp_coords(-wi - wr, gr);
+    let dx = -vec3<f32>(dot(d, fp.tx), dot(d, fp.bx), dot(d, fp.nx)) - fp.wrx;
+    let dy = -vec3<f32>(dot(d, fp.ty), dot(d, fp.by), dot(d, fp.ny)) - fp.wry;
+    let rc = sb_resp_coords(-wi - wr + o.x * dx + o.y * dy, gr);
     return gain(wi, wr) * env_map(env_esun, rc, gr);
 }
 
@@ -814,26 +827,31 @@ fn env_sun_point(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: Sb
 // point per frame: on a pack of real size the orders of a point are as
 // narrow as the disc (82 um: a lobe of about 0.4 degrees, the disc 0.53),
 // so one point per sample leaves the sun's streaks noisy in the first frame
-// (docs/LIGHTING.md "The sun's disc in the first frame"). Written out:
-// llvmpipe counts loop iterations against one limit per invocation, which
-// the cells' walk needs.
-fn env_sun_disc(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: SbGrid) -> vec3<f32> {
+// (docs/LIGHTING.md "The sun's disc in the first frame"). Each point is
+// also read at its own place in the pixel's footprint fp
+// (sb_sun_pixel_offset): the points integrate the disc and the pixel
+// together, as a camera's pixel does; where the sun's orders are sharp
+// within a pixel (a domed scale, a pack of real size) one place in the
+// pixel is a point sample of them (docs/LIGHTING.md "The sun over the
+// pixel"). Written out: llvmpipe counts loop iterations against one limit
+// per invocation, which the cells' walk needs.
+fn env_sun_disc(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: SbGrid, fp: EnvFootprint) -> vec3<f32> {
     let r = SB_TAU * env_qmc(envg.frame + 1u, 19u);
-    var s = env_sun_point(t, b, n, wr, gr, 0.5 / SB_SUN_POINTS, r);
-    s = s + env_sun_point(t, b, n, wr, gr, 1.5 / SB_SUN_POINTS, r + 1.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 2.5 / SB_SUN_POINTS, r + 2.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 3.5 / SB_SUN_POINTS, r + 3.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 4.5 / SB_SUN_POINTS, r + 4.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 5.5 / SB_SUN_POINTS, r + 5.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 6.5 / SB_SUN_POINTS, r + 6.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 7.5 / SB_SUN_POINTS, r + 7.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 8.5 / SB_SUN_POINTS, r + 8.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 9.5 / SB_SUN_POINTS, r + 9.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 10.5 / SB_SUN_POINTS, r + 10.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 11.5 / SB_SUN_POINTS, r + 11.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 12.5 / SB_SUN_POINTS, r + 12.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 13.5 / SB_SUN_POINTS, r + 13.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 14.5 / SB_SUN_POINTS, r + 14.0 * SB_GOLDEN);
-    s = s + env_sun_point(t, b, n, wr, gr, 15.5 / SB_SUN_POINTS, r + 15.0 * SB_GOLDEN);
+    var s = env_sun_point_fp(t, b, n, wr, gr, 0.5 / SB_SUN_POINTS, r, sb_sun_pixel_offset(0u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 1.5 / SB_SUN_POINTS, r + 1.0 * SB_GOLDEN, sb_sun_pixel_offset(1u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 2.5 / SB_SUN_POINTS, r + 2.0 * SB_GOLDEN, sb_sun_pixel_offset(2u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 3.5 / SB_SUN_POINTS, r + 3.0 * SB_GOLDEN, sb_sun_pixel_offset(3u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 4.5 / SB_SUN_POINTS, r + 4.0 * SB_GOLDEN, sb_sun_pixel_offset(4u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 5.5 / SB_SUN_POINTS, r + 5.0 * SB_GOLDEN, sb_sun_pixel_offset(5u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 6.5 / SB_SUN_POINTS, r + 6.0 * SB_GOLDEN, sb_sun_pixel_offset(6u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 7.5 / SB_SUN_POINTS, r + 7.0 * SB_GOLDEN, sb_sun_pixel_offset(7u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 8.5 / SB_SUN_POINTS, r + 8.0 * SB_GOLDEN, sb_sun_pixel_offset(8u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 9.5 / SB_SUN_POINTS, r + 9.0 * SB_GOLDEN, sb_sun_pixel_offset(9u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 10.5 / SB_SUN_POINTS, r + 10.0 * SB_GOLDEN, sb_sun_pixel_offset(10u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 11.5 / SB_SUN_POINTS, r + 11.0 * SB_GOLDEN, sb_sun_pixel_offset(11u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 12.5 / SB_SUN_POINTS, r + 12.0 * SB_GOLDEN, sb_sun_pixel_offset(12u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 13.5 / SB_SUN_POINTS, r + 13.0 * SB_GOLDEN, sb_sun_pixel_offset(13u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 14.5 / SB_SUN_POINTS, r + 14.0 * SB_GOLDEN, sb_sun_pixel_offset(14u), fp);
+    s = s + env_sun_point_fp(t, b, n, wr, gr, 15.5 / SB_SUN_POINTS, r + 15.0 * SB_GOLDEN, sb_sun_pixel_offset(15u), fp);
     return s / SB_SUN_POINTS;
 }

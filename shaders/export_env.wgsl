@@ -146,6 +146,14 @@ fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
 // functions). The transmitted table is made for one index
 // (environment.json `irradiance.ior`): the material's skin.x must be it.
 fn sunbeam_shade_environment(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    return sunbeam_shade_environment_footprint(t, b, n, wr, env_no_footprint());
+}
+
+// As sunbeam_shade_environment, the hot spots' taps read over the pixel's
+// footprint fp (EnvFootprint: the screen derivatives of t, b, n and of the
+// local view (dot(wr, t), dot(wr, b), dot(wr, n)), dFdx / dFdy), as the
+// player does: a hot spot's orders are sharp within a pixel.
+fn sunbeam_shade_environment_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, fp: EnvFootprint) -> vec3<f32> {
     let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
     if (wr_l.z <= 0.0) {
         return vec3<f32>(0.0);
@@ -155,7 +163,7 @@ fn sunbeam_shade_environment(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<
     if (dw >= 1.0 || env_cells_top() == 0u) {
         return base;
     }
-    let xyz = env_cells(t, b, n, wr_l) + env_hotspots(t, b, n, wr_l);
+    let xyz = env_cells(t, b, n, wr_l) + env_hotspots_footprint(t, b, n, wr_l, fp);
     return base + (1.0 - dw) * sb_xyz_to_linear_srgb(xyz);
 }
 
@@ -169,6 +177,15 @@ fn sunbeam_shade_environment(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<
 // frame does (0: the point wi alone), plus the base lit by the disc, dw *
 // base * Omega L cos (1 - F) / pi at wi. 0 without a sun.
 fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    return sunbeam_shade_sun_footprint(t, b, n, wi, wr, env_no_footprint());
+}
+
+// As sunbeam_shade_sun, each point of the disc read at its own place in the
+// pixel's footprint fp (as sunbeam_shade_environment_footprint;
+// sb_sun_pixel_offset): the points integrate the disc and the pixel
+// together, as the player's first frame does, where the sun's orders are
+// sharp within a pixel (domed scales, packs of real size).
+fn sunbeam_shade_sun_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>, fp: EnvFootprint) -> vec3<f32> {
     if (sunbeam_env.sun_dir.w <= 0.0) {
         return vec3<f32>(0.0);
     }
@@ -189,11 +206,14 @@ fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr
             for (var i = 0u; i < u32(SB_SUN_POINTS); i = i + 1u) {
                 let u = (f32(i) + 0.5) / SB_SUN_POINTS;
                 let d = sb_sun_disc_dir(wi, dt, db, cos_cap, u, f32(i) * SB_GOLDEN);
-                diff = diff + env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr);
+                let o = sb_sun_pixel_offset(i);
+                let dx = o.x * (-vec3<f32>(dot(d, fp.tx), dot(d, fp.bx), dot(d, fp.nx)) - fp.wrx);
+                let dy = o.y * (-vec3<f32>(dot(d, fp.ty), dot(d, fp.by), dot(d, fp.ny)) - fp.wry);
+                diff = diff + env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr, dx + dy);
             }
             diff = diff / SB_SUN_POINTS;
         } else {
-            diff = env_sun_at(wi_l, wr_l, skin, gr);
+            diff = env_sun_at(wi_l, wr_l, skin, gr, vec3<f32>(0.0));
         }
         diff = sb_xyz_to_linear_srgb(diff);
     }
@@ -202,13 +222,14 @@ fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr
     return dw * sunbeam.base.rgb * lit + (1.0 - dw) * diff;
 }
 
-// The sun's map at local incidence wi and view wr, times G and the masking
-// (XYZ; 0 for a direction below the horizon).
-fn env_sun_at(wi: vec3<f32>, wr: vec3<f32>, skin: SbSkin, gr: SbGrid) -> vec3<f32> {
+// The sun's map at local incidence wi and view wr, its (u, v, w) moved by
+// `shift` (a place in the pixel's footprint), times G and the masking (XYZ;
+// 0 for a direction below the horizon).
+fn env_sun_at(wi: vec3<f32>, wr: vec3<f32>, skin: SbSkin, gr: SbGrid, shift: vec3<f32>) -> vec3<f32> {
     if (wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    let at = sb_resp_uvw(sb_resp_coords(-wi - wr, gr), gr);
+    let at = sb_resp_uvw(sb_resp_coords(-wi - wr + shift, gr), gr);
     let e = textureSampleLevel(env_sun_map, resp_smp, at, 0.0).xyz;
     return e * sb_gain(wi, wr, skin) * sb_masking(wi, wr, skin.slope);
 }

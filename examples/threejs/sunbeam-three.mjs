@@ -185,7 +185,7 @@ export function adaptExportedGlsl(src) {
     out.push(l);
   }
   const text = out.join('\n');
-  for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun(', 'vec3 sunbeam_shade_environment(', 'mat3x3 sb_frame(',
+  for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun_footprint(', 'vec3 sunbeam_shade_environment_footprint(', 'struct EnvFootprint', 'mat3x3 sb_frame(',
     'uniform SunbeamMaterial _group_0_binding_0_fs;', 'uniform SunbeamEnvironment _group_0_binding_8_fs;', '_group_0_binding_1_fs', '_group_0_binding_7_fs', '_group_0_binding_9_fs',
     'mat3x3 sunbeam_scale_frame(', '_group_0_binding_10_fs', '_group_0_binding_11_fs']) {
     if (!text.includes(need)) throw new Error(`exported GLSL: ${need} not found (docs/ENGINES.md; export it with this sunbeam-play)`);
@@ -309,6 +309,16 @@ void main() {
   vec3 b = f[1];
   vec3 n = f[2];
   vec3 wr = normalize(sbEye - vWorld);
+  // The pixel's footprint for the environment's sharp lights (the sun's
+  // disc, a map's hot spots): the frame's and the local view's screen
+  // derivatives, taken here in uniform control flow (env_hotspots.wgsl
+  // EnvFootprint, as the player's). None on a mesh with scale maps: the
+  // derivatives jump across the scales' borders, where they would smear the
+  // orders of two scales together (the player shades such pixels at their
+  // samples instead; docs/LIGHTING.md "The sun over the pixel").
+  vec3 wrl = vec3(dot(wr, t), dot(wr, b), dot(wr, n));
+  float k = sbScales == 0u ? 1.0 : 0.0;
+  EnvFootprint fp = EnvFootprint(k * dFdx(t), k * dFdy(t), k * dFdx(b), k * dFdy(b), k * dFdx(n), k * dFdy(n), k * dFdx(wrl), k * dFdy(wrl));
   vec3 rgb = vec3(0.0);
   for (int i = 0; i < ${MAX_LIGHTS}; i++) {
     if (i >= sbLightCount) break;
@@ -329,7 +339,7 @@ void main() {
     vec3 base = _group_0_binding_0_fs.base.rgb;
     vec4 sun = _group_0_binding_8_fs.sun_dir;
     if (sbHasMap == 1) {
-      rgb += sunbeam_shade_environment(t, b, n, wr) + sunbeam_shade_sun(t, b, n, sun.xyz, wr);
+      rgb += sunbeam_shade_environment_footprint(t, b, n, wr, fp) + sunbeam_shade_sun_footprint(t, b, n, sun.xyz, wr, fp);
     } else {
       rgb += base * env_irradiance(false, n) / PI;
       if (sun.w > 0.0) rgb += base * _group_0_binding_8_fs.sun_rgb.rgb * max(dot(sun.xyz, n), 0.0) / PI;

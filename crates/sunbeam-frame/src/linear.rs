@@ -234,9 +234,45 @@ pub struct RegionDiff {
 
 /// [`RegionDiff`] of `a` against `reference` (same size).
 pub fn compare_regions(a: &LinearImage, reference: &LinearImage) -> Result<RegionDiff> {
-    let d = per_pixel_de(a, reference)?;
+    compare_regions_within(a, reference, None)
+}
+
+/// Per-pixel differences ([`per_pixel_de`]) kept only where `mask` (same
+/// size) is lit.
+pub fn only_lit_in(d: &mut [Option<f64>], mask: &LinearImage) {
+    for (v, p) in d.iter_mut().zip(&mask.rgb) {
+        if luminance(*p) < LIT_Y {
+            *v = None;
+        }
+    }
+}
+
+/// [`compare_regions`] over the pixels lit in `mask` (same size) alone, the
+/// interior and the edge taken from the mask's lit area: an object's pixels
+/// when a background is drawn behind it (the mask: a frame of the same
+/// camera with the background off), where the reference's lit area is the
+/// whole frame. `None`: the reference's lit area.
+pub fn compare_regions_within(
+    a: &LinearImage,
+    reference: &LinearImage,
+    mask: Option<&LinearImage>,
+) -> Result<RegionDiff> {
+    let mut d = per_pixel_de(a, reference)?;
+    let area = match mask {
+        Some(m) => {
+            if (m.width, m.height) != (reference.width, reference.height) {
+                return Err(Error::input(format!(
+                    "the mask's size {}x{} differs from the reference's {}x{}",
+                    m.width, m.height, reference.width, reference.height
+                )));
+            }
+            only_lit_in(&mut d, m);
+            m
+        }
+        None => reference,
+    };
     let mut inner = vec![false; d.len()];
-    for i in interior_pixels(&[reference]) {
+    for i in interior_pixels(&[area]) {
         inner[i] = true;
     }
     let (mut all, mut interior, mut edge) = (Vec::new(), Vec::new(), Vec::new());
@@ -302,6 +338,19 @@ mod tests {
         let whole = compare_linear(&a, &r).unwrap();
         assert_eq!(whole, d.all);
         assert!((d.interior.mean - d.interior.max / 2.0).abs() < 1e-12);
+
+        // A mask lit on the right 3 x 3 alone: (0, 0) is outside it, (2, 1)
+        // its one interior pixel, and the interior error at (1, 1) now on
+        // its edge.
+        let mut m = r.clone();
+        for y in 0..3 {
+            m.rgb[y * 4] = [0.0; 3];
+        }
+        let d = compare_regions_within(&a, &r, Some(&m)).unwrap();
+        assert_eq!((d.all.pixels, d.interior.pixels, d.edge.pixels), (9, 1, 8));
+        assert_eq!(d.interior.max, 0.0);
+        assert!(d.edge.max > 10.0, "{d:?}");
+        assert!(compare_regions_within(&a, &r, Some(&LinearImage::new(3, 3))).is_err());
     }
 
     #[test]

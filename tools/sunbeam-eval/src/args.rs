@@ -68,6 +68,9 @@ pub(crate) struct DiffArgs {
     /// CIEDE2000 shown as yellow in the heat map.
     #[arg(long, default_value_t = 10.0, value_parser = positive)]
     pub(crate) scale: f64,
+    /// Judge only the pixels lit in this frame (linear EXR, the same size; e.g. the object lit from the eye with the background off), its interior and edge: an object in front of a drawn background.
+    #[arg(long)]
+    pub(crate) mask: Option<PathBuf>,
     /// Machine-readable report on stdout.
     #[arg(long)]
     pub(crate) json: bool,

@@ -35,6 +35,7 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             &a.image,
             &a.reference,
             a.heatmap.as_deref(),
+            a.mask.as_deref(),
             a.scale,
             a.json,
         ),

@@ -4,12 +4,13 @@
 //! transform), split into the interior of the lit area and its one-pixel
 //! edge (silhouettes, where sub-pixel coverage dominates), with an optional
 //! false-colour map of the per-pixel error to see *where* two renderers
-//! disagree.
+//! disagree, and an optional mask (`--mask`: an object's pixels in front of a
+//! drawn background).
 
 use serde_json::json;
 use std::path::Path;
 use sunbeam_common::Result;
-use sunbeam_raster::linear::{compare_regions, per_pixel_de};
+use sunbeam_raster::linear::{compare_regions_within, only_lit_in, per_pixel_de};
 use sunbeam_raster::{Image, LinearImage};
 
 /// Black (0) through red to yellow (at `scale` and above); unlit pixels dark blue.
@@ -27,6 +28,7 @@ pub(crate) fn run(
     image: &Path,
     reference: &Path,
     heatmap: Option<&Path>,
+    mask: Option<&Path>,
     scale: f64,
     json_out: bool,
 ) -> Result<()> {
@@ -41,10 +43,29 @@ pub(crate) fn run(
             ),
         ));
     }
-    let regions = compare_regions(&a, &r)?;
+    let mask = match mask {
+        Some(m) => {
+            let im = LinearImage::read_exr(m)?;
+            if (im.width, im.height) != (r.width, r.height) {
+                return Err(sunbeam_common::Error::input_file(
+                    m,
+                    format!(
+                        "size {}x{} differs from the reference's {}x{}",
+                        im.width, im.height, r.width, r.height
+                    ),
+                ));
+            }
+            Some(im)
+        }
+        None => None,
+    };
+    let regions = compare_regions_within(&a, &r, mask.as_ref())?;
     let (all, inner, edge) = (regions.all, regions.interior, regions.edge);
     if let Some(path) = heatmap {
-        let d = per_pixel_de(&a, &r)?;
+        let mut d = per_pixel_de(&a, &r)?;
+        if let Some(m) = &mask {
+            only_lit_in(&mut d, m);
+        }
         let mut im = Image::new(a.width, a.height);
         for (px, v) in im.rgb.iter_mut().zip(&d) {
             *px = heat(*v, scale);

@@ -121,3 +121,59 @@ fn diff_refuses_different_sizes_and_missing_files() {
     assert_eq!(o.status.code(), Some(1), "a usage error");
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// `--mask`: only the pixels lit in the mask count, and the interior comes
+/// from the mask's lit area; a mask of another size exits 2 naming it.
+#[test]
+fn diff_judges_only_the_masks_pixels() {
+    let d = tmpdir("diff-mask");
+    let (a, r, m) = (d.join("a.exr"), d.join("r.exr"), d.join("m.exr"));
+    // Every pixel of the reference lit (a background drawn behind).
+    let mut full = LinearImage::new(5, 5);
+    full.rgb.iter_mut().for_each(|p| *p = GREY);
+    full.write_exr(&r).unwrap();
+    // The object: the 4 x 4 block from (1, 1); its interior (2..=3, 2..=3).
+    let mut mask = LinearImage::new(5, 5);
+    for y in 1..5 {
+        for x in 1..5 {
+            mask.rgb[y * 5 + x] = GREY;
+        }
+    }
+    mask.write_exr(&m).unwrap();
+    let mut im = full.clone();
+    im.rgb[0] = RED; // the background: not judged
+    im.rgb[2 * 5 + 2] = RED; // the object's interior
+    im.write_exr(&a).unwrap();
+    let out = ok(&[
+        "diff",
+        a.to_str().unwrap(),
+        r.to_str().unwrap(),
+        "--mask",
+        m.to_str().unwrap(),
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(stats(&v, "all").3, 16);
+    let (_, _, max, n) = stats(&v, "interior");
+    assert_eq!(n, 4);
+    assert!(max > 10.0, "{max}");
+    assert_eq!(stats(&v, "edge").2, 0.0);
+    // Without the mask the background's pixel counts.
+    let out = ok(&["diff", a.to_str().unwrap(), r.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(stats(&v, "all").3, 25);
+    assert!(stats(&v, "edge").2 > 10.0);
+
+    LinearImage::new(4, 5).write_exr(&m).unwrap();
+    let o = run(&[
+        "diff",
+        a.to_str().unwrap(),
+        r.to_str().unwrap(),
+        "--mask",
+        m.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("m.exr") && err.contains("4x5"), "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}

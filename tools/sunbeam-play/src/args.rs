@@ -38,7 +38,8 @@ pub(crate) struct Cli {
     #[arg(long, default_value_t = 1)]
     pub(crate) supersample: u32,
     /// Read the response maps at the pixel centre only (no footprint filter): the point
-    /// lights' map, and the environment's hot spots under the cells estimator.
+    /// lights' map, and the environment's hot spots and the sun's disc points under the
+    /// cells estimator.
     #[arg(long)]
     pub(crate) no_footprint: bool,
     /// Frame size WxH (headless: default the scene's size; window: initial size).
