@@ -62,7 +62,9 @@ struct EnvGlobals {
     // 1: the hot spots' taps read the maps over the pixel's footprint
     // (env_hotspots_footprint), 0: at one point
     hot_footprint: u32,
-    _e2: u32,
+    // the part of the pixel along each axis one frame of a running mean
+    // stands for: the footprint's scale (EnvGlobals::frame_share)
+    frame_share: f32,
 };
 
 struct EnvProposal {
@@ -709,10 +711,11 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     let gr = env_grid();
     var xyz = vec3<f32>(0.0);
     // The pixel's footprint for the sharp lights (the hot spots, the sun's
-    // disc); a point under `--no-footprint`.
+    // disc), this frame's share of it in a running mean; a point under
+    // `--no-footprint`.
     var hot_fp = env_no_footprint();
     if (envg.hot_footprint == 1u) {
-        hot_fp = fp;
+        hot_fp = env_footprint_times(fp, envg.frame_share);
     }
     if (envg.estimator == 0u) {
         xyz = env_cells_pixel(t, b, n, wr, clip, dist, walk) + env_hotspots_footprint(t, b, n, wr, hot_fp);

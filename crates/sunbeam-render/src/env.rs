@@ -74,7 +74,13 @@ pub(crate) struct EnvGlobals {
     pub(crate) table_phase: f32,
     /// 1: the hot spots' taps read the maps over the pixel's footprint.
     pub(crate) hot_footprint: u32,
-    pub(crate) _e2: u32,
+    /// The part of the pixel, along each axis, that one frame of a running
+    /// mean stands for (the footprint's scale for the hot spots and the
+    /// sun): 1 for a frame alone, 1 / m for each of a headless run's m x m
+    /// lattice frames, 0 for the window's jittered frames after the first
+    /// (their jitter covers the pixel; a footprint as well would widen the
+    /// pixel's kernel to a tent).
+    pub(crate) frame_share: f32,
 }
 
 /// How the player integrates an environment (`sunbeam-play --env-estimator`).
@@ -248,6 +254,7 @@ impl EnvScene {
             },
             irr_ior: ior as f32,
             hot_footprint: u32::from(footprint),
+            frame_share: 1.0,
             table_w: 1,
             table_h: 1,
             ..Default::default()
@@ -376,9 +383,10 @@ impl EnvScene {
     }
 
     /// Set the frame index (the random numbers' seed) for the next frame.
-    pub(crate) fn set_frame(&self, gpu: &Gpu, frame: u32) {
+    pub(crate) fn set_frame(&self, gpu: &Gpu, frame: u32, share: f32) {
         let mut v = self.values;
         v.frame = frame;
+        v.frame_share = share;
         gpu.queue
             .write_buffer(&self.globals, 0, bytemuck::bytes_of(&v));
     }

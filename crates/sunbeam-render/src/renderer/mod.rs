@@ -686,9 +686,9 @@ impl Renderer {
     }
 
     /// Set the frame index that seeds the next frame's random numbers.
-    pub fn set_frame(&self, gpu: &Gpu, frame: u32) {
+    pub fn set_frame(&self, gpu: &Gpu, frame: u32, share: f32) {
         if self.progressive() {
-            self.env.set_frame(gpu, frame);
+            self.env.set_frame(gpu, frame, share);
         }
     }
 

@@ -194,12 +194,15 @@ impl Offscreen {
         match &self.acc {
             Some(a) => {
                 let k = a.count();
-                let jitter = match self.planned {
-                    Some(n) if k < n => lattice_jitter(k, n),
-                    _ => subpixel_jitter(k),
+                // (the share of the pixel each frame stands for: the
+                // footprint of the environment's sharp lights is scaled by it)
+                let (jitter, share) = match self.planned {
+                    Some(n) if k < n => (lattice_jitter(k, n), 1.0 / (n as f32).sqrt()),
+                    _ if k == 0 => (subpixel_jitter(k), 1.0),
+                    _ => (subpixel_jitter(k), 0.0),
                 };
                 r.update_jittered(gpu, state, self.width, self.height, jitter);
-                r.set_frame(gpu, a.count());
+                r.set_frame(gpu, a.count(), share);
             }
             None => r.update(gpu, state, self.width, self.height),
         }

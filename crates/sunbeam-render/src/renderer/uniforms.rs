@@ -294,7 +294,7 @@ mod layout_tests {
         check(
             "EnvGlobals",
             size_of::<EnvGlobals>(),
-            &f!(EnvGlobals; basis_to_rgb, sun_dir, sun_rgb, sun_t, sun_b, table_w, table_h, frame, on, has_sun, samples, estimator, chain_levels, irr_ior, table_phase, hot_footprint),
+            &f!(EnvGlobals; basis_to_rgb, sun_dir, sun_rgb, sun_t, sun_b, table_w, table_h, frame, on, has_sun, samples, estimator, chain_levels, irr_ior, table_phase, hot_footprint, frame_share),
         );
         check(
             "EnvProposal",
