@@ -40,6 +40,18 @@ fn env_footprint_times(fp: EnvFootprint, k: f32) -> EnvFootprint {
     return EnvFootprint(k * fp.tx, k * fp.ty, k * fp.bx, k * fp.by, k * fp.nx, k * fp.ny, k * fp.wrx, k * fp.wry);
 }
 
+// How (u, v, w) = -wi - wr of a fixed world direction d moves across the
+// pixel, along x: the frame's columns turn under d and the view changes
+// (the hot spots' taps, the sun's disc points).
+fn env_footprint_dx(d: vec3<f32>, fp: EnvFootprint) -> vec3<f32> {
+    return -vec3<f32>(dot(d, fp.tx), dot(d, fp.bx), dot(d, fp.nx)) - fp.wrx;
+}
+
+// As env_footprint_dx, along y.
+fn env_footprint_dy(d: vec3<f32>, fp: EnvFootprint) -> vec3<f32> {
+    return -vec3<f32>(dot(d, fp.ty), dot(d, fp.by), dot(d, fp.ny)) - fp.wry;
+}
+
 // XYZ of the hot spots at local view wr, frame (t, b, n), read at one point
 // of each tap's (u, v, w) (the export; the player without a footprint).
 fn env_hotspots(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
@@ -71,8 +83,8 @@ fn env_hotspots_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32
         }
         let p = env_hot_power(i);
         let uvw = -wi - wr;
-        let dx = -vec3<f32>(dot(d, fp.tx), dot(d, fp.bx), dot(d, fp.nx)) - fp.wrx;
-        let dy = -vec3<f32>(dot(d, fp.ty), dot(d, fp.by), dot(d, fp.ny)) - fp.wry;
+        let dx = env_footprint_dx(d, fp);
+        let dy = env_footprint_dy(d, fp);
         let sx = u32(clamp(ceil(2.0 * length(sb_resp_dcoords(uvw, dx, gr))), 1.0, ENV_HOT_FOOTPRINT));
         let sy = u32(clamp(ceil(2.0 * length(sb_resp_dcoords(uvw, dy, gr))), 1.0, ENV_HOT_FOOTPRINT));
         var e = vec3<f32>(0.0);

@@ -819,9 +819,7 @@ fn env_sun_point_fp(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr:
     if (wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    let dx = -vec3<f32>(dot(d, fp.tx), dot(d, fp.bx), dot(d, fp.nx)) - fp.wrx;
-    let dy = -vec3<f32>(dot(d, fp.ty), dot(d, fp.by), dot(d, fp.ny)) - fp.wry;
-    let rc = sb_resp_coords(-wi - wr + o.x * dx + o.y * dy, gr);
+    let rc = sb_resp_coords(-wi - wr + o.x * env_footprint_dx(d, fp) + o.y * env_footprint_dy(d, fp), gr);
     return gain(wi, wr) * env_map(env_esun, rc, gr);
 }
 

@@ -207,9 +207,8 @@ fn sunbeam_shade_sun_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec
                 let u = (f32(i) + 0.5) / SB_SUN_POINTS;
                 let d = sb_sun_disc_dir(wi, dt, db, cos_cap, u, f32(i) * SB_GOLDEN);
                 let o = sb_sun_pixel_offset(i);
-                let dx = o.x * (-vec3<f32>(dot(d, fp.tx), dot(d, fp.bx), dot(d, fp.nx)) - fp.wrx);
-                let dy = o.y * (-vec3<f32>(dot(d, fp.ty), dot(d, fp.by), dot(d, fp.ny)) - fp.wry);
-                diff = diff + env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr, dx + dy);
+                let shift = o.x * env_footprint_dx(d, fp) + o.y * env_footprint_dy(d, fp);
+                diff = diff + env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr, shift);
             }
             diff = diff / SB_SUN_POINTS;
         } else {
