@@ -312,12 +312,19 @@ void main() {
   // The pixel's footprint for the environment's sharp lights (the sun's
   // disc, a map's hot spots): the frame's and the local view's screen
   // derivatives, taken here in uniform control flow (env_hotspots.wgsl
-  // EnvFootprint, as the player's). None on a mesh with scale maps: the
-  // derivatives jump across the scales' borders, where they would smear the
-  // orders of two scales together (the player shades such pixels at their
-  // samples instead; docs/LIGHTING.md "The sun over the pixel").
+  // EnvFootprint, as the player's). On a mesh with scale maps, only inside
+  // one scale: across a scale's border the derivatives jump and would smear
+  // the orders of two scales together, so a pixel whose 2 x 2 quad sees two
+  // scale ids (the orientation map's alpha at the nearest texel) reads at a
+  // point (the player shades such pixels at their samples instead;
+  // docs/LIGHTING.md "The sun over the pixel").
   vec3 wrl = vec3(dot(wr, t), dot(wr, b), dot(wr, n));
-  float k = sbScales == 0u ? 1.0 : 0.0;
+  ivec2 osz = textureSize(_group_0_binding_11_fs, 0);
+  // the texel under vUv, wrapped (GLSL ES leaves % of negatives undefined)
+  vec2 ouv = vUv - floor(vUv);
+  ivec2 otx = min(ivec2(ouv * vec2(osz)), osz - 1);
+  float scaleId = texelFetch(_group_0_binding_11_fs, otx, 0).a * 255.0;
+  float k = sbScales == 0u || fwidth(scaleId) < 0.5 ? 1.0 : 0.0;
   EnvFootprint fp = EnvFootprint(k * dFdx(t), k * dFdy(t), k * dFdx(b), k * dFdy(b), k * dFdx(n), k * dFdy(n), k * dFdx(wrl), k * dFdy(wrl));
   vec3 rgb = vec3(0.0);
   for (int i = 0; i < ${MAX_LIGHTS}; i++) {
