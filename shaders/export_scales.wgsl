@@ -26,3 +26,13 @@ fn sunbeam_scale_frame(normal: vec3<f32>, orientation: vec3<f32>, tangent: vec4<
     }
     return sb_scale_frame(scale_normal_tex, scale_orient_tex, scales & 15u, normal, tangent, uv, fr);
 }
+
+// The scale id under `uv` (sb_scale_id; 0 without scale maps): where it
+// differs across a pixel's 2 x 2 quad (fwidth) the quad spans a scale
+// border, and the screen derivatives of the frame jump there.
+fn sunbeam_scale_id(uv: vec2<f32>, scales: u32) -> f32 {
+    if ((scales & 16u) == 0u) {
+        return 0.0;
+    }
+    return sb_scale_id(scale_orient_tex, uv, (scales >> 2u) & 3u);
+}

@@ -43,6 +43,17 @@ fn sb_scale_taps(tex: texture_2d<f32>, uv: vec2<f32>, wrap: u32, texels: ptr<fun
     return vec4<f32>((1.0 - w.x) * (1.0 - w.y), w.x * (1.0 - w.y), (1.0 - w.x) * w.y, w.x * w.y);
 }
 
+// The scale id at `uv`: the orientation map's alpha (the id modulo 256,
+// docs/BAKE.md) at the texel under `uv`, with the map's wrap bits as in
+// sb_scale_taps; a change between neighbouring fragments marks a scale border.
+fn sb_scale_id(ot: texture_2d<f32>, uv: vec2<f32>, wrap: u32) -> f32 {
+    let n = max(vec2<i32>(textureDimensions(ot, 0)), vec2<i32>(1));
+    let i = vec2<i32>(floor(uv * vec2<f32>(n)));
+    let x = sb_scale_index(i.x, n.x, (wrap & 1u) == 1u);
+    let y = sb_scale_index(i.y, n.y, (wrap & 2u) == 2u);
+    return textureLoad(ot, vec2<i32>(x, y), 0).a * 255.0;
+}
+
 // The shading frame (columns t, b, n) at a fragment of a scaled mesh:
 // `normal` and `tangent` (the glTF TANGENT: xyz = the UV frame, w = the
 // bitangent's sign) interpolated from the vertices, `uv` its TEXCOORD_0;

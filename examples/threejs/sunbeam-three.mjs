@@ -187,7 +187,7 @@ export function adaptExportedGlsl(src) {
   const text = out.join('\n');
   for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun_footprint(', 'vec3 sunbeam_shade_environment_footprint(', 'struct EnvFootprint', 'mat3x3 sb_frame(',
     'uniform SunbeamMaterial _group_0_binding_0_fs;', 'uniform SunbeamEnvironment _group_0_binding_8_fs;', '_group_0_binding_1_fs', '_group_0_binding_7_fs', '_group_0_binding_9_fs',
-    'mat3x3 sunbeam_scale_frame(', '_group_0_binding_10_fs', '_group_0_binding_11_fs']) {
+    'mat3x3 sunbeam_scale_frame(', 'float sunbeam_scale_id(', '_group_0_binding_10_fs', '_group_0_binding_11_fs']) {
     if (!text.includes(need)) throw new Error(`exported GLSL: ${need} not found (docs/ENGINES.md; export it with this sunbeam-play)`);
   }
   return text;
@@ -315,16 +315,11 @@ void main() {
   // EnvFootprint, as the player's). On a mesh with scale maps, only inside
   // one scale: across a scale's border the derivatives jump and would smear
   // the orders of two scales together, so a pixel whose 2 x 2 quad sees two
-  // scale ids (the orientation map's alpha at the nearest texel) reads at a
-  // point (the player shades such pixels at their samples instead;
-  // docs/LIGHTING.md "The sun over the pixel").
+  // scale ids (sunbeam_scale_id: the orientation map's alpha at the texel
+  // under the uv) reads at a point (the player shades such pixels at their
+  // samples instead; docs/LIGHTING.md "The sun over the pixel").
   vec3 wrl = vec3(dot(wr, t), dot(wr, b), dot(wr, n));
-  ivec2 osz = textureSize(_group_0_binding_11_fs, 0);
-  // the texel under vUv, wrapped (GLSL ES leaves % of negatives undefined)
-  vec2 ouv = vUv - floor(vUv);
-  ivec2 otx = min(ivec2(ouv * vec2(osz)), osz - 1);
-  float scaleId = texelFetch(_group_0_binding_11_fs, otx, 0).a * 255.0;
-  float k = sbScales == 0u || fwidth(scaleId) < 0.5 ? 1.0 : 0.0;
+  float k = fwidth(sunbeam_scale_id(vUv, sbScales)) < 0.5 ? 1.0 : 0.0;
   EnvFootprint fp = EnvFootprint(k * dFdx(t), k * dFdy(t), k * dFdx(b), k * dFdy(b), k * dFdx(n), k * dFdy(n), k * dFdx(wrl), k * dFdy(wrl));
   vec3 rgb = vec3(0.0);
   for (int i = 0; i < ${MAX_LIGHTS}; i++) {
