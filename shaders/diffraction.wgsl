@@ -350,9 +350,19 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
         dpdx(in.tangent), dpdy(in.tangent), dpdx(in.uv), dpdy(in.uv),
         dpdx(in.uv_tangent), dpdy(in.uv_tangent)
     );
-    // The pixel's footprint for the environment's hot spots (the frame's and
-    // the view's derivatives at the centre).
-    let env_fp = EnvFootprint(dpdx(t), dpdy(t), dpdx(b), dpdy(b), dpdx(n), dpdy(n), dpdx(wr_l), dpdy(wr_l));
+    // The pixel's footprint for the environment's hot spots and the sun's
+    // disc (the frame's and the view's derivatives at the centre). On a mesh
+    // with scale maps none where the 2 x 2 pixels whose differences make the
+    // derivatives lie on more than one scale (as three.js, sunbeam_scale_id):
+    // the frame jumps at a scale's border, and a footprint across it smears
+    // both scales' orders together, a bias that more samples do not remove
+    // (the scaled snake under the sky at 8 x 8: p99 4.48 with it, 3.21
+    // without; docs/LIGHTING.md "The sun over the pixel").
+    let scale_id_width = fwidth(sb_scale_id(scale_orient, in.uv, (mat.scales_wrap >> 2u) & 3u));
+    var env_fp = EnvFootprint(dpdx(t), dpdy(t), dpdx(b), dpdy(b), dpdx(n), dpdy(n), dpdx(wr_l), dpdy(wr_l));
+    if (mat.scales_on == 1u && scale_id_width >= 0.5) {
+        env_fp = env_no_footprint();
+    }
     // A partly covered pixel whose centre sees the surface at a grazing angle
     // or from below (a silhouette, with MSAA) shades the point lights at each
     // of its covered samples and takes their mean: the centre lies past the
