@@ -357,11 +357,14 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
     // the frame jumps at a scale's border, and a footprint across it smears
     // both scales' orders together, a bias that more samples do not remove
     // (the scaled snake under the sky at 8 x 8: p99 4.48 with it, 3.21
-    // without; docs/LIGHTING.md "The sun over the pixel").
-    let scale_id_width = fwidth(sb_scale_id(scale_orient, in.uv, (mat.scales_wrap >> 2u) & 3u));
+    // without; docs/LIGHTING.md "The sun over the pixel"). The scale id is
+    // read only on such meshes: `mat` is a uniform, so the branch is uniform
+    // and its derivatives are defined.
     var env_fp = EnvFootprint(dpdx(t), dpdy(t), dpdx(b), dpdy(b), dpdx(n), dpdy(n), dpdx(wr_l), dpdy(wr_l));
-    if (mat.scales_on == 1u && scale_id_width >= 0.5) {
-        env_fp = env_no_footprint();
+    if (mat.scales_on == 1u) {
+        if (fwidth(sb_scale_id(scale_orient, in.uv, (mat.scales_wrap >> 2u) & 3u)) >= 0.5) {
+            env_fp = env_no_footprint();
+        }
     }
     // A partly covered pixel whose centre sees the surface at a grazing angle
     // or from below (a silhouette, with MSAA) shades the point lights at each
