@@ -32,7 +32,13 @@
 //! - `GRAZE=LO:HI`: the views' `cos` to the normal drawn in `[LO, HI]`
 //!   (default `0.02:1`), to look at grazing or near-normal views alone;
 //! - `NOPRE=1`, `OMS=X`: the environment read at the centroid unfiltered, or
-//!   its solid angle scaled by `X`; `WORST=1`: print the worst points.
+//!   its solid angle scaled by `X`; `WORST=1`: print the worst points;
+//! - `QUAD=L`: a control variate: the environment's coefficients (after the
+//!   hot spots) fitted by a polynomial of degree `L` in the direction, its
+//!   part integrated by the reference's quadrature (what per-view tables of
+//!   the maps' moments would hold), the cells on the residual only;
+//!   `QUAD_ONLY=1`: the polynomial's part alone (docs/LIGHTING.md "A
+//!   polynomial control variate").
 
 use std::time::Instant;
 use sunbeam_common::rng::SplitMix64;
@@ -157,6 +163,41 @@ fn main() {
             }
             None => (table, Vec::new()),
         };
+        // QUAD=L: the environment's coefficients (after the hot spots) fitted
+        // by a polynomial of degree L in the direction (the span of the
+        // spherical harmonics to order L), least squares over the table with
+        // solid-angle weights; its part integrated by the reference's
+        // quadrature (what tables over the view would hold), the cells on
+        // the residual only. QUAD_ONLY=1: no cells.
+        let quad_deg: Option<u32> = std::env::var("QUAD")
+            .ok()
+            .map(|v| v.parse().expect("QUAD=DEGREE"));
+        let quad_fit: Option<Vec<[f64; 3]>> = quad_deg.map(|deg| {
+            let nb = poly_basis(deg, [0.0, 0.0, 1.0]).len();
+            let mut ata = vec![vec![0.0f64; nb]; nb];
+            let mut atb = vec![[0.0f64; 3]; nb];
+            for j in 0..h {
+                let th0 = std::f64::consts::PI * j as f64 / h as f64;
+                let th1 = std::f64::consts::PI * (j + 1) as f64 / h as f64;
+                let om = (th0.cos() - th1.cos()) * std::f64::consts::TAU / w as f64;
+                let theta = (j as f64 + 0.5) / h as f64 * std::f64::consts::PI;
+                for i in 0..w {
+                    let phi = (i as f64 + 0.5) / w as f64 * std::f64::consts::TAU;
+                    let d = sunbeam_light::direction(theta.cos(), phi);
+                    let f = poly_basis(deg, d);
+                    let t = 4 * (j * w + i);
+                    for a in 0..nb {
+                        for b in 0..nb {
+                            ata[a][b] += om * f[a] * f[b];
+                        }
+                        for c in 0..3 {
+                            atb[a][c] += om * f[a] * table[t + c] as f64;
+                        }
+                    }
+                }
+            }
+            solve(ata, atb)
+        });
         let pre = Prefiltered::new(w, h, table);
         let t_pre = t0.elapsed();
         eprintln!(
@@ -225,22 +266,47 @@ fn main() {
             }
         }
         let sun_u = [0.5, 0.5];
+        let integrate = |q: &EnvQuadrature, frame, wr| {
+            q.integrate_many(
+                env,
+                &[Query {
+                    frame,
+                    wr,
+                    sun_u,
+                    masking: mask,
+                    skin,
+                }],
+                (0, 1),
+            )[0]
+        };
         let refs: Vec<[f64; 3]> = pts
             .iter()
-            .map(|(f, wr)| {
-                quad.integrate_many(
-                    env,
-                    &[Query {
-                        frame: *f,
-                        wr: *wr,
-                        sun_u,
-                        masking: mask,
-                        skin,
-                    }],
-                    (0, 1),
-                )[0]
-            })
+            .map(|(f, wr)| integrate(&quad, *f, *wr))
             .collect();
+        let quad_q = quad_fit.as_ref().map(|q| {
+            let deg = quad_deg.unwrap();
+            let t0 = Instant::now();
+            let qq = quad.with_coefficients(&|d| poly_eval(deg, q, d));
+            // the fit's own error: rms over the sphere relative to the mean
+            let (mut e2, mut m2) = (0.0, 0.0);
+            let mut rng = SplitMix64::new(3);
+            for _ in 0..20000 {
+                let z = 2.0 * rng.unit() - 1.0;
+                let ph = std::f64::consts::TAU * rng.unit();
+                let d = sunbeam_light::direction(z, ph);
+                let c = pre.lookup(d, 1e-6);
+                let p = poly_eval(deg, q, d);
+                e2 += (c[0] - p[0]).powi(2);
+                m2 += c[0].powi(2);
+            }
+            eprintln!(
+                "  degree {deg} fit ({} functions): residual rms / rms of c_0 {:.3}, table {:.2?}",
+                q.len(),
+                (e2 / m2).sqrt(),
+                t0.elapsed()
+            );
+            qq
+        });
         let mut ys: Vec<f64> = refs.iter().map(|x| x[1]).collect();
         ys.sort_by(f64::total_cmp);
         let white = ys[ys.len() * 9 / 10] * 2.0;
@@ -343,7 +409,26 @@ fn main() {
                         )
                     }
                 };
-                let mut x = cells.estimate(*f, *wr, mask, skin, &coeffs);
+                let mut x = match &quad_fit {
+                    Some(q) => {
+                        let res = |d: [f64; 3], om: f64| {
+                            let c = coeffs(d, om);
+                            let qd = poly_eval(quad_deg.unwrap(), q, d);
+                            [c[0] - qd[0], c[1] - qd[1], c[2] - qd[2]]
+                        };
+                        let mut x = if std::env::var("QUAD_ONLY").is_ok() {
+                            [0.0; 3]
+                        } else {
+                            cells.estimate(*f, *wr, mask, skin, &res)
+                        };
+                        let qx = integrate(quad_q.as_ref().unwrap(), *f, *wr);
+                        for a in 0..3 {
+                            x[a] += qx[a];
+                        }
+                        x
+                    }
+                    None => cells.estimate(*f, *wr, mask, skin, &coeffs),
+                };
                 // the hot spots: each a small light through the basis maps
                 let hx =
                     sunbeam_response::hotspots::estimate(&lights, &er.basis, *f, *wr, mask, skin);
@@ -424,4 +509,65 @@ fn main() {
             );
         }
     }
+}
+
+/// A basis of the polynomials of degree `deg` on the sphere (the span of
+/// the spherical harmonics to order `deg`): `x^a y^b z^c` with `c <= 1`,
+/// `a + b + c <= deg` (`z^2 = 1 - x^2 - y^2` reduces the rest), `(deg + 1)^2`
+/// functions.
+fn poly_basis(deg: u32, d: [f64; 3]) -> Vec<f64> {
+    let [x, y, z] = d;
+    let mut out = Vec::new();
+    for c in 0..=1u32.min(deg) {
+        for a in 0..=deg - c {
+            for b in 0..=deg - c - a {
+                out.push(x.powi(a as i32) * y.powi(b as i32) * z.powi(c as i32));
+            }
+        }
+    }
+    out
+}
+
+fn poly_eval(deg: u32, q: &[[f64; 3]], d: [f64; 3]) -> [f64; 3] {
+    let f = poly_basis(deg, d);
+    let mut out = [0.0; 3];
+    for (fa, qa) in f.iter().zip(q) {
+        for c in 0..3 {
+            out[c] += qa[c] * fa;
+        }
+    }
+    out
+}
+
+/// Gaussian elimination with partial pivoting, three right sides.
+fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
+    let n = a.len();
+    for k in 0..n {
+        let p = (k..n)
+            .max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))
+            .unwrap();
+        a.swap(k, p);
+        b.swap(k, p);
+        let (ak, bk) = (a[k].clone(), b[k]);
+        for (ai, bi) in a.iter_mut().zip(b.iter_mut()).skip(k + 1) {
+            let f = ai[k] / ak[k];
+            for (x, y) in ai.iter_mut().zip(&ak).skip(k) {
+                *x -= f * y;
+            }
+            for (x, y) in bi.iter_mut().zip(&bk) {
+                *x -= f * y;
+            }
+        }
+    }
+    let mut x = vec![[0.0; 3]; n];
+    for k in (0..n).rev() {
+        for c in 0..3 {
+            let mut v = b[k][c];
+            for j in k + 1..n {
+                v -= a[k][j] * x[j][c];
+            }
+            x[k][c] = v / a[k][k];
+        }
+    }
+    x
 }

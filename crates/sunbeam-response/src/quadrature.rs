@@ -50,6 +50,7 @@
 use crate::build::{self, Options};
 use crate::env::env_weights;
 use crate::grid::Grid;
+use rayon::prelude::*;
 use sunbeam_light::prefilter::Prefiltered;
 use sunbeam_light::Environment;
 use sunbeam_optics::gain;
@@ -215,6 +216,21 @@ impl EnvQuadrature {
             white: false,
             chain: None,
             lamps: Vec::new(),
+        }
+    }
+
+    /// The same sum under coefficients `f(d)` at world direction `d` over
+    /// the whole sphere (tabulated like the sky's, the ground included), with
+    /// no sun and no lamps: what one part of an environment contributes (for
+    /// measurements: benches/cells.rs `QUAD`, a polynomial fit of the sky).
+    pub fn with_coefficients(&self, f: &(dyn Fn([f64; 3]) -> [f64; 3] + Sync)) -> EnvQuadrature {
+        EnvQuadrature {
+            sun: Vec::new(),
+            table: Some(OctTable::sphere(f, OCT_SIDE)),
+            white: false,
+            chain: None,
+            lamps: Vec::new(),
+            ..self.clone()
         }
     }
 
@@ -504,6 +520,9 @@ struct OctTable {
     c: Vec<[f32; 3]>,
     /// The coefficients at and below the horizon (the ground's, constant).
     ground: [f64; 3],
+    /// The table covers the whole sphere (octahedral, folded below the
+    /// horizon) instead of the upper hemisphere and the ground.
+    sphere: bool,
 }
 
 impl OctTable {
@@ -511,19 +530,9 @@ impl OctTable {
         let mut c = Vec::with_capacity(side * side);
         for j in 0..side {
             for i in 0..side {
-                let u = 2.0 * (i as f64 + 0.5) / side as f64 - 1.0;
-                let v = 2.0 * (j as f64 + 0.5) / side as f64 - 1.0;
-                let y = 1.0 - u.abs() - v.abs();
-                let (x, z) = if y < 0.0 {
-                    ((1.0 - v.abs()) * u.signum(), (1.0 - u.abs()) * v.signum())
-                } else {
-                    (u, v)
-                };
                 // Texels below the horizon hold the sky's continuation
                 // (the ground is read exactly, not from here).
-                let y = y.max(1e-9);
-                let l = (x * x + y * y + z * z).sqrt();
-                let k = env.coefficients([x / l, y / l, z / l]);
+                let k = env.coefficients(oct_direction(i, j, side, true));
                 c.push(k.map(|v| v as f32));
             }
         }
@@ -531,18 +540,36 @@ impl OctTable {
             side,
             c,
             ground: env.coefficients([0.0, -1.0, 0.0]),
+            sphere: false,
+        }
+    }
+
+    /// `f` over the whole sphere.
+    fn sphere(f: &(dyn Fn([f64; 3]) -> [f64; 3] + Sync), side: usize) -> OctTable {
+        let c = (0..side * side)
+            .into_par_iter()
+            .map(|t| f(oct_direction(t % side, t / side, side, false)).map(|v| v as f32))
+            .collect();
+        OctTable {
+            side,
+            c,
+            ground: [0.0; 3],
+            sphere: true,
         }
     }
 
     fn at(&self, d: [f64; 3]) -> [f64; 3] {
-        if d[1] <= 0.0 {
+        if d[1] <= 0.0 && !self.sphere {
             return self.ground;
         }
         let s = d[0].abs() + d[1].abs() + d[2].abs();
         if s.is_nan() || s <= 0.0 {
             return [0.0; 3];
         }
-        let (u, v) = (d[0] / s, d[2] / s);
+        let (mut u, mut v) = (d[0] / s, d[2] / s);
+        if d[1] < 0.0 {
+            (u, v) = oct_fold(u, v);
+        }
         let n = self.side as f64;
         let fx = ((u + 1.0) * 0.5 * n - 0.5).clamp(0.0, n - 1.0);
         let fy = ((v + 1.0) * 0.5 * n - 0.5).clamp(0.0, n - 1.0);
@@ -564,6 +591,25 @@ impl OctTable {
             top * (1.0 - ty) + bot * ty
         })
     }
+}
+
+/// The octahedron's fold between the upper and the lower hemisphere (its own
+/// inverse): `(u, v)` of the square to `(x, z)` below the horizon and back.
+fn oct_fold(u: f64, v: f64) -> (f64, f64) {
+    ((1.0 - v.abs()) * u.signum(), (1.0 - u.abs()) * v.signum())
+}
+
+/// The world direction at the centre of texel `(i, j)` of an octahedral
+/// table of `side` texels (`y` up); `upper`: below the horizon, the upper
+/// hemisphere's continuation (`y` floored at 0).
+fn oct_direction(i: usize, j: usize, side: usize, upper: bool) -> [f64; 3] {
+    let u = 2.0 * (i as f64 + 0.5) / side as f64 - 1.0;
+    let v = 2.0 * (j as f64 + 0.5) / side as f64 - 1.0;
+    let y = 1.0 - u.abs() - v.abs();
+    let (x, z) = if y < 0.0 { oct_fold(u, v) } else { (u, v) };
+    let y = if upper { y.max(1e-9) } else { y };
+    let l = (x * x + y * y + z * z).sqrt();
+    [x / l, y / l, z / l]
 }
 
 /// Up to three maps (XYZ per texel, response-map order `(k * n_rho + j) *
@@ -865,5 +911,33 @@ impl<'a> View<'a> {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::OctTable;
+
+    // The whole-sphere table (EnvQuadrature::with_coefficients) reads back a
+    // smooth function everywhere, below the horizon too (the fold), against
+    // the function itself.
+    #[test]
+    fn the_sphere_table_reads_back_a_smooth_function_below_the_horizon_too() {
+        let f = |d: [f64; 3]| [d[0], d[1] + 2.0, d[2] * d[0] - d[1] * d[1]];
+        let t = OctTable::sphere(&f, 256);
+        let mut worst = 0.0f64;
+        for k in 0..2000 {
+            let z = -1.0 + 2.0 * (k as f64 + 0.5) / 2000.0;
+            let ph = k as f64 * 2.399_963_229_728_653;
+            let d = sunbeam_light::direction(z, ph);
+            let (a, b) = (t.at(d), f(d));
+            for c in 0..3 {
+                worst = worst.max((a[c] - b[c]).abs());
+            }
+        }
+        // bilinear within half a texel of the octahedron's seams (about 0.7
+        // degrees at 256, where f's gradient is at most about 2); a wrong
+        // fold would be off by O(1)
+        assert!(worst < 1e-2, "worst {worst}");
     }
 }
