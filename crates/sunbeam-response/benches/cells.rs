@@ -37,8 +37,9 @@
 //!   hot spots) fitted by a polynomial of degree `L` in the direction, its
 //!   part integrated by the reference's quadrature (what per-view tables of
 //!   the maps' moments would hold), the cells on the residual only;
-//!   `QUAD_ONLY=1`: the polynomial's part alone (docs/LIGHTING.md "A
-//!   polynomial control variate").
+//!   `QUAD_ONLY=1`: the polynomial's part alone; `HORIZON=1`: the fit over
+//!   the upper hemisphere only and the ground below the horizon taken
+//!   exactly (docs/LIGHTING.md "A polynomial control variate").
 
 use std::time::Instant;
 use sunbeam_common::rng::SplitMix64;
@@ -169,6 +170,17 @@ fn main() {
         // solid-angle weights; its part integrated by the reference's
         // quadrature (what tables over the view would hold), the cells on
         // the residual only. QUAD_ONLY=1: no cells.
+        let horizon = std::env::var("HORIZON").is_ok();
+        let ground = env.coefficients([0.0, -1.0, 0.0]);
+        // the part taken exactly: the polynomial, and with HORIZON the ground
+        // below the horizon instead
+        let exact_part = |deg: u32, q: &[[f64; 3]], d: [f64; 3]| {
+            if horizon && d[1] < 0.0 {
+                ground
+            } else {
+                poly_eval(deg, q, d)
+            }
+        };
         let quad_deg: Option<u32> = std::env::var("QUAD")
             .ok()
             .map(|v| v.parse().expect("QUAD=DEGREE"));
@@ -176,7 +188,10 @@ fn main() {
             let nb = poly_basis(deg, [0.0, 0.0, 1.0]).len();
             let mut ata = vec![vec![0.0f64; nb]; nb];
             let mut atb = vec![[0.0f64; 3]; nb];
-            for j in 0..h {
+            // HORIZON=1: the fit over the upper hemisphere only; the part
+            // below the horizon is the ground's, exact (a half-space term)
+            let rows = if horizon { h / 2 } else { h };
+            for j in 0..rows {
                 let th0 = std::f64::consts::PI * j as f64 / h as f64;
                 let th1 = std::f64::consts::PI * (j + 1) as f64 / h as f64;
                 let om = (th0.cos() - th1.cos()) * std::f64::consts::TAU / w as f64;
@@ -286,7 +301,7 @@ fn main() {
         let quad_q = quad_fit.as_ref().map(|q| {
             let deg = quad_deg.unwrap();
             let t0 = Instant::now();
-            let qq = quad.with_coefficients(&|d| poly_eval(deg, q, d));
+            let qq = quad.with_coefficients(&|d| exact_part(deg, q, d));
             // the fit's own error: rms over the sphere relative to the mean
             let (mut e2, mut m2) = (0.0, 0.0);
             let mut rng = SplitMix64::new(3);
@@ -295,7 +310,7 @@ fn main() {
                 let ph = std::f64::consts::TAU * rng.unit();
                 let d = sunbeam_light::direction(z, ph);
                 let c = pre.lookup(d, 1e-6);
-                let p = poly_eval(deg, q, d);
+                let p = exact_part(deg, q, d);
                 e2 += (c[0] - p[0]).powi(2);
                 m2 += c[0].powi(2);
             }
@@ -413,7 +428,7 @@ fn main() {
                     Some(q) => {
                         let res = |d: [f64; 3], om: f64| {
                             let c = coeffs(d, om);
-                            let qd = poly_eval(quad_deg.unwrap(), q, d);
+                            let qd = exact_part(quad_deg.unwrap(), q, d);
                             [c[0] - qd[0], c[1] - qd[1], c[2] - qd[2]]
                         };
                         let mut x = if std::env::var("QUAD_ONLY").is_ok() {
