@@ -39,7 +39,11 @@
 //!   the maps' moments would hold), the cells on the residual only;
 //!   `QUAD_ONLY=1`: the polynomial's part alone; `HORIZON=1`: the fit over
 //!   the upper hemisphere only and the ground below the horizon taken
-//!   exactly (docs/LIGHTING.md "A polynomial control variate").
+//!   exactly; `CUT=1` (with `CELLS_CFG=1:DEPTH`): the cells only where the
+//!   world's horizon or the ground is, a cut per view from the root,
+//!   `SBELOW=S` the largest spread kept below the horizon (docs/LIGHTING.md
+//!   "A polynomial control variate"). Each configuration prints the nodes
+//!   visited per point.
 
 use std::time::Instant;
 use sunbeam_common::rng::SplitMix64;
@@ -171,6 +175,16 @@ fn main() {
         // quadrature (what tables over the view would hold), the cells on
         // the residual only. QUAD_ONLY=1: no cells.
         let horizon = std::env::var("HORIZON").is_ok();
+        // CUT=1 (with QUAD=L): the polynomial fitted over the upper hemisphere
+        // and taken exactly over the whole sphere; the cells carry what is
+        // left below the world's horizon only, through a per-view cut of a
+        // tree from the root (CELLS_CFG=1:DEPTH) that skips the nodes wholly
+        // above it (their residual, the fit's error, is left out)
+        let cut_walk = std::env::var("CUT").is_ok();
+        let s_below: f64 = std::env::var("SBELOW")
+            .ok()
+            .map(|v| v.parse().expect("SBELOW=SPREAD"))
+            .unwrap_or(1.0);
         let ground = env.coefficients([0.0, -1.0, 0.0]);
         // the part taken exactly: the polynomial, and with HORIZON the ground
         // below the horizon instead
@@ -190,6 +204,9 @@ fn main() {
             let mut atb = vec![[0.0f64; 3]; nb];
             // HORIZON=1: the fit over the upper hemisphere only; the part
             // below the horizon is the ground's, exact (a half-space term)
+            // CUT=1: over the whole sphere, below the horizon towards the
+            // horizon's own value at the same azimuth (a continuation without
+            // the ground's step, which the cells carry)
             let rows = if horizon { h / 2 } else { h };
             for j in 0..rows {
                 let th0 = std::f64::consts::PI * j as f64 / h as f64;
@@ -200,7 +217,8 @@ fn main() {
                     let phi = (i as f64 + 0.5) / w as f64 * std::f64::consts::TAU;
                     let d = sunbeam_light::direction(theta.cos(), phi);
                     let f = poly_basis(deg, d);
-                    let t = 4 * (j * w + i);
+                    let jt = if cut_walk { j.min(h / 2 - 1) } else { j };
+                    let t = 4 * (jt * w + i);
                     for a in 0..nb {
                         for b in 0..nb {
                             ata[a][b] += om * f[a] * f[b];
@@ -408,6 +426,7 @@ fn main() {
                 );
             }
             let t0 = Instant::now();
+            let mut visits = 0usize;
             let mut de = Vec::new();
             let mut bins: Vec<Vec<f64>> = vec![Vec::new(); 5];
             for ((f, wr), r) in pts.iter().zip(&refs) {
@@ -433,6 +452,11 @@ fn main() {
                         };
                         let mut x = if std::env::var("QUAD_ONLY").is_ok() {
                             [0.0; 3]
+                        } else if cut_walk {
+                            let (cut, walked) = horizon_cut(&cells, *f, *wr, s_below);
+                            let (x, v) = cells.estimate_from(&cut, *f, *wr, mask, skin, &res);
+                            visits += walked + v;
+                            x
                         } else {
                             cells.estimate(*f, *wr, mask, skin, &res)
                         };
@@ -442,7 +466,12 @@ fn main() {
                         }
                         x
                     }
-                    None => cells.estimate(*f, *wr, mask, skin, &coeffs),
+                    None => {
+                        let top: Vec<u32> = (0..cells.n_top as u32).collect();
+                        let (x, v) = cells.estimate_from(&top, *f, *wr, mask, skin, &coeffs);
+                        visits += v;
+                        x
+                    }
                 };
                 // the hot spots: each a small light through the basis maps
                 let hx =
@@ -514,6 +543,10 @@ fn main() {
                 })
                 .collect();
             eprintln!("    by cos_r fifths (mean/p95): {}", binned.join("  "));
+            eprintln!(
+                "    nodes visited per point (with CUT: the cut's walk and the sum): {:.1}",
+                visits as f64 / pts.len() as f64
+            );
             let mean = de.iter().sum::<f64>() / de.len() as f64;
             eprintln!(
                 "  cells {n_top:5} depth {depth}: nodes {:6}  dE mean {mean:.3} p99 {:.3} max {:.3}  {:.1} us/point",
@@ -585,4 +618,48 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
         }
     }
     x
+}
+
+/// The nodes from the roots down whose part of the disc may lie below the
+/// world's horizon (`y < 0`) for view `wr` in `frame`: a node wholly above it
+/// is left out, one that straddles it (its centroid's direction within its
+/// angular reach, 3 spreads over `cos(theta_i)`) or whose spread exceeds
+/// `s_below` is split; with the number of nodes visited.
+fn horizon_cut(
+    cells: &Cells,
+    frame: ([f64; 3], [f64; 3], [f64; 3]),
+    wr: [f64; 3],
+    s_below: f64,
+) -> (Vec<u32>, usize) {
+    let (t, b, n) = frame;
+    let mut cut = Vec::new();
+    let mut visits = 0;
+    let mut stack: Vec<u32> = (0..cells.n_top as u32).rev().collect();
+    while let Some(id) = stack.pop() {
+        visits += 1;
+        let c = &cells.nodes[id as usize];
+        let wxy = [-c.uv[0] - wr[0], -c.uv[1] - wr[1]];
+        let l = wxy[0].hypot(wxy[1]);
+        if l > 1.05 + 3.0 * c.spread {
+            continue;
+        }
+        let k = if l > 0.999 { 0.999 / l } else { 1.0 };
+        let wi = [wxy[0] * k, wxy[1] * k];
+        let wz = (1.0 - wi[0] * wi[0] - wi[1] * wi[1]).max(0.0).sqrt();
+        let y = wi[0] * t[1] + wi[1] * b[1] + wz * n[1];
+        let reach = (3.0 * c.spread / wz.max(0.05))
+            .min(std::f64::consts::FRAC_PI_2)
+            .sin();
+        if y > reach {
+            continue;
+        }
+        match c.children {
+            Some([a, bb]) if y > -reach || c.spread > s_below => {
+                stack.push(bb);
+                stack.push(a);
+            }
+            _ => cut.push(id),
+        }
+    }
+    (cut, visits)
 }

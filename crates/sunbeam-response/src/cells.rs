@@ -519,14 +519,32 @@ impl Cells {
         skin: gain::Material,
         coeffs: &dyn Fn([f64; 3], f64) -> [f64; 3],
     ) -> [f64; 3] {
+        let top: Vec<u32> = (0..self.n_top as u32).collect();
+        self.estimate_from(&top, frame, wr, masking, skin, coeffs).0
+    }
+
+    /// [`Cells::estimate`] from the nodes `start` instead of the top cut
+    /// (a cut chosen per view, for measurements: benches/cells.rs `CUT`),
+    /// with the number of nodes visited.
+    pub fn estimate_from(
+        &self,
+        start: &[u32],
+        frame: Frame,
+        wr: [f64; 3],
+        masking: Masking,
+        skin: gain::Material,
+        coeffs: &dyn Fn([f64; 3], f64) -> [f64; 3],
+    ) -> ([f64; 3], usize) {
         let mut xyz = [0.0; 3];
+        let mut visits = 0;
         if wr[2].is_nan() || wr[2] <= 0.0 {
-            return xyz;
+            return (xyz, visits);
         }
         let (t, b, n) = frame;
         let world = |d: [f64; 3]| [0, 1, 2].map(|k| d[0] * t[k] + d[1] * b[k] + d[2] * n[k]);
-        let mut stack: Vec<u32> = (0..self.n_top as u32).rev().collect();
+        let mut stack: Vec<u32> = start.iter().rev().copied().collect();
         while let Some(id) = stack.pop() {
+            visits += 1;
             let c = &self.nodes[id as usize];
             let wxy = [-c.uv[0] - wr[0], -c.uv[1] - wr[1]];
             let dist = 1.0 - (wxy[0] * wxy[0] + wxy[1] * wxy[1]).sqrt();
@@ -612,7 +630,7 @@ impl Cells {
                 }
             }
         }
-        xyz
+        (xyz, visits)
     }
 }
 
