@@ -39,7 +39,9 @@
 //!   the maps' moments would hold), the cells on the residual only;
 //!   `QUAD_ONLY=1`: the polynomial's part alone; `HORIZON=1`: the fit over
 //!   the upper hemisphere only and the ground below the horizon taken
-//!   exactly; `CUT=1` (with `CELLS_CFG=1:DEPTH`): the cells only where the
+//!   exactly, and with it `TILT=N`, the horizon's direction in the local
+//!   frame read from an N x N grid (what a table over it would hold; slow:
+//!   four quadrature tables per point); `CUT=1` (with `CELLS_CFG=1:DEPTH`): the cells only where the
 //!   world's horizon or the ground is, a cut per view from the root,
 //!   `SBELOW=S` the largest spread kept below the horizon (docs/LIGHTING.md
 //!   "A polynomial control variate"). Each configuration prints the nodes
@@ -181,6 +183,11 @@ fn main() {
         // tree from the root (CELLS_CFG=1:DEPTH) that skips the nodes wholly
         // above it (their residual, the fit's error, is left out)
         let cut_walk = std::env::var("CUT").is_ok();
+        // TILT=N (with HORIZON=1): the horizon's direction in the local frame
+        // from an N x N grid, bilinear (what a table over it would hold)
+        let tilt_n: Option<usize> = std::env::var("TILT")
+            .ok()
+            .map(|v| v.parse().expect("TILT=N"));
         let s_below: f64 = std::env::var("SBELOW")
             .ok()
             .map(|v| v.parse().expect("SBELOW=SPREAD"))
@@ -460,7 +467,33 @@ fn main() {
                         } else {
                             cells.estimate(*f, *wr, mask, skin, &res)
                         };
-                        let qx = integrate(quad_q.as_ref().unwrap(), *f, *wr);
+                        let qx = match tilt_n {
+                            // the horizon's tilt in the local frame read from
+                            // an N x N octahedral grid, bilinear
+                            Some(nt) if horizon => {
+                                let (t, b, n) = *f;
+                                let deg = quad_deg.unwrap();
+                                let mut acc = [0.0; 3];
+                                for (qd, wgt) in oct_corners([t[1], b[1], n[1]], nt) {
+                                    let half = |d: [f64; 3]| {
+                                        let dot =
+                                            |a: [f64; 3]| a[0] * d[0] + a[1] * d[1] + a[2] * d[2];
+                                        let wi = [dot(t), dot(b), dot(n)];
+                                        if wi[0] * qd[0] + wi[1] * qd[1] + wi[2] * qd[2] < 0.0 {
+                                            ground
+                                        } else {
+                                            poly_eval(deg, q, d)
+                                        }
+                                    };
+                                    let v = integrate(&quad.with_coefficients(&half), *f, *wr);
+                                    for a in 0..3 {
+                                        acc[a] += wgt * v[a];
+                                    }
+                                }
+                                acc
+                            }
+                            _ => integrate(quad_q.as_ref().unwrap(), *f, *wr),
+                        };
                         for a in 0..3 {
                             x[a] += qx[a];
                         }
@@ -662,4 +695,37 @@ fn horizon_cut(
         }
     }
     (cut, visits)
+}
+
+/// The four texel centres of an `n` x `n` octahedral grid over the sphere
+/// (`z` up) around unit vector `u`, with their bilinear weights.
+fn oct_corners(u: [f64; 3], n: usize) -> Vec<([f64; 3], f64)> {
+    let l1 = u[0].abs() + u[1].abs() + u[2].abs();
+    let (mut x, mut y) = (u[0] / l1, u[1] / l1);
+    if u[2] < 0.0 {
+        (x, y) = ((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum());
+    }
+    let nf = n as f64;
+    let fx = ((x + 1.0) * 0.5 * nf - 0.5).clamp(0.0, nf - 1.0);
+    let fy = ((y + 1.0) * 0.5 * nf - 0.5).clamp(0.0, nf - 1.0);
+    let (i0, j0) = ((fx as usize).min(n - 2), (fy as usize).min(n - 2));
+    let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
+    let dir = |i: usize, j: usize| {
+        let a = 2.0 * (i as f64 + 0.5) / nf - 1.0;
+        let b = 2.0 * (j as f64 + 0.5) / nf - 1.0;
+        let z = 1.0 - a.abs() - b.abs();
+        let (a, b) = if z < 0.0 {
+            ((1.0 - b.abs()) * a.signum(), (1.0 - a.abs()) * b.signum())
+        } else {
+            (a, b)
+        };
+        let l = (a * a + b * b + z * z).sqrt();
+        [a / l, b / l, z / l]
+    };
+    vec![
+        (dir(i0, j0), (1.0 - tx) * (1.0 - ty)),
+        (dir(i0 + 1, j0), tx * (1.0 - ty)),
+        (dir(i0, j0 + 1), (1.0 - tx) * ty),
+        (dir(i0 + 1, j0 + 1), tx * ty),
+    ]
 }
