@@ -43,7 +43,8 @@
 //!   frame read from an N x N grid (what a table over it would hold; slow:
 //!   four quadrature tables per point); `CUT=1` (with `CELLS_CFG=1:DEPTH`): the cells only where the
 //!   world's horizon or the ground is, a cut per view from the root,
-//!   `SBELOW=S` the largest spread kept below the horizon (docs/LIGHTING.md
+//!   `SBELOW=S` the largest spread kept below the horizon, `CUT_W=X` the
+//!   weight of the rows below the horizon in the fit (docs/LIGHTING.md
 //!   "A polynomial control variate"). Each configuration prints the nodes
 //!   visited per point.
 
@@ -188,6 +189,10 @@ fn main() {
         let tilt_n: Option<usize> = std::env::var("TILT")
             .ok()
             .map(|v| v.parse().expect("TILT=N"));
+        let cut_w: f64 = std::env::var("CUT_W")
+            .ok()
+            .map(|v| v.parse().expect("CUT_W=WEIGHT"))
+            .unwrap_or(1.0);
         let s_below: f64 = std::env::var("SBELOW")
             .ok()
             .map(|v| v.parse().expect("SBELOW=SPREAD"))
@@ -218,7 +223,12 @@ fn main() {
             for j in 0..rows {
                 let th0 = std::f64::consts::PI * j as f64 / h as f64;
                 let th1 = std::f64::consts::PI * (j + 1) as f64 / h as f64;
-                let om = (th0.cos() - th1.cos()) * std::f64::consts::TAU / w as f64;
+                let mut om = (th0.cos() - th1.cos()) * std::f64::consts::TAU / w as f64;
+                // CUT_W=X: the rows below the horizon weigh X (a tame
+                // extrapolation, the fit above nearly the upper one's)
+                if cut_walk && j >= h / 2 {
+                    om *= cut_w;
+                }
                 let theta = (j as f64 + 0.5) / h as f64 * std::f64::consts::PI;
                 for i in 0..w {
                     let phi = (i as f64 + 0.5) / w as f64 * std::f64::consts::TAU;
