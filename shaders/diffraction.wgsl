@@ -302,18 +302,19 @@ fn carried_view(in: VsOut, d: AttrDerivs, o: vec2<f32>) -> CarriedView {
 }
 
 // The environment (shaders/environment.wgsl env_shade) at offset o (pixels)
-// from the pixel centre.
-fn env_shade_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw: f32, diffract: bool, fp: EnvFootprint) -> vec3<f32> {
+// from the pixel centre; `sun`: env_shade's (false where the caller adds
+// env_sun_disc_carried).
+fn env_shade_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw: f32, diffract: bool, fp: EnvFootprint, sun: bool) -> vec3<f32> {
     let v = carried_view(in, d, o);
-    return env_shade(v.frame[0], v.frame[1], v.frame[2], v.wr, base, dw, diffract, in.clip.xy, v.dist, fp, true);
+    return env_shade(v.frame[0], v.frame[1], v.frame[2], v.wr, base, dw, diffract, in.clip.xy, v.dist, fp, true, sun);
 }
 
 // The environment at offset o (pixels) from the pixel centre without
 // walking the cells (env_shade's `walk`): its colour in xyz, and in w 1
 // where env_shade would have walked them (env_cells_walks), else 0.
-fn env_shade_carried_nowalk(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw: f32, diffract: bool, fp: EnvFootprint) -> vec4<f32> {
+fn env_shade_carried_nowalk(in: VsOut, d: AttrDerivs, o: vec2<f32>, base: vec3<f32>, dw: f32, diffract: bool, fp: EnvFootprint, sun: bool) -> vec4<f32> {
     let v = carried_view(in, d, o);
-    let rgb = env_shade(v.frame[0], v.frame[1], v.frame[2], v.wr, base, dw, diffract, in.clip.xy, v.dist, fp, false);
+    let rgb = env_shade(v.frame[0], v.frame[1], v.frame[2], v.wr, base, dw, diffract, in.clip.xy, v.dist, fp, false, sun);
     let walks = env_cells_walks(v.frame[2], v.wr, dw, diffract, in.clip.xy, v.dist);
     return vec4<f32>(rgb, select(0.0, 1.0, walks));
 }
@@ -326,6 +327,40 @@ fn env_cells_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, dw: f32) -> vec3<f3
         return vec3<f32>(0.0);
     }
     return (1.0 - dw) * xyz_to_rgb(env_cells(v.frame[0], v.frame[1], v.frame[2], v.wr));
+}
+
+// The first-frame estimator's sun (linear sRGB, dw applied) on a mesh with
+// scale maps, for a point at offset o (pixels) from the pixel centre that
+// stands for `share` of the pixel along each axis: as env_sun_disc, each of
+// the disc's SB_SUN_POINTS points read at its own place in that part of the
+// pixel (sb_sun_pixel_offset), but with the frame and the view the scale
+// maps give at that place (carried_view) instead of the footprint's linear
+// model. A scale is about a pixel long at the scaled snake's size, its dome
+// turns the sun's orders within it and its border turns them by the next
+// scale's tilt and ridge angle: the screen derivatives of a 2 x 2 quad can
+// not carry that, and each point's own read of the maps can
+// (docs/LIGHTING.md "Scale borders").
+fn env_sun_disc_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, share: f32, dw: f32) -> vec3<f32> {
+    if (!(envg.on == 1u && envg.estimator == 0u && envg.has_sun == 1u && envp.has_sun == 1u && envp.on == 1u && mat.has_pack == 1u && dw < 1.0)) {
+        return vec3<f32>(0.0);
+    }
+    // this frame's share of the part of the pixel (env_shade's hot_fp); a
+    // point under `--no-footprint`
+    var k = 0.0;
+    if (envg.hot_footprint == 1u) {
+        k = share * envg.frame_share;
+    }
+    env_seed_at(vec2<u32>(in.clip.xy), envg.frame);
+    let gr = env_grid();
+    let r = SB_TAU * env_qmc(envg.frame + 1u, 19u);
+    var xyz = vec3<f32>(0.0);
+    for (var i = 0u; i < u32(SB_SUN_POINTS); i = i + 1u) {
+        let v = carried_view(in, d, o + k * sb_sun_pixel_offset(i));
+        if (v.wr.z > 0.0) {
+            xyz = xyz + env_sun_point_fp(v.frame[0], v.frame[1], v.frame[2], v.wr, gr, (f32(i) + 0.5) / SB_SUN_POINTS, r + f32(i) * SB_GOLDEN, vec2<f32>(0.0), env_no_footprint());
+        }
+    }
+    return (1.0 - dw) * xyz_to_rgb(xyz / SB_SUN_POINTS);
 }
 
 // The colour of a fragment (`covered`: its sample mask), whichever the
@@ -352,14 +387,14 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
     );
     // The pixel's footprint for the environment's hot spots and the sun's
     // disc (the frame's and the view's derivatives at the centre). On a mesh
-    // with scale maps none where the 2 x 2 pixels whose differences make the
-    // derivatives lie on more than one scale (as three.js, sunbeam_scale_id):
-    // the frame jumps at a scale's border, and a footprint across it smears
-    // both scales' orders together, a bias that more samples do not remove
-    // (the scaled snake under the sky at 8 x 8: p99 4.48 with it, 3.21
-    // without; docs/LIGHTING.md "The sun over the pixel"). The scale id is
-    // read only on such meshes: `mat` is a uniform, so the branch is uniform
-    // and its derivatives are defined.
+    // with scale maps (where the sun's disc reads the maps point by point
+    // instead: env_sun_disc_carried) none where the 2 x 2 pixels whose
+    // differences make the derivatives lie on more than one scale (as
+    // three.js, sunbeam_scale_id): the frame jumps at a scale's border, and
+    // a footprint across it smears both scales' orders together, a bias that
+    // more samples do not remove (docs/LIGHTING.md "Scale borders"). The
+    // scale id is read only on such meshes: `mat` is a uniform, so the
+    // branch is uniform and its derivatives are defined.
     var env_fp = EnvFootprint(dpdx(t), dpdy(t), dpdx(b), dpdy(b), dpdx(n), dpdy(n), dpdx(wr_l), dpdy(wr_l));
     if (mat.scales_on == 1u) {
         if (fwidth(sb_scale_id(scale_orient, in.uv, (mat.scales_wrap >> 2u) & 3u)) >= 0.5) {
@@ -463,6 +498,9 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
         // of 2048 cells were cut short, darkening the partly covered pixels
         // of grazing views (docs/LIGHTING.md "One walk per fragment").
         if (envg.estimator == 0u) {
+            // On a mesh with scale maps the sun's disc reads the maps at
+            // each of its points (env_sun_disc_carried).
+            let scaled = mat.scales_on == 1u;
             if (g.msaa >= 4u && (n_cov < 4u || mat.scales_on == 1u)) {
                 // (a mesh with scale maps too, as the point lights: the
                 // sun's orders jump at the scales' borders)
@@ -473,8 +511,11 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
                 let sample_fp = env_footprint_times(env_fp, 0.5);
                 for (var j = 0u; j < 4u; j = j + 1u) {
                     if (((covered >> j) & 1u) == 1u) {
-                        let sj = env_shade_carried_nowalk(in, da, msaa_position(j), base, dw, diffract, sample_fp);
+                        let sj = env_shade_carried_nowalk(in, da, msaa_position(j), base, dw, diffract, sample_fp, !scaled);
                         acc = acc + sj.xyz;
+                        if (scaled) {
+                            acc = acc + env_sun_disc_carried(in, da, msaa_position(j), 0.5, dw);
+                        }
                         at = at + sj.w * msaa_position(j);
                         k = k + sj.w;
                     }
@@ -484,7 +525,10 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
                 }
                 rgb = rgb + acc / f32(n_cov);
             } else {
-                rgb = rgb + env_shade_carried(in, da, vec2<f32>(0.0), base, dw, diffract, env_fp);
+                rgb = rgb + env_shade_carried(in, da, vec2<f32>(0.0), base, dw, diffract, env_fp, !scaled);
+                if (scaled) {
+                    rgb = rgb + env_sun_disc_carried(in, da, vec2<f32>(0.0), 1.0, dw);
+                }
             }
         } else {
             var off = vec2<f32>(0.0);
@@ -492,7 +536,7 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
                 env_seed_at(vec2<u32>(in.clip.xy), envg.frame);
                 off = covered_pick(covered, env_qmc(envg.frame + 1u, 31u));
             }
-            rgb = rgb + env_shade_carried(in, da, off, base, dw, diffract, env_fp);
+            rgb = rgb + env_shade_carried(in, da, off, base, dw, diffract, env_fp, true);
         }
     }
     return display(rgb);

@@ -669,8 +669,9 @@ fn env_cells_walks(n: vec3<f32>, wr: vec3<f32>, dw: f32, diffract: bool, clip: v
 // dw, diffract: the mesh has a pack's maps; walk: the first-frame estimator
 // walks the cells where the centre pass has no value (else the caller does,
 // once for several points: env_cells_walks, shaders/diffraction.wgsl
-// env_cells_carried).
-fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32, fp: EnvFootprint, walk: bool) -> vec3<f32> {
+// env_cells_carried); sun: the first-frame estimator adds the sun's disc
+// (else the caller does: env_sun_disc_carried on a mesh with scale maps).
+fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32, fp: EnvFootprint, walk: bool, sun: bool) -> vec3<f32> {
     if (envg.on == 0u || wr.z <= 0.0) {
         return vec3<f32>(0.0);
     }
@@ -791,7 +792,9 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     }
     if (envg.has_sun == 1u && envp.has_sun == 1u) {
         if (envg.estimator == 0u) {
-            xyz = xyz + env_sun_disc(t, b, n, wr, gr, hot_fp);
+            if (sun) {
+                xyz = xyz + env_sun_disc(t, b, n, wr, gr, hot_fp);
+            }
         } else {
             // Uniform on the disc (Sky::sample_sun).
             let u = env_qmc(envg.frame + 1u, 17u);

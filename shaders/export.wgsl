@@ -15,7 +15,8 @@
 // sunbeam_scale_frame(normal, orientation, tangent, uv, scales) on a mesh
 // with scale maps (sunbeam-bake --scales);
 // sunbeam_shade_environment(t, b, n, wr) adds an environment without its
-// sun, sunbeam_shade_sun(t, b, n, wi, wr) the sky's sun (shaders/export_env.wgsl). The entry point
+// sun, sunbeam_shade_sun(t, b, n, wi, wr) the sky's sun (shaders/export_env.wgsl;
+// on a mesh with scale maps point by point: sunbeam_shade_sun_point). The entry point
 // sunbeam_fragment shows the calls with the attributes and the two
 // directions as varyings.
 

@@ -189,36 +189,78 @@ fn sunbeam_shade_sun_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec
     if (sunbeam_env.sun_dir.w <= 0.0) {
         return vec3<f32>(0.0);
     }
-    let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
     let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
     let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw, sunbeam.energy);
     let dw = sunbeam.warp.z;
     var diff = vec3<f32>(0.0);
     if (wr_l.z > 0.0 && sunbeam_env.sun_grid.x > 0.0) {
         let gr = env_map_grid(sunbeam_env.sun_grid);
-        let omega = sunbeam_env.sun_rgb.w;
-        if (omega > 0.0) {
-            // a frame about the disc's centre
-            let up = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(wi.y) > 0.9);
-            let dt = normalize(cross(up, wi));
-            let db = cross(wi, dt);
-            let cos_cap = 1.0 - omega / SB_TAU;
+        if (sunbeam_env.sun_rgb.w > 0.0) {
             for (var i = 0u; i < u32(SB_SUN_POINTS); i = i + 1u) {
-                let u = (f32(i) + 0.5) / SB_SUN_POINTS;
-                let d = sb_sun_disc_dir(wi, dt, db, cos_cap, u, f32(i) * SB_GOLDEN);
+                let d = sunbeam_sun_point_dir(wi, i);
                 let o = sb_sun_pixel_offset(i);
                 let shift = o.x * env_footprint_dx(d, fp) + o.y * env_footprint_dy(d, fp);
                 diff = diff + env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr, shift);
             }
             diff = diff / SB_SUN_POINTS;
         } else {
-            diff = env_sun_at(wi_l, wr_l, skin, gr, vec3<f32>(0.0));
+            diff = env_sun_at(vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n)), wr_l, skin, gr, vec3<f32>(0.0));
         }
         diff = sb_xyz_to_linear_srgb(diff);
     }
-    let cos_i = max(wi_l.z, 0.0);
-    let lit = sunbeam_env.sun_rgb.rgb * cos_i * sb_base_transmission(cos_i, skin.ior, true) / ENV_PI;
-    return dw * sunbeam.base.rgb * lit + (1.0 - dw) * diff;
+    return sunbeam_shade_sun_base(t, b, n, wi) + (1.0 - dw) * diff;
+}
+
+// The base's part of sunbeam_shade_sun: dw * base * Omega L cos (1 - F) / pi
+// at wi (linear sRGB; 0 without a sun).
+fn sunbeam_shade_sun_base(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    if (sunbeam_env.sun_dir.w <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let cos_i = max(dot(wi, n), 0.0);
+    let lit = sunbeam_env.sun_rgb.rgb * cos_i * sb_base_transmission(cos_i, sunbeam.skin.x, true) / ENV_PI;
+    return sunbeam.warp.z * sunbeam.base.rgb * lit;
+}
+
+// Point i (0 <= i < SB_SUN_POINTS, 16) of the sun's disc about wi (towards
+// its centre): a Vogel spiral of equal solid angles over the cap of solid
+// angle sun_rgb.w; wi itself for a sun without a disc (sun_rgb.w 0).
+fn sunbeam_sun_point_dir(wi: vec3<f32>, i: u32) -> vec3<f32> {
+    let omega = sunbeam_env.sun_rgb.w;
+    if (omega <= 0.0) {
+        return wi;
+    }
+    // a frame about the disc's centre
+    let up = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(wi.y) > 0.9);
+    let dt = normalize(cross(up, wi));
+    let db = cross(wi, dt);
+    return sb_sun_disc_dir(wi, dt, db, 1.0 - omega / SB_TAU, (f32(i) + 0.5) / SB_SUN_POINTS, f32(i) * SB_GOLDEN);
+}
+
+// Where in the pixel disc point i is read: offset (pixels, in [-1/2, 1/2)
+// along x and y) from the pixel centre (sb_sun_pixel_offset).
+fn sunbeam_sun_pixel_offset(i: u32) -> vec2<f32> {
+    return sb_sun_pixel_offset(i);
+}
+
+// The diffraction of disc point i alone, (1 - dw) G G2 Omega E_sun in
+// linear sRGB, for a host that reads each point with its own frame and view:
+// on a mesh with scale maps, the frame the maps give at the point's place in
+// the pixel (sunbeam_sun_pixel_offset(i), the attributes carried there along
+// their screen derivatives) and the view from there, as the player's first
+// frame does (docs/ENGINES.md "Scale maps under an environment"). The mean
+// over i of this plus sunbeam_shade_sun_base is sunbeam_shade_sun at one
+// frame.
+fn sunbeam_shade_sun_point(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>, i: u32) -> vec3<f32> {
+    let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
+    if (sunbeam_env.sun_dir.w <= 0.0 || sunbeam_env.sun_grid.x <= 0.0 || wr_l.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw, sunbeam.energy);
+    let gr = env_map_grid(sunbeam_env.sun_grid);
+    let d = sunbeam_sun_point_dir(wi, i);
+    let xyz = env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr, vec3<f32>(0.0));
+    return (1.0 - sunbeam.warp.z) * sb_xyz_to_linear_srgb(xyz);
 }
 
 // The sun's map at local incidence wi and view wr, its (u, v, w) moved by

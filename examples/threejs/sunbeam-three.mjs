@@ -185,7 +185,7 @@ export function adaptExportedGlsl(src) {
     out.push(l);
   }
   const text = out.join('\n');
-  for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun_footprint(', 'vec3 sunbeam_shade_environment_footprint(', 'struct EnvFootprint', 'mat3x3 sb_frame(',
+  for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun_footprint(', 'vec3 sunbeam_shade_sun_point(', 'vec3 sunbeam_shade_sun_base(', 'vec2 sunbeam_sun_pixel_offset(', 'vec3 sunbeam_shade_environment_footprint(', 'struct EnvFootprint', 'mat3x3 sb_frame(',
     'uniform SunbeamMaterial _group_0_binding_0_fs;', 'uniform SunbeamEnvironment _group_0_binding_8_fs;', '_group_0_binding_1_fs', '_group_0_binding_7_fs', '_group_0_binding_9_fs',
     'mat3x3 sunbeam_scale_frame(', 'float sunbeam_scale_id(', '_group_0_binding_10_fs', '_group_0_binding_11_fs']) {
     if (!text.includes(need)) throw new Error(`exported GLSL: ${need} not found (docs/ENGINES.md; export it with this sunbeam-play)`);
@@ -321,6 +321,18 @@ void main() {
   vec3 wrl = vec3(dot(wr, t), dot(wr, b), dot(wr, n));
   float k = fwidth(sunbeam_scale_id(vUv, sbScales)) < 0.5 ? 1.0 : 0.0;
   EnvFootprint fp = EnvFootprint(k * dFdx(t), k * dFdy(t), k * dFdx(b), k * dFdy(b), k * dFdx(n), k * dFdy(n), k * dFdx(wrl), k * dFdy(wrl));
+  // The attributes' screen derivatives (here, in uniform control flow): on a
+  // mesh with scale maps each point of the sun's disc is read with the frame
+  // and the view at its own place in the pixel (sunbeam_sun_pixel_offset),
+  // the attributes carried there along them, and the scale maps read there:
+  // within a pixel the scales' domes turn the sun's orders and their borders
+  // jump them, which no footprint's linear model carries (the player's
+  // env_sun_disc_carried; docs/ENGINES.md "Scale maps under an environment").
+  vec3 dWx = dFdx(vWorld), dWy = dFdy(vWorld);
+  vec3 dNx = dFdx(vNormal), dNy = dFdy(vNormal);
+  vec3 dOx = dFdx(vOrient), dOy = dFdy(vOrient);
+  vec4 dTx = dFdx(vTangent), dTy = dFdy(vTangent);
+  vec2 dUx = dFdx(vUv), dUy = dFdy(vUv);
   vec3 rgb = vec3(0.0);
   for (int i = 0; i < ${MAX_LIGHTS}; i++) {
     if (i >= sbLightCount) break;
@@ -341,7 +353,20 @@ void main() {
     vec3 base = _group_0_binding_0_fs.base.rgb;
     vec4 sun = _group_0_binding_8_fs.sun_dir;
     if (sbHasMap == 1) {
-      rgb += sunbeam_shade_environment_footprint(t, b, n, wr, fp) + sunbeam_shade_sun_footprint(t, b, n, sun.xyz, wr, fp);
+      rgb += sunbeam_shade_environment_footprint(t, b, n, wr, fp);
+      if (sbScales != 0u) {
+        vec3 s = vec3(0.0);
+        for (uint i = 0u; i < 16u; i++) {
+          vec2 o = sunbeam_sun_pixel_offset(i);
+          mat3 fi = sunbeam_scale_frame(vNormal + o.x * dNx + o.y * dNy, vOrient + o.x * dOx + o.y * dOy,
+            vTangent + o.x * dTx + o.y * dTy, vUv + o.x * dUx + o.y * dUy, sbScales);
+          vec3 wri = normalize(sbEye - (vWorld + o.x * dWx + o.y * dWy));
+          s += sunbeam_shade_sun_point(fi[0], fi[1], fi[2], sun.xyz, wri, i);
+        }
+        rgb += sunbeam_shade_sun_base(t, b, n, sun.xyz) + s / 16.0;
+      } else {
+        rgb += sunbeam_shade_sun_footprint(t, b, n, sun.xyz, wr, fp);
+      }
     } else {
       rgb += base * env_irradiance(false, n) / PI;
       if (sun.w > 0.0) rgb += base * _group_0_binding_8_fs.sun_rgb.rgb * max(dot(sun.xyz, n), 0.0) / PI;

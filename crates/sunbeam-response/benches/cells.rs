@@ -44,7 +44,9 @@
 //!   four quadrature tables per point); `CUT=1` (with `CELLS_CFG=1:DEPTH`): the cells only where the
 //!   world's horizon or the ground is, a cut per view from the root,
 //!   `SBELOW=S` the largest spread kept below the horizon, `CUT_W=X` the
-//!   weight of the rows below the horizon in the fit (docs/LIGHTING.md
+//!   weight of the rows below the horizon in the fit; `STEP=1`: the fit
+//!   over the whole sphere with the ground's indicator as one more
+//!   function, a constant step below the horizon (docs/LIGHTING.md
 //!   "A polynomial control variate"). Each configuration prints the nodes
 //!   visited per point.
 
@@ -197,12 +199,20 @@ fn main() {
             .ok()
             .map(|v| v.parse().expect("SBELOW=SPREAD"))
             .unwrap_or(1.0);
+        // STEP=1 (with QUAD=L): the fit over the whole sphere with one more
+        // function, the indicator of the ground (below the world's horizon):
+        // the polynomial plus a constant step there
+        let step = std::env::var("STEP").is_ok();
         let ground = env.coefficients([0.0, -1.0, 0.0]);
         // the part taken exactly: the polynomial, and with HORIZON the ground
         // below the horizon instead
         let exact_part = |deg: u32, q: &[[f64; 3]], d: [f64; 3]| {
             if horizon && d[1] < 0.0 {
                 ground
+            } else if step && d[1] < 0.0 {
+                let p = poly_eval(deg, q, d);
+                let c = q[q.len() - 1];
+                [p[0] + c[0], p[1] + c[1], p[2] + c[2]]
             } else {
                 poly_eval(deg, q, d)
             }
@@ -211,7 +221,7 @@ fn main() {
             .ok()
             .map(|v| v.parse().expect("QUAD=DEGREE"));
         let quad_fit: Option<Vec<[f64; 3]>> = quad_deg.map(|deg| {
-            let nb = poly_basis(deg, [0.0, 0.0, 1.0]).len();
+            let nb = poly_basis(deg, [0.0, 0.0, 1.0]).len() + usize::from(step);
             let mut ata = vec![vec![0.0f64; nb]; nb];
             let mut atb = vec![[0.0f64; 3]; nb];
             // HORIZON=1: the fit over the upper hemisphere only; the part
@@ -233,7 +243,10 @@ fn main() {
                 for i in 0..w {
                     let phi = (i as f64 + 0.5) / w as f64 * std::f64::consts::TAU;
                     let d = sunbeam_light::direction(theta.cos(), phi);
-                    let f = poly_basis(deg, d);
+                    let mut f = poly_basis(deg, d);
+                    if step {
+                        f.push(if d[1] < 0.0 { 1.0 } else { 0.0 });
+                    }
                     let jt = if cut_walk { j.min(h / 2 - 1) } else { j };
                     let t = 4 * (jt * w + i);
                     for a in 0..nb {

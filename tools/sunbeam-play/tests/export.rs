@@ -55,6 +55,12 @@ fn glsl_passes_glslang() {
         for m in [
             "vec3 sunbeam_shade_environment(",
             "vec3 sunbeam_shade_sun(",
+            // the sun point by point on scaled meshes (docs/ENGINES.md
+            // "Scale maps under an environment")
+            "vec3 sunbeam_shade_sun_point(",
+            "vec3 sunbeam_shade_sun_base(",
+            "vec2 sunbeam_sun_pixel_offset(",
+            "vec3 sunbeam_sun_point_dir(",
             "vec3 env_cells(",
             "usampler2D _group_0_binding_7_fs",
             "sampler2D _group_0_binding_3_fs",

@@ -1,0 +1,161 @@
+//! The scaled snake under the sky (issue 27: the player and three.js
+//! against the reference under an environment): a 16 x 16 crop of the
+//! whole scaled snake of tests/scales_player.rs (`sunbeam-bake
+//! --generate-snake --scales`, defaults; the same camera and pixel size as
+//! its 128 x 64 frame, so a scale is about 1.5 pixels long and half the lit
+//! pixels touch the silhouette), the tests' 5 um ridge pack, the default
+//! sky with the sun at 35 deg and the sky drawn behind. The player's first
+//! frame (`--env-estimator cells --supersample 4`, 4x MSAA) and render.mjs
+//! (`--supersample 4`) against `sunbeam-eval render --samples 256 --converge
+//! 0.15` (seed 1), over the snake's pixels (a mask: the snake lit from the
+//! eye, nothing behind), anti-aliased, in linear light.
+//!
+//! What it checks: the sun's disc points read with the frame the scale maps
+//! give at each point's own place in the pixel (the player's
+//! env_sun_disc_carried, three.js through `sunbeam_shade_sun_point`;
+//! docs/LIGHTING.md "Scale borders"). Before, with the footprint's linear
+//! model inside a scale and a point across a border, the same crop read
+//! p99 5.04 (player) and 12.5 (three.js); the bounds below fail that.
+//! The issue's p99 < 2 holds at 8 x 8 on the whole snake (the benchmark,
+//! docs/BENCHMARKS.md); 4 x 4 on a crop keeps this under 3 minutes.
+
+mod common;
+
+use common::player_works;
+use common::threejs::{example, ridges, threejs_frame_at};
+use std::path::Path;
+use std::process::Command;
+use sunbeam::{run_ok, scratch, tool};
+use sunbeam_frame::linear::{compare_regions_within, RegionDiff};
+use sunbeam_frame::LinearImage;
+
+/// The crop: the whole-snake camera turned to a stretch of the body, the
+/// field of view cut to keep its 0.547 deg per pixel.
+fn scene(mesh: &str, material: &str, lighting: &str) -> String {
+    format!(
+        r#"{{ "camera": {{ "eye": [0, 0.3, 1.0], "target": [-0.1, 0, 0], "fov_y_deg": 8.75 }},
+  "meshes": [ {{ "mesh": "{mesh}", {material} }} ],
+  {lighting}, "size": [16, 16] }}"#
+    )
+}
+
+fn write(d: &Path, name: &str, text: &str) -> std::path::PathBuf {
+    let p = d.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn the_scaled_snake_under_the_sky_in_the_player_and_three_js() {
+    let d = scratch("scales_sky");
+    if !player_works(&d) {
+        return;
+    }
+    let render = example(&d);
+    ridges(&d);
+    run_ok(
+        Command::new(tool("sunbeam-bake"))
+            .args(["--generate-snake", "--scales", "-q", "-o"])
+            .arg(d.join("snake.glb")),
+    );
+    let sky = write(
+        &d,
+        "sky.json",
+        &scene(
+            "snake.glb",
+            r#""pack": "ridges.ktx2", "base_color": [0.05, 0.05, 0.05], "diffuse_weight": 0.2"#,
+            r#""environment": { "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 60 } }, "background": "environment", "exposure": 4.64"#,
+        ),
+    );
+    // The mask: the snake alone, lit from the eye, black behind.
+    let mask_scene = write(
+        &d,
+        "mask.json",
+        &scene(
+            "snake.glb",
+            r#""base_color": [0.5, 0.5, 0.5], "diffuse_weight": 1"#,
+            r#""lights": [ { "direction": [0, 0.3, 1.0], "intensity": 1 } ], "exposure": 0"#,
+        ),
+    );
+    let play = |scene: &Path, out: &Path, extra: &[&str]| {
+        run_ok(
+            Command::new(tool("sunbeam-play"))
+                .arg(scene)
+                .args(["--headless", "-q"])
+                .args(extra)
+                .arg("-o")
+                .arg(out),
+        );
+        LinearImage::read_exr(out).unwrap()
+    };
+    let mask = play(&mask_scene, &d.join("mask.exr"), &[]);
+    let t = std::time::Instant::now();
+    run_ok(
+        Command::new(tool("sunbeam-eval"))
+            .arg("render")
+            .arg(&sky)
+            .args([
+                "--samples",
+                "256",
+                "--converge",
+                "0.15",
+                "--seed",
+                "1",
+                "-q",
+                "-o",
+            ])
+            .arg(d.join("reference.exr")),
+    );
+    let reference = LinearImage::read_exr(&d.join("reference.exr")).unwrap();
+    let t_ref = t.elapsed();
+    let judge = |a: &LinearImage| -> RegionDiff {
+        compare_regions_within(a, &reference, Some(&mask)).unwrap()
+    };
+
+    let t = std::time::Instant::now();
+    let player = play(
+        &sky,
+        &d.join("player.exr"),
+        &["--env-estimator", "cells", "--supersample", "4"],
+    );
+    let t_player = t.elapsed();
+    let p = judge(&player);
+    eprintln!(
+        "scaled snake crop under the sky, player 4 x 4: all {}, interior {}, ring {} (reference {t_ref:.1?}, player {t_player:.1?})",
+        p.all, p.interior, p.edge
+    );
+    assert!(p.all.pixels > 100, "the crop shows little snake: {}", p.all);
+    assert!(p.all.p99 < PLAYER_P99, "player: {}", p.all);
+
+    // three.js needs node and chromium (`example`: under SUNBEAM_REQUIRE_ALL=1
+    // their absence fails, as in tests/threejs_scales.rs).
+    let Some(render) = render else { return };
+    let js = threejs_frame_at(&render, &d, &sky, "threejs", 4);
+    let j = judge(&js);
+    eprintln!(
+        "scaled snake crop under the sky, three.js 4 x 4: all {}, interior {}, ring {}",
+        j.all, j.interior, j.edge
+    );
+    assert!(
+        j.interior.p99 < THREEJS_INTERIOR_P99,
+        "three.js, interior: {}",
+        j.interior
+    );
+    assert!(j.all.p99 < THREEJS_P99, "three.js: {}", j.all);
+}
+
+/// Bound of the player's first frame over the crop's snake pixels:
+/// measured p99 2.50 (mean 0.71, 123 px; 2.35 against seed 2, the two
+/// seeds p99 0.44 apart), lavapipe, 2026-12-04; plus 20 %. Before the
+/// carried disc points 5.04.
+const PLAYER_P99: f64 = 3.0;
+
+/// Bound of three.js inside the silhouette: measured p99 1.81 (SwiftShader,
+/// 2026-12-04), plus 25 %; before 12.5.
+const THREEJS_INTERIOR_P99: f64 = 2.3;
+
+/// Bound of three.js over all the snake's pixels: measured p99 4.26 (the
+/// ring 5.96: one shading point per sub-pixel at the silhouette, where the
+/// player shades its covered samples; docs/ENGINES.md), plus 25 %; before
+/// 12.5.
+const THREEJS_P99: f64 = 5.3;
