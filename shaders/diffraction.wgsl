@@ -501,7 +501,7 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
             // On a mesh with scale maps the sun's disc reads the maps at
             // each of its points (env_sun_disc_carried).
             let scaled = mat.scales_on == 1u;
-            if (g.msaa >= 4u && (n_cov < 4u || mat.scales_on == 1u)) {
+            if (g.msaa >= 4u && (n_cov < 4u || scaled)) {
                 // (a mesh with scale maps too, as the point lights: the
                 // sun's orders jump at the scales' borders)
                 var acc = vec3<f32>(0.0);

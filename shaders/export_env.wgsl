@@ -196,8 +196,9 @@ fn sunbeam_shade_sun_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec
     if (wr_l.z > 0.0 && sunbeam_env.sun_grid.x > 0.0) {
         let gr = env_map_grid(sunbeam_env.sun_grid);
         if (sunbeam_env.sun_rgb.w > 0.0) {
+            let df = sunbeam_sun_disc_frame(wi);
             for (var i = 0u; i < u32(SB_SUN_POINTS); i = i + 1u) {
-                let d = sunbeam_sun_point_dir(wi, i);
+                let d = sunbeam_sun_point_in(df, i);
                 let o = sb_sun_pixel_offset(i);
                 let shift = o.x * env_footprint_dx(d, fp) + o.y * env_footprint_dy(d, fp);
                 diff = diff + env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr, shift);
@@ -226,15 +227,24 @@ fn sunbeam_shade_sun_base(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32
 // its centre): a Vogel spiral of equal solid angles over the cap of solid
 // angle sun_rgb.w; wi itself for a sun without a disc (sun_rgb.w 0).
 fn sunbeam_sun_point_dir(wi: vec3<f32>, i: u32) -> vec3<f32> {
-    let omega = sunbeam_env.sun_rgb.w;
-    if (omega <= 0.0) {
-        return wi;
-    }
-    // a frame about the disc's centre
+    return sunbeam_sun_point_in(sunbeam_sun_disc_frame(wi), i);
+}
+
+// A frame about the disc's centre wi: columns dt, db and wi (made once for
+// all of the disc's points).
+fn sunbeam_sun_disc_frame(wi: vec3<f32>) -> mat3x3<f32> {
     let up = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(wi.y) > 0.9);
     let dt = normalize(cross(up, wi));
-    let db = cross(wi, dt);
-    return sb_sun_disc_dir(wi, dt, db, 1.0 - omega / SB_TAU, (f32(i) + 0.5) / SB_SUN_POINTS, f32(i) * SB_GOLDEN);
+    return mat3x3<f32>(dt, cross(wi, dt), wi);
+}
+
+// sunbeam_sun_point_dir in the disc's frame f (sunbeam_sun_disc_frame).
+fn sunbeam_sun_point_in(f: mat3x3<f32>, i: u32) -> vec3<f32> {
+    let omega = sunbeam_env.sun_rgb.w;
+    if (omega <= 0.0) {
+        return f[2];
+    }
+    return sb_sun_disc_dir(f[2], f[0], f[1], 1.0 - omega / SB_TAU, (f32(i) + 0.5) / SB_SUN_POINTS, f32(i) * SB_GOLDEN);
 }
 
 // Where in the pixel disc point i is read: offset (pixels, in [-1/2, 1/2)

@@ -185,7 +185,7 @@ export function adaptExportedGlsl(src) {
     out.push(l);
   }
   const text = out.join('\n');
-  for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun_footprint(', 'vec3 sunbeam_shade_sun_point(', 'vec3 sunbeam_shade_sun_base(', 'vec2 sunbeam_sun_pixel_offset(', 'vec3 sunbeam_shade_environment_footprint(', 'struct EnvFootprint', 'mat3x3 sb_frame(',
+  for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun_footprint(', 'vec3 sunbeam_shade_sun_point(', 'vec3 sunbeam_shade_sun_base(', 'vec2 sunbeam_sun_pixel_offset(', 'const float SB_SUN_POINTS', 'vec3 sunbeam_shade_environment_footprint(', 'struct EnvFootprint', 'mat3x3 sb_frame(',
     'uniform SunbeamMaterial _group_0_binding_0_fs;', 'uniform SunbeamEnvironment _group_0_binding_8_fs;', '_group_0_binding_1_fs', '_group_0_binding_7_fs', '_group_0_binding_9_fs',
     'mat3x3 sunbeam_scale_frame(', 'float sunbeam_scale_id(', '_group_0_binding_10_fs', '_group_0_binding_11_fs']) {
     if (!text.includes(need)) throw new Error(`exported GLSL: ${need} not found (docs/ENGINES.md; export it with this sunbeam-play)`);
@@ -356,14 +356,14 @@ void main() {
       rgb += sunbeam_shade_environment_footprint(t, b, n, wr, fp);
       if (sbScales != 0u) {
         vec3 s = vec3(0.0);
-        for (uint i = 0u; i < 16u; i++) {
+        for (uint i = 0u; i < uint(SB_SUN_POINTS); i++) {
           vec2 o = sunbeam_sun_pixel_offset(i);
           mat3 fi = sunbeam_scale_frame(vNormal + o.x * dNx + o.y * dNy, vOrient + o.x * dOx + o.y * dOy,
             vTangent + o.x * dTx + o.y * dTy, vUv + o.x * dUx + o.y * dUy, sbScales);
           vec3 wri = normalize(sbEye - (vWorld + o.x * dWx + o.y * dWy));
           s += sunbeam_shade_sun_point(fi[0], fi[1], fi[2], sun.xyz, wri, i);
         }
-        rgb += sunbeam_shade_sun_base(t, b, n, sun.xyz) + s / 16.0;
+        rgb += sunbeam_shade_sun_base(t, b, n, sun.xyz) + s / SB_SUN_POINTS;
       } else {
         rgb += sunbeam_shade_sun_footprint(t, b, n, sun.xyz, wr, fp);
       }
