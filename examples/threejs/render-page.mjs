@@ -14,16 +14,22 @@ THREE.ColorManagement.enabled = false;
 
 window.sunbeamRender = async (job) => {
   try {
-    const { scene: desc, meshes, size, supersample: k, msaa = 1, glsl, env: envJob } = job;
+    const { scene: desc, meshes, size, supersample: k, msaa = 1, glsl, env: envJob, tile: tileAsked = 0 } = job;
     const [w, h] = size;
     const W = w * k, H = h * k;
     const canvas = document.createElement('canvas');
-    canvas.width = W;
-    canvas.height = H;
+    canvas.width = 1;
+    canvas.height = 1;
     document.body.appendChild(canvas);
     const renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
     renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
     const gl = renderer.getContext();
+    // The K-times frame is drawn in tiles (camera.setViewOffset) no larger
+    // than the GPU's render targets allow, capped at 2048 texels a side to
+    // bound the float read-back: any size and K render, and every texel
+    // sees the same projection as in one pass.
+    const limit = Math.min(gl.getParameter(gl.MAX_RENDERBUFFER_SIZE), gl.getParameter(gl.MAX_TEXTURE_SIZE), 2048);
+    const tile = tileAsked > 0 ? Math.min(tileAsked, limit) : limit;
     const exported = adaptExportedGlsl(glsl);
     const scale = Math.pow(2, desc.exposure);
     const root = new THREE.Scene();
@@ -98,37 +104,48 @@ window.sunbeamRender = async (job) => {
     root.updateMatrixWorld(true);
     updateSunbeamUniforms(root, camera);
     // msaa > 1: a multisampled target, resolved (averaged) before the read.
-    const rt = new THREE.WebGLRenderTarget(W, H, {
+    const rt = new THREE.WebGLRenderTarget(Math.min(tile, W), Math.min(tile, H), {
       type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true, samples: msaa > 1 ? msaa : 0,
     });
     renderer.setRenderTarget(rt);
     const bg = Array.isArray(desc.background) ? desc.background : [0, 0, 0];
     renderer.setClearColor(new THREE.Color(bg[0] * scale, bg[1] * scale, bg[2] * scale), 1);
-    renderer.render(root, camera);
-    const buf = new Float32Array(W * H * 4);
-    renderer.readRenderTargetPixels(rt, 0, 0, W, H, buf);
-    // Box filter K x K in linear light; WebGL rows run bottom-up.
-    const rgb = new Array(w * h * 3).fill(0);
-    for (let y = 0; y < h; y++) {
-      for (let x = 0; x < w; x++) {
-        let r = 0, g = 0, b = 0;
-        for (let j = 0; j < k; j++) {
-          const row = H - 1 - (y * k + j);
-          for (let i = 0; i < k; i++) {
-            const p = 4 * (row * W + x * k + i);
-            r += buf[p]; g += buf[p + 1]; b += buf[p + 2];
+    // Box filter K x K in linear light: each texel of each tile adds to its pixel.
+    const rgb = new Float64Array(w * h * 3);
+    const buf = new Float32Array(Math.min(tile, W) * Math.min(tile, H) * 4);
+    // The tile's window within the camera's own (a lens shift is a view offset already).
+    const view = camera.view && camera.view.enabled ? { ...camera.view }
+      : { fullWidth: W, fullHeight: H, offsetX: 0, offsetY: 0, width: W, height: H };
+    const sx = view.width / W, sy = view.height / H;
+    for (let y0 = 0; y0 < H; y0 += tile) {
+      for (let x0 = 0; x0 < W; x0 += tile) {
+        const tw = Math.min(tile, W - x0), th = Math.min(tile, H - y0);
+        camera.setViewOffset(view.fullWidth, view.fullHeight, view.offsetX + x0 * sx, view.offsetY + y0 * sy, tw * sx, th * sy);
+        rt.viewport.set(0, 0, tw, th);
+        renderer.setRenderTarget(rt);
+        renderer.render(root, camera);
+        renderer.readRenderTargetPixels(rt, 0, 0, tw, th, buf);
+        // WebGL rows run bottom-up; the tile's top row is y0.
+        for (let j = 0; j < th; j++) {
+          const y = Math.floor((y0 + j) / k);
+          const row = th - 1 - j;
+          for (let i = 0; i < tw; i++) {
+            const p = 4 * (row * tw + i);
+            const o = 3 * (y * w + Math.floor((x0 + i) / k));
+            rgb[o] += buf[p]; rgb[o + 1] += buf[p + 1]; rgb[o + 2] += buf[p + 2];
           }
         }
-        const o = 3 * (y * w + x);
-        rgb[o] = r / (k * k); rgb[o + 1] = g / (k * k); rgb[o + 2] = b / (k * k);
       }
     }
+    if (camera.view && view.enabled) camera.setViewOffset(view.fullWidth, view.fullHeight, view.offsetX, view.offsetY, view.width, view.height);
+    else camera.clearViewOffset();
+    for (let i = 0; i < rgb.length; i++) rgb[i] /= k * k;
     const dbg = gl.getExtension('WEBGL_debug_renderer_info');
     const name = dbg ? gl.getParameter(dbg.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);
     const glError = gl.getError();
     if (glError !== gl.NO_ERROR) return { error: `WebGL error 0x${glError.toString(16)}` };
     renderer.dispose();
-    return { rgb, renderer: name };
+    return { rgb: Array.from(rgb), renderer: name, tiles: Math.ceil(W / tile) * Math.ceil(H / tile) };
   } catch (e) {
     return { error: `three.js: ${e.message}` };
   }

@@ -1,7 +1,7 @@
 // Render a Sunbeam scene file (docs/SCENE.md) with three.js in headless
 // Chromium, as a browser would draw it:
 //
-//   node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N]
+//   node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--tile T]
 //
 // - the material is sunbeam-three.mjs: the GLSL ES that
 //   `sunbeam-play --export-shader glsl-es` writes from the player's WGSL
@@ -16,7 +16,10 @@
 //   K = 4) and box-filtered in linear light (a pixel is the average over its
 //   area), then written as PNG (exposure, clip at 1, sRGB curve: what
 //   sunbeam-eval render and sunbeam-play write) and, with --exr, as a linear
-//   OpenEXR (exposure applied, no tone curve) for comparisons;
+//   OpenEXR (exposure applied, no tone curve) for comparisons; K runs 1 to
+//   16, and the K-times frame is drawn in tiles of at most --tile T texels a
+//   side (default and cap: 2048, or less where the GPU's render targets are
+//   smaller), so any size and K render and the tiles' frame equals one pass;
 // - --msaa N (1 or 4, default 1) renders that target with N samples per
 //   texel, as a page with `antialias: true` draws its canvas: coverage at N
 //   samples, the material shaded once per texel at the centroid of the
@@ -37,7 +40,7 @@ const here = dirname(fileURLToPath(import.meta.url));
 
 function usage(msg) {
   if (msg) console.error(`render.mjs: error: ${msg}`);
-  console.error('usage: node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--glsl FILE]');
+  console.error('usage: node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--tile T] [--glsl FILE]');
   process.exit(1);
 }
 
@@ -60,7 +63,10 @@ for (let i = 0; i < args.length; i++) {
     opt.size = [+m[1], +m[2]];
   } else if (a === '--supersample') {
     opt.supersample = Number(next());
-    if (!Number.isInteger(opt.supersample) || opt.supersample < 1 || opt.supersample > 8) usage('--supersample: 1..8');
+    if (!Number.isInteger(opt.supersample) || opt.supersample < 1 || opt.supersample > 16) usage('--supersample: 1..16');
+  } else if (a === '--tile') {
+    opt.tile = Number(next());
+    if (!Number.isInteger(opt.tile) || opt.tile < 1) usage('--tile: a positive number of texels');
   } else if (a === '--msaa') {
     opt.msaa = Number(next());
     if (opt.msaa !== 1 && opt.msaa !== 4) usage('--msaa: 1 or 4');
@@ -262,7 +268,7 @@ try {
   p.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
   await p.goto(`${base}/render.html`);
   await p.waitForFunction(() => window.sunbeamRender !== undefined, null, { timeout: 60000 });
-  const job = { scene, meshes, size, supersample: opt.supersample, msaa: opt.msaa, glsl, env };
+  const job = { scene, meshes, size, supersample: opt.supersample, msaa: opt.msaa, glsl, env, tile: opt.tile ?? 0 };
   pixels = await p.evaluate((j) => window.sunbeamRender(j), job);
 } catch (e) {
   fail(4, `rendering in Chromium failed: ${e.message}${problems.length ? `\n${problems.join('\n')}` : ''}`);
@@ -356,4 +362,4 @@ function exrBytes() {
   return Buffer.concat([header, table, lines]);
 }
 if (opt.exr) atomicWrite(opt.exr, exrBytes());
-console.error(`render.mjs: wrote ${opt.output}${opt.exr ? ` and ${opt.exr}` : ''} (${w}x${h}, ${opt.supersample}x${opt.supersample} samples per pixel${opt.msaa > 1 ? `, ${opt.msaa}x MSAA` : ''}, ${pixels.renderer})`);
+console.error(`render.mjs: wrote ${opt.output}${opt.exr ? ` and ${opt.exr}` : ''} (${w}x${h}, ${opt.supersample}x${opt.supersample} samples per pixel${opt.msaa > 1 ? `, ${opt.msaa}x MSAA` : ''}${pixels.tiles > 1 ? `, ${pixels.tiles} tiles` : ''}, ${pixels.renderer})`);

@@ -693,8 +693,8 @@ export function sceneCamera(scene, aspect) {
  * coefficient table holding the direction: table.ktx2, or level 0 of the
  * chain when there are no hot spots; its columns start chain.phase turns
  * after phi = 0) times
- * basis_to_rgb, plus the sky's sun inside its disc, times 2^exposure. `camera` is the scene camera (a moving
- * camera: update the uniforms sbInvViewProj and sbEye per frame). `display`:
+ * basis_to_rgb, plus the sky's sun inside its disc, times 2^exposure. `camera` is the scene camera; the
+ * rays follow whichever camera draws it (its view, projection and view offset, read before each draw). `display`:
  * clip and sRGB-encode, as sunbeamMaterial's (drawing to a canvas).
  */
 export function environmentBackground(exportedGlsl, environment, camera, exposure = 0, display = false) {
@@ -767,5 +767,10 @@ void main() {
   const mesh = new THREE.Mesh(geometry, material);
   mesh.frustumCulled = false;
   mesh.renderOrder = -1;
+  mesh.onBeforeRender = (r, s, cam, geom, mat) => {
+    mat.uniforms.sbInvViewProj.value.multiplyMatrices(cam.projectionMatrix, cam.matrixWorldInverse).invert();
+    mat.uniforms.sbEye.value.setFromMatrixPosition(cam.matrixWorld);
+    mat.uniformsNeedUpdate = true;
+  };
   return mesh;
 }

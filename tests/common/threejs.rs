@@ -100,6 +100,18 @@ pub fn threejs_frame_at(
     name: &str,
     supersample: u32,
 ) -> LinearImage {
+    threejs_frame_with(render, d, scene, name, supersample, &[])
+}
+
+/// [`threejs_frame_at`] with more render.mjs options (`--tile T`, `--msaa N`).
+pub fn threejs_frame_with(
+    render: &Path,
+    d: &Path,
+    scene: &Path,
+    name: &str,
+    supersample: u32,
+    extra: &[&str],
+) -> LinearImage {
     let (png, exr) = (d.join(format!("{name}.png")), d.join(format!("{name}.exr")));
     run_ok(
         Command::new("node")
@@ -110,6 +122,7 @@ pub fn threejs_frame_at(
             .arg("--exr")
             .arg(&exr)
             .args(["--supersample", &supersample.to_string()])
+            .args(extra)
             .env("SUNBEAM_PLAY", tool("sunbeam-play")),
     );
     assert!(png.is_file());
