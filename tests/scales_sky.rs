@@ -6,18 +6,22 @@
 //! pixels touch the silhouette), the tests' 5 um ridge pack, the default
 //! sky with the sun at 35 deg and the sky drawn behind. The player's first
 //! frame (`--env-estimator cells --supersample 4`, 4x MSAA) and render.mjs
-//! (`--supersample 4`) against `sunbeam-eval render --samples 256 --converge
-//! 0.15` (seed 1), over the snake's pixels (a mask: the snake lit from the
-//! eye, nothing behind), anti-aliased, in linear light.
+//! (`--supersample 16`: at the silhouette three.js shades one point per
+//! sub-pixel, where the player shades each covered sample) against
+//! `sunbeam-eval render --samples 256 --converge 0.15` (seed 1), over the
+//! snake's pixels (a mask: the snake lit from the eye, nothing behind),
+//! anti-aliased, in linear light.
 //!
 //! What it checks: the sun's disc points read with the frame the scale maps
 //! give at each point's own place in the pixel (the player's
 //! env_sun_disc_carried, three.js through `sunbeam_shade_sun_point`;
 //! docs/LIGHTING.md "Scale borders"). Before, with the footprint's linear
 //! model inside a scale and a point across a border, the same crop read
-//! p99 5.04 (player) and 12.5 (three.js); the bounds below fail that.
-//! The p99 < 2 holds at 8 x 8 on the whole snake (the benchmark,
-//! docs/BENCHMARKS.md); 4 x 4 on a crop keeps this under 3 minutes.
+//! p99 5.04 (player) and 12.5 (three.js, at 4 x 4); the bounds below fail
+//! that. three.js is held to the p99 < 2 with the silhouette here
+//! (the crop's ring reads 5.96 / 2.32 / 0.67 at 4 x 4 / 8 x 8 / 16 x 16); the
+//! player meets it at 8 x 8 on the whole snake (the benchmark,
+//! docs/BENCHMARKS.md), and 4 x 4 on a crop keeps its part short.
 
 mod common;
 
@@ -130,17 +134,18 @@ fn the_scaled_snake_under_the_sky_in_the_player_and_three_js() {
     // three.js needs node and chromium (`example`: under SUNBEAM_REQUIRE_ALL=1
     // their absence fails, as in tests/threejs_scales.rs).
     let Some(render) = render else { return };
-    let js = threejs_frame_at(&render, &d, &sky, "threejs", 4);
+    let js = threejs_frame_at(&render, &d, &sky, "threejs", 16);
     let j = judge(&js);
     eprintln!(
-        "scaled snake crop under the sky, three.js 4 x 4: all {}, interior {}, ring {}",
+        "scaled snake crop under the sky, three.js 16 x 16: all {}, interior {}, ring {}",
         j.all, j.interior, j.edge
     );
     assert!(
-        j.interior.p99 < THREEJS_INTERIOR_P99,
-        "three.js, interior: {}",
-        j.interior
+        j.edge.pixels > 40,
+        "the crop shows little silhouette: {}",
+        j.edge
     );
+    assert!(j.edge.p99 < THREEJS_P99, "three.js, ring: {}", j.edge);
     assert!(j.all.p99 < THREEJS_P99, "three.js: {}", j.all);
 }
 
@@ -150,12 +155,8 @@ fn the_scaled_snake_under_the_sky_in_the_player_and_three_js() {
 /// carried disc points 5.04.
 const PLAYER_P99: f64 = 3.0;
 
-/// Bound of three.js inside the silhouette: measured p99 1.81 (SwiftShader,
-/// 2026-12-04), plus 25 %; before 12.5.
-const THREEJS_INTERIOR_P99: f64 = 2.3;
-
-/// Bound of three.js over all the snake's pixels: measured p99 4.26 (the
-/// ring 5.96: one shading point per sub-pixel at the silhouette, where the
-/// player shades its covered samples; docs/ENGINES.md), plus 25 %; before
-/// 12.5.
-const THREEJS_P99: f64 = 5.3;
+/// Bound of three.js at 16 x 16 over all the snake's pixels and over its
+/// ring alone: measured p99 0.61 (ring 0.67, interior 0.44; SwiftShader,
+/// 2026-12-04), plus 60 % and within the 2; at 8 x 8 2.07 (ring
+/// 2.32), at 4 x 4 4.26 (ring 5.96).
+const THREEJS_P99: f64 = 1.0;
