@@ -114,8 +114,8 @@ window.sunbeamRender = async (job) => {
     const rgb = new Float64Array(w * h * 3);
     const buf = new Float32Array(Math.min(tile, W) * Math.min(tile, H) * 4);
     // The tile's window within the camera's own (a lens shift is a view offset already).
-    const view = camera.view && camera.view.enabled ? { ...camera.view }
-      : { fullWidth: W, fullHeight: H, offsetX: 0, offsetY: 0, width: W, height: H };
+    const shifted = camera.view?.enabled === true;
+    const view = shifted ? { ...camera.view } : { fullWidth: W, fullHeight: H, offsetX: 0, offsetY: 0, width: W, height: H };
     const sx = view.width / W, sy = view.height / H;
     for (let y0 = 0; y0 < H; y0 += tile) {
       for (let x0 = 0; x0 < W; x0 += tile) {
@@ -137,7 +137,7 @@ window.sunbeamRender = async (job) => {
         }
       }
     }
-    if (camera.view && view.enabled) camera.setViewOffset(view.fullWidth, view.fullHeight, view.offsetX, view.offsetY, view.width, view.height);
+    if (shifted) camera.setViewOffset(view.fullWidth, view.fullHeight, view.offsetX, view.offsetY, view.width, view.height);
     else camera.clearViewOffset();
     for (let i = 0; i < rgb.length; i++) rgb[i] /= k * k;
     const dbg = gl.getExtension('WEBGL_debug_renderer_info');
