@@ -40,7 +40,7 @@ COLUMNS=7
 SCALE_TEXELS=16
 # Scales per species (examples/Makefile SCALES_*; docs/BAKE.md "Scales").
 SCALES_xeno="--scale-rows 20 --scale-length 1.0 --scale-overlap 0.3 --scale-dome 0.06 --scale-tilt 6 --scale-tilt-jitter 4 --scale-ridge-jitter 6"
-SCALES_elaphe="--scale-rows 36 --scale-length 1.5 --scale-overlap 0.3 --scale-dome 0.1 --scale-tilt 6 --scale-tilt-jitter 4 --scale-ridge-jitter 4"
+SCALES_elaphe="--scale-rows 36 --scale-length 1.5 --scale-overlap 0.3 --scale-dome 0.06 --scale-keel 0.03 --scale-tilt 6 --scale-tilt-jitter 4 --scale-ridge-jitter 4"
 HDRI=__default__
 SHEET=__default__
 Q=-q

@@ -7,7 +7,8 @@
 //!
 //! - point-sampled (the pixel centre on both sides): the maps' lookup and
 //!   frame texel for texel, also with a 45 deg ridge jitter, where the groove
-//!   mask's weighting of the ridge vectors shows at the borders;
+//!   mask's weighting of the ridge vectors shows at the borders, and with
+//!   keeled scales (their steepest normals);
 //! - anti-aliased: both renderers at 2x and box-filtered (the player with its
 //!   4x MSAA and footprint filter, the reference with `--samples 16`);
 //! - the same frame by the player without the maps must differ from the
@@ -31,9 +32,10 @@ use sunbeam_render::Settings;
 const SIZE: u32 = 48;
 
 /// The snake baked with scales (the tool itself, as a user runs it), the
-/// ridges of each scale turned by up to +-`ridge_jitter` degrees.
-fn scaled_snake(dir: &Path, ridge_jitter: u32) -> PathBuf {
-    let out = dir.join(format!("snake-scales-{ridge_jitter}.glb"));
+/// ridges of each scale turned by up to +-`ridge_jitter` degrees, a keel of
+/// `keel` scale widths on each.
+fn scaled_snake(dir: &Path, ridge_jitter: u32, keel: &str) -> PathBuf {
+    let out = dir.join(format!("snake-scales-{ridge_jitter}-{keel}.glb"));
     sunbeam::run_ok(
         std::process::Command::new(sunbeam::tool("sunbeam-bake"))
             .args([
@@ -45,6 +47,8 @@ fn scaled_snake(dir: &Path, ridge_jitter: u32) -> PathBuf {
                 "8",
                 "--scale-ridge-jitter",
                 &ridge_jitter.to_string(),
+                "--scale-keel",
+                keel,
                 "-q",
                 "-o",
             ])
@@ -145,7 +149,7 @@ fn player_applies_the_scale_maps_as_the_reference() {
     let Some(gpu) = gpu() else { return };
     let dir = sunbeam::scratch("scales_player");
     let pack = Arc::new(ridge_pack(160, 31e-9));
-    let p = scene(&scaled_snake(&dir, 6), pack.clone());
+    let p = scene(&scaled_snake(&dir, 6, "0"), pack.clone());
     let out = std::env::var("SUNBEAM_SCALES_OUT").ok().map(PathBuf::from);
     if let Some(d) = &out {
         std::fs::create_dir_all(d).unwrap();
@@ -180,7 +184,12 @@ fn player_applies_the_scale_maps_as_the_reference() {
         sunbeam_frame::compare_linear(&player, &reference).unwrap()
     };
     let d_point = point(&p, "point");
-    let d_jitter = point(&scene(&scaled_snake(&dir, 45), pack), "point-jitter45");
+    let d_jitter = point(
+        &scene(&scaled_snake(&dir, 45, "0"), pack.clone()),
+        "point-jitter45",
+    );
+    // Keeled scales (Elaphe's; a keel of 0.1 widths, the largest allowed: flanks at 46 deg).
+    let d_keel = point(&scene(&scaled_snake(&dir, 6, "0.1"), pack), "point-keel");
 
     // Anti-aliased: both at 2x, box-filtered.
     let t = std::time::Instant::now();
@@ -210,7 +219,7 @@ fn player_applies_the_scale_maps_as_the_reference() {
     let d = sunbeam_frame::compare_linear(&player, &reference).unwrap();
     let d0 = sunbeam_frame::compare_linear(&without, &reference).unwrap();
     eprintln!(
-        "scaled snake ({SIZE}^2, 5 um ridge pack, 48 wavelengths): point-sampled {d_point} (ridge jitter 45 deg: {d_jitter}); 2x both: player {d}; without the maps {d0} (reference {t_cpu:.2?}, player {t_gpu:.2?})"
+        "scaled snake ({SIZE}^2, 5 um ridge pack, 48 wavelengths): point-sampled {d_point} (ridge jitter 45 deg: {d_jitter}; keel 0.1: {d_keel}); 2x both: player {d}; without the maps {d0} (reference {t_cpu:.2?}, player {t_gpu:.2?})"
     );
     let lit = (SIZE * SIZE) as usize / 2;
     assert!(
@@ -218,7 +227,7 @@ fn player_applies_the_scale_maps_as_the_reference() {
         "the snake shows little: {} lit pixels",
         d.pixels
     );
-    for d in [&d_point, &d_jitter] {
+    for d in [&d_point, &d_jitter, &d_keel] {
         assert!(d.p99 < 0.5 && d.max < 1.5, "point-sampled: {d}");
     }
     assert!(d.p99 < 1.0, "player against the reference: {d}");

@@ -9,7 +9,8 @@
 #
 # PACK: the Xenopeltis pack (default examples/out/xeno.ktx2, from `make demo`);
 # OUTDIR: where the PNGs go (default docs/img). BIN (default target/release),
-# SIZE (160x120) and SAMPLES (1) from the environment. About 22 renders of 15 s each on 2 cores.
+# SIZE (160x120) and SAMPLES (1) from the environment; PARAMS (default: all)
+# names the strips to make, e.g. PARAMS=keel. About 25 renders of 15 s each on 2 cores.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 BIN=${BIN:-$root/target/release}
@@ -22,17 +23,19 @@ tmp=$(mktemp -d "${TMPDIR:-/tmp}/scales-sweep.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
 
 # The demo's Xenopeltis (examples/Makefile SCALES_xeno); each sweep replaces one flag.
-declare -A base=([rows]=20 [length]=1.0 [overlap]=0.3 [dome]=0.06 [tilt]=6 [tilt-jitter]=4 [ridge-jitter]=6)
+declare -A base=([rows]=20 [length]=1.0 [overlap]=0.3 [dome]=0.06 [keel]=0 [tilt]=6 [tilt-jitter]=4 [ridge-jitter]=6)
 declare -A sweep=(
   [rows]="10 15 20 30"
   [length]="0.6 1.0 1.6 2.4"
   [overlap]="0 0.15 0.3 0.5"
   [dome]="0 0.06 0.15 0.3"
+  [keel]="0 0.02 0.04 0.08"
   [tilt]="-10 0 6 20"
   [tilt-jitter]="0 4 10 20"
   [ridge-jitter]="0 6 20 45"
 )
-order="rows length overlap dome tilt tilt-jitter ridge-jitter"
+all="rows length overlap dome keel tilt tilt-jitter ridge-jitter"
+order=${PARAMS:-$all}
 
 # A short stretch of the back (where the spine runs along +x, near x = 0.1),
 # one point light from the head's side and above. The base colour is lighter
@@ -55,7 +58,7 @@ for p in $order; do
   pngs=()
   for v in ${sweep[$p]}; do
     flags=(--scales --scale-texels 16)
-    for q in $order; do
+    for q in $all; do
       x=${base[$q]}; [ "$q" = "$p" ] && x=$v
       flags+=("--scale-$q" "$x")
     done

@@ -543,11 +543,13 @@ def scale_maps(test, glb):
 # The object settings of sunbeam-bake's scale flags: written out here (not the add-on's table)
 SCALE_PROPS = {"--scale-rows": "scale_rows", "--scale-length": "scale_length",
                "--scale-overlap": "scale_overlap", "--scale-dome": "scale_dome",
+               "--scale-keel": "scale_keel",
                "--scale-tilt": "scale_tilt", "--scale-tilt-jitter": "scale_tilt_jitter",
                "--scale-ridge-jitter": "scale_ridge_jitter", "--scale-texels": "scale_texels",
                "--scale-seed": "scale_seed"}
 REPORT_KEYS = {"scale_rows": "rows", "scale_length": "length", "scale_overlap": "overlap",
-               "scale_dome": "dome", "scale_tilt": "tilt_deg", "scale_tilt_jitter": "tilt_jitter_deg",
+               "scale_dome": "dome", "scale_keel": "keel",
+               "scale_tilt": "tilt_deg", "scale_tilt_jitter": "tilt_jitter_deg",
                "scale_ridge_jitter": "ridge_jitter_deg", "scale_texels": "texels_per_scale",
                "scale_seed": "seed"}
 
@@ -564,7 +566,7 @@ class ScalesTest(unittest.TestCase):
         o.use_scales = True
         o.scale_rows, o.scale_texels, o.scale_length, o.scale_overlap = 7, 8, 1.5, 0.45
         o.scale_dome, o.scale_tilt, o.scale_tilt_jitter, o.scale_ridge_jitter = 0.1, -12.0, 3.0, 20.0
-        o.scale_seed = 12345
+        o.scale_keel, o.scale_seed = 0.04, 12345
         return scene, sphere
 
     def test_operator_writes_the_maps_with_the_panel_values(self):

@@ -11,7 +11,9 @@
 //! scale's free edge points to decreasing `u` (toward the tail) and overlaps the
 //! base of the scale behind it by `overlap` scale lengths; where two overlap the
 //! anterior one lies on top. The free edge is rounded (its corners lie a
-//! quarter of a scale length behind its tip).
+//! quarter of a scale length behind its tip). Each scale is a low dome, and
+//! may carry a keel: a ridge along its midline that fades out toward the free
+//! edge's tip (the keeled scales of *Elaphe*).
 //!
 //! Textures (8-bit RGBA PNG, sampled with `TEXCOORD_n`, wrap `v` repeat, `u` clamp):
 //! - **normal map** (`normalTexture`): the glTF tangent-space normal, RGB =
@@ -47,6 +49,8 @@ pub struct ScaleParams {
     pub overlap: f64,
     /// Dome height, in scale widths.
     pub dome: f64,
+    /// Keel height (a ridge along the scale's midline), in scale widths.
+    pub keel: f64,
     /// Tilt of the free edge (rotation of the scale's normal toward the head), degrees.
     pub tilt_deg: f64,
     /// Per-scale jitter of the tilt (uniform in +-), degrees.
@@ -66,6 +70,7 @@ impl Default for ScaleParams {
             length: 1.0,
             overlap: 0.3,
             dome: 0.06,
+            keel: 0.0,
             tilt_deg: 6.0,
             tilt_jitter_deg: 4.0,
             ridge_jitter_deg: 6.0,
@@ -81,6 +86,11 @@ pub const MAX_SIDE: u32 = 8192;
 const GROOVE: f64 = 0.06;
 /// How far the free edge's corners lie behind its tip (a rounded edge), in scale lengths.
 const ROUND: f64 = 0.25;
+/// Half-width of the keel, in scale widths (the ridge spans the middle 30 % of the scale).
+pub const KEEL_HALF_WIDTH: f64 = 0.15;
+/// The keel fades in over this fraction of the scale from its free edge's tip
+/// (xi, 0 at the tip, 1 at the base): keels stop short of the tip.
+pub const KEEL_FADE: f64 = 0.35;
 
 impl ScaleParams {
     /// Range checks (the CLI's value parsers check the same ranges).
@@ -96,6 +106,7 @@ impl ScaleParams {
         r("length", self.length, 0.25, 4.0)?;
         r("overlap", self.overlap, 0.0, 0.6)?;
         r("dome", self.dome, 0.0, 0.3)?;
+        r("keel", self.keel, 0.0, 0.1)?;
         r("tilt_deg", self.tilt_deg, -30.0, 30.0)?;
         r("tilt_jitter_deg", self.tilt_jitter_deg, 0.0, 20.0)?;
         r("ridge_jitter_deg", self.ridge_jitter_deg, 0.0, 45.0)?;
@@ -155,8 +166,13 @@ impl Tiling {
         );
         let (de, dx) = (-4.0 * (2.0 * eta - 1.0), -4.0 * (2.0 * xi - 1.0));
         let len = self.p.length * (1.0 + o);
-        let slope_u = self.p.dome * fe * dx / len - tilt.tan();
-        let slope_v = self.p.dome * de * fx;
+        // Keel h = keel W b(eta) f(xi): a quartic bump b = (1 - (t/a)^2)^2 across
+        // the midline (t = eta - 1/2, |t| < a = KEEL_HALF_WIDTH), its height
+        // faded in from the tip by f = smoothstep(xi / KEEL_FADE).
+        let (kb, kdb) = keel_profile(eta - 0.5);
+        let (kf, kdf) = keel_fade(xi);
+        let slope_u = (self.p.dome * fe * dx + self.p.keel * kb * kdf) / len - tilt.tan();
+        let slope_v = self.p.dome * de * fx + self.p.keel * kdb * kf;
         // Tangent-space normal: X along +u, Y along decreasing v (the glTF bitangent).
         let g = [-slope_u, slope_v, 1.0];
         let l = norm(g);
@@ -173,6 +189,28 @@ impl Tiling {
             mask,
             id,
         }
+    }
+}
+
+/// The keel's cross profile b(t) and db/dt at t = eta - 1/2 (see [`Tiling::eval`]).
+fn keel_profile(t: f64) -> (f64, f64) {
+    let a = KEEL_HALF_WIDTH;
+    if t.abs() >= a {
+        return (0.0, 0.0);
+    }
+    let q = 1.0 - (t / a).powi(2);
+    (q * q, -4.0 * t / (a * a) * q)
+}
+
+/// The keel's fade along the scale, f(xi) and df/dxi (see [`Tiling::eval`]).
+fn keel_fade(xi: f64) -> (f64, f64) {
+    let s = xi / KEEL_FADE;
+    if s >= 1.0 {
+        (1.0, 0.0)
+    } else if s <= 0.0 {
+        (0.0, 0.0)
+    } else {
+        (s * s * (3.0 - 2.0 * s), 6.0 * s * (1.0 - s) / KEEL_FADE)
     }
 }
 

@@ -35,6 +35,7 @@ fn tilted_quad(dir: &Path, tilt_deg: f64) -> std::path::PathBuf {
         length: 1.0,
         overlap: 0.3,
         dome: 0.0,
+        keel: 0.0,
         tilt_deg,
         tilt_jitter_deg: 0.0,
         ridge_jitter_deg: 0.0,

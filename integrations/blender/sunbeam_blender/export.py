@@ -352,7 +352,7 @@ def bake_source(depsgraph, obj):
 # sunbeam-bake's scale flags and the object settings that give them (properties.py)
 SCALE_FLAGS = (("--scale-rows", "scale_rows"), ("--scale-length", "scale_length"),
                ("--scale-overlap", "scale_overlap"), ("--scale-dome", "scale_dome"),
-               ("--scale-tilt", "scale_tilt"), ("--scale-tilt-jitter", "scale_tilt_jitter"),
+               ("--scale-keel", "scale_keel"), ("--scale-tilt", "scale_tilt"), ("--scale-tilt-jitter", "scale_tilt_jitter"),
                ("--scale-ridge-jitter", "scale_ridge_jitter"), ("--scale-texels", "scale_texels"),
                ("--scale-seed", "scale_seed"))
 

@@ -77,6 +77,9 @@ class SunbeamObjectSettings(bpy.types.PropertyGroup):
                                  "it, in scale lengths (--scale-overlap)")
     scale_dome: FloatProperty(name="Dome", min=0.0, max=0.3, default=0.06, precision=3,
                               description="Dome height of a scale, in scale widths (--scale-dome)")
+    scale_keel: FloatProperty(name="Keel", min=0.0, max=0.1, default=0.0, precision=3,
+                              description="Keel height of a scale, a ridge along its midline, in "
+                              "scale widths; 0: smooth (--scale-keel)")
     scale_tilt: FloatProperty(name="Tilt", min=-30.0, max=30.0, default=6.0,
                               description="Tilt of the free edge, degrees: the scale's normal turns "
                               "toward the head (--scale-tilt)")

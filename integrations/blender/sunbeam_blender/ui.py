@@ -85,8 +85,9 @@ class SUNBEAM_PT_orientation_scales(bpy.types.Panel):
         layout.active = o.use_scales
         if o.source != "UV":
             layout.prop(o, "uv_set")
-        for name in ("scale_rows", "scale_length", "scale_overlap", "scale_dome", "scale_tilt",
-                     "scale_tilt_jitter", "scale_ridge_jitter", "scale_texels", "scale_seed"):
+        for name in ("scale_rows", "scale_length", "scale_overlap", "scale_dome", "scale_keel",
+                     "scale_tilt", "scale_tilt_jitter", "scale_ridge_jitter", "scale_texels",
+                     "scale_seed"):
             layout.prop(o, name)
 
 

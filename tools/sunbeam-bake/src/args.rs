@@ -149,6 +149,10 @@ pub(crate) struct Cli {
     #[arg(long, value_name = "H", default_value_t = 0.06, requires = "scales",
           value_parser = sunbeam_common::cli::ranged(0.0, 0.3))]
     pub(crate) scale_dome: f64,
+    /// Keel height of a scale (a ridge along its midline), in scale widths; 0: smooth.
+    #[arg(long, value_name = "H", default_value_t = 0.0, requires = "scales",
+          value_parser = sunbeam_common::cli::ranged(0.0, 0.1))]
+    pub(crate) scale_keel: f64,
     /// Tilt of the free edge, degrees (the scale's normal turns toward the head).
     #[arg(long, value_name = "DEG", default_value_t = 6.0, requires = "scales",
           allow_hyphen_values = true, value_parser = sunbeam_common::cli::ranged(-30.0, 30.0))]

@@ -212,6 +212,7 @@ fn scale_params(cli: &Cli) -> ScaleParams {
         length: cli.scale_length,
         overlap: cli.scale_overlap,
         dome: cli.scale_dome,
+        keel: cli.scale_keel,
         tilt_deg: cli.scale_tilt,
         tilt_jitter_deg: cli.scale_tilt_jitter,
         ridge_jitter_deg: cli.scale_ridge_jitter,

@@ -175,6 +175,8 @@ fn bad_input_is_refused_with_no_output() {
         (vec!["--scale-overlap", "nan"], "--scale-overlap"),
         (vec!["--scale-length", "abc"], "--scale-length"),
         (vec!["--scale-dome", "0.5"], "--scale-dome"),
+        (vec!["--scale-keel", "0.2"], "--scale-keel"),
+        (vec!["--scale-keel=-0.01"], "--scale-keel"),
         (vec!["--scale-ridge-jitter=-1"], "--scale-ridge-jitter"),
         (vec!["--scale-texels", "1000"], "--scale-texels"),
     ] {
@@ -223,5 +225,96 @@ fn bad_input_is_refused_with_no_output() {
     ok(&o);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("runs along u at only 0 %"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The keel, read back from the normal map of a flat quad (u, v in 0..1; 4
+/// rows of 4 scales, 64 texels a width, no dome, tilt or jitter): across a
+/// scale's midline the v-slope is positive, then negative (the normal leans
+/// toward the ridge's crest from both sides), and integrating it across the
+/// scale gives back the keel's height, `--scale-keel` scale widths, at the
+/// middle of the scale and little of it near the free edge's tip (the keel
+/// fades out there). Without the keel the same texels are flat.
+#[test]
+fn keel_height_is_read_back_from_the_normal_map() {
+    let d = tmpdir("keel");
+    let obj = d.join("quad.obj");
+    std::fs::write(
+        &obj,
+        "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n",
+    )
+    .unwrap();
+    // Height profile across row 0 (image rows 0..64) at texel column `col`:
+    // the running sum of the decoded v-slope ny / nz over eta (one texel = 1/64 width).
+    let profile = |keel: &str, col: usize| -> Vec<f64> {
+        let glb = d.join(format!("quad-{keel}.glb"));
+        let o = bake_env(
+            &[
+                &s(&obj),
+                "--uv-direction",
+                "u",
+                "--scales",
+                "--scale-rows",
+                "4",
+                "--scale-length",
+                "1",
+                "--scale-dome",
+                "0",
+                "--scale-keel",
+                keel,
+                "--scale-tilt",
+                "0",
+                "--scale-tilt-jitter",
+                "0",
+                "--scale-ridge-jitter",
+                "0",
+                "--scale-texels",
+                "64",
+                "-o",
+                &s(&glb),
+            ],
+            None,
+        );
+        ok(&o);
+        let mut doc = Document::load(&glb).unwrap();
+        let maps = scale_maps::read(&mut doc, 0).unwrap().expect("scale maps");
+        assert_eq!(maps.normal.size, [256, 256]);
+        let dec = |b: u8| b as f64 / 255.0 * 2.0 - 1.0;
+        (0..64)
+            .map(|y| {
+                let px = &maps.normal.data[(y * 256 + col) * 4..][..4];
+                dec(px[1]) / dec(px[2])
+            })
+            .collect()
+    };
+    // Column 32: x = 0.5 scale lengths into scale 0 (xi = 0.62, the keel at full height).
+    let slope = profile("0.05", 32);
+    let before: f64 = slope[..32].iter().sum::<f64>() / 64.0;
+    let after: f64 = slope[32..].iter().sum::<f64>() / 64.0;
+    // Each decoded slope is within 1/255 of the truth (8 bits; a flat texel
+    // decodes to +1/255), so a sum over 32 or 64 texels is within 0.004 widths.
+    assert!(
+        (before - 0.05).abs() < 0.005,
+        "height at the crest {before}, want 0.05 widths; slopes {slope:?}"
+    );
+    assert!(
+        (before + after).abs() < 0.005,
+        "the ridge ends where it began: {before} + {after}"
+    );
+    assert!(slope[26] > 0.1 && slope[37] < -0.1, "{slope:?}");
+    // Outside the keel's middle 30 % the scale is flat (no dome).
+    assert!(slope[..20]
+        .iter()
+        .chain(&slope[44..])
+        .all(|x| x.abs() < 0.01));
+    // Column 0: x = 0.008, xi = 0.24 from the tip, where the keel has faded in
+    // to smoothstep(0.24 / 0.35) = 0.76 of its height; it is lower than at the middle.
+    let tip: f64 = profile("0.05", 0)[..32].iter().sum::<f64>() / 64.0;
+    assert!(
+        tip < 0.9 * before && tip > 0.2 * before,
+        "{tip} vs {before}"
+    );
+    // No keel: flat everywhere.
+    assert!(profile("0", 32).iter().all(|x| x.abs() < 0.01));
     let _ = std::fs::remove_dir_all(&d);
 }
