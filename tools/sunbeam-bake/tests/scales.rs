@@ -42,6 +42,9 @@ fn scaled_snake_validates_and_every_texel_is_unit() {
             "--scales",
             "--scale-texels",
             "16",
+            // The steepest keel allowed: its flanks' normals are checked below too.
+            "--scale-keel",
+            "0.1",
             "-o",
             &s(&glb),
             "--json",
@@ -55,6 +58,7 @@ fn scaled_snake_validates_and_every_texel_is_unit() {
     let sc = &rep["scales"];
     assert_eq!(sc["texels_per_scale_width"], 16, "{sc}");
     assert_eq!(sc["params"]["rows"], 20, "{sc}");
+    assert_eq!(sc["params"]["keel"], 0.1, "{sc}");
     assert!(sc["field_along_u"].as_f64().unwrap() > 0.9, "{sc}");
     // The snake: 1 m long, ~0.17 m around at its widest: ~100-200 scales along.
     let along = sc["scales_along"].as_u64().unwrap();
