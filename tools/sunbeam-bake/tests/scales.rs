@@ -31,6 +31,17 @@ fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()
 }
 
+/// `DIR/quad.obj`: a unit square in z = 0 with UVs 0..1 (u along x, v along y).
+fn unit_quad(dir: &Path) -> PathBuf {
+    let quad = dir.join("quad.obj");
+    std::fs::write(
+        &quad,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    quad
+}
+
 #[test]
 fn scaled_snake_validates_and_every_texel_is_unit() {
     let d = tmpdir("snake");
@@ -216,12 +227,7 @@ fn bad_input_is_refused_with_no_output() {
     assert!(err.contains("nouv.obj") && err.contains("UV"), "{err}");
     assert!(!out.exists());
     // A field across u: baked, with a warning.
-    let quad = d.join("quad.obj");
-    std::fs::write(
-        &quad,
-        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
-    )
-    .unwrap();
+    let quad = unit_quad(&d);
     let o = bake_env(
         &[&s(&quad), "--axis", "0,1,0", "--scales", "-o", &s(&out)],
         None,
@@ -242,15 +248,9 @@ fn bad_input_is_refused_with_no_output() {
 #[test]
 fn keel_height_is_read_back_from_the_normal_map() {
     let d = tmpdir("keel");
-    let obj = d.join("quad.obj");
-    std::fs::write(
-        &obj,
-        "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n",
-    )
-    .unwrap();
-    // Height profile across row 0 (image rows 0..64) at texel column `col`:
-    // the running sum of the decoded v-slope ny / nz over eta (one texel = 1/64 width).
-    let profile = |keel: &str, col: usize| -> Vec<f64> {
+    let obj = unit_quad(&d);
+    // The normal map (256 x 256 RGBA8) of the quad with a keel of `keel` widths.
+    let bake = |keel: &str| -> Vec<u8> {
         let glb = d.join(format!("quad-{keel}.glb"));
         let o = bake_env(
             &[
@@ -283,16 +283,22 @@ fn keel_height_is_read_back_from_the_normal_map() {
         let mut doc = Document::load(&glb).unwrap();
         let maps = scale_maps::read(&mut doc, 0).unwrap().expect("scale maps");
         assert_eq!(maps.normal.size, [256, 256]);
+        maps.normal.data
+    };
+    // The decoded v-slope ny / nz across row 0 (image rows 0..64, one texel =
+    // 1/64 width) at texel column `col`.
+    let slopes = |map: &[u8], col: usize| -> Vec<f64> {
         let dec = |b: u8| b as f64 / 255.0 * 2.0 - 1.0;
         (0..64)
             .map(|y| {
-                let px = &maps.normal.data[(y * 256 + col) * 4..][..4];
+                let px = &map[(y * 256 + col) * 4..][..4];
                 dec(px[1]) / dec(px[2])
             })
             .collect()
     };
+    let keeled = bake("0.05");
     // Column 32: x = 0.5 scale lengths into scale 0 (xi = 0.62, the keel at full height).
-    let slope = profile("0.05", 32);
+    let slope = slopes(&keeled, 32);
     let before: f64 = slope[..32].iter().sum::<f64>() / 64.0;
     let after: f64 = slope[32..].iter().sum::<f64>() / 64.0;
     // Each decoded slope is within 1/255 of the truth (8 bits; a flat texel
@@ -313,12 +319,12 @@ fn keel_height_is_read_back_from_the_normal_map() {
         .all(|x| x.abs() < 0.01));
     // Column 0: x = 0.008, xi = 0.24 from the tip, where the keel has faded in
     // to smoothstep(0.24 / 0.35) = 0.76 of its height; it is lower than at the middle.
-    let tip: f64 = profile("0.05", 0)[..32].iter().sum::<f64>() / 64.0;
+    let tip: f64 = slopes(&keeled, 0)[..32].iter().sum::<f64>() / 64.0;
     assert!(
         tip < 0.9 * before && tip > 0.2 * before,
         "{tip} vs {before}"
     );
     // No keel: flat everywhere.
-    assert!(profile("0", 32).iter().all(|x| x.abs() < 0.01));
+    assert!(slopes(&bake("0"), 32).iter().all(|x| x.abs() < 0.01));
     let _ = std::fs::remove_dir_all(&d);
 }
