@@ -253,15 +253,13 @@ fn msaa_position(j: u32) -> vec2<f32> {
 
 // The centre of the quarter of the pixel that holds MSAA sample j (pixels
 // from the centre): the part of the pixel the sample stands for. Points
-// spread over a sample's part of the pixel (env_sun_disc_carried) are spread
-// over its quarter: the four quarters tile the pixel, so the samples' points
-// are one stratification of it. Half-pixel squares about the sample
-// positions overlap and reach 1/8 pixel past the pixel's sides, a kernel
-// whose weight varies 2:1 across the pixel; where the sun's orders are sharp
-// within a pixel it does not average them as the pixel does: the whole
-// scaled snake with a 20 um pack, 8 x 8 supersampled under the sky, was
-// CIEDE2000 p99 6.56 from the reference (mean 1.23), 2.48 (0.63) with the
-// quarters (docs/bench/play.md "With a 20 um pack").
+// spread over a sample's part (env_sun_disc_carried) go over its quarter, so
+// the four samples' points tile the pixel once. Half-pixel squares about
+// the sample positions would overlap and reach 1/8 pixel past its sides, a
+// kernel whose weight varies 2:1 across the pixel, which shows where the
+// sun's orders are sharp within it: the whole scaled snake with a 20 um
+// pack, 8 x 8 under the sky, reads CIEDE2000 p99 2.48 with the quarters and
+// 6.56 with the squares (docs/bench/play.md "With a 20 um pack").
 fn msaa_quarter(j: u32) -> vec2<f32> {
     return 0.5 * vec2<f32>(f32(j & 1u) - 0.5, f32(j >> 1u) - 0.5);
 }
