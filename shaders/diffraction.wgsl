@@ -342,11 +342,28 @@ fn env_cells_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, dw: f32) -> vec3<f3
     return (1.0 - dw) * xyz_to_rgb(env_cells(v.frame[0], v.frame[1], v.frame[2], v.wr));
 }
 
+// The sun's disc points of one shading point on a mesh with scale maps
+// (env_sun_disc_carried: an MSAA sample's quarter of the pixel, or the
+// pixel): 64, not SB_SUN_POINTS' 16. Each point pairs a place in that part
+// of the pixel with a direction in the disc, and a domed scale's glint at
+// 20 um is smaller than a quarter and as narrow as the disc: on a 16 x 16
+// crop of the scaled snake under the sky (8 x 8, 4x MSAA) p99 4.23 with 16
+// points, 2.24 with 64, for a fifth more time (docs/LIGHTING.md "Scale
+// borders"). Point i's place is a rank-1 lattice, one point in each of the
+// part's 64 rows and columns (25 and 41 are prime to 64), for the same
+// reason as sb_sun_pixel_offset's.
+const SB_SUN_SAMPLE_POINTS: u32 = 64u;
+
+fn sb_sun_sample_offset(i: u32) -> vec2<f32> {
+    let n = SB_SUN_SAMPLE_POINTS;
+    return (vec2<f32>(f32((25u * i) % n), f32((41u * i) % n)) + 0.5) / f32(n) - 0.5;
+}
+
 // The first-frame estimator's sun (linear sRGB, dw applied) on a mesh with
 // scale maps, for a point at offset o (pixels) from the pixel centre that
 // stands for `share` of the pixel along each axis: as env_sun_disc, each of
-// the disc's SB_SUN_POINTS points read at its own place in that part of the
-// pixel (sb_sun_pixel_offset), but with the frame and the view the scale
+// the disc's SB_SUN_SAMPLE_POINTS points read at its own place in that part
+// of the pixel (sb_sun_sample_offset), but with the frame and the view the scale
 // maps give at that place (carried_view) instead of the footprint's linear
 // model. A scale is about a pixel long at the scaled snake's size, its dome
 // turns the sun's orders within it and its border turns them by the next
@@ -367,13 +384,13 @@ fn env_sun_disc_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, share: f32, dw: 
     let gr = env_grid();
     let r = SB_TAU * env_qmc(envg.frame + 1u, 19u);
     var xyz = vec3<f32>(0.0);
-    for (var i = 0u; i < u32(SB_SUN_POINTS); i = i + 1u) {
-        let v = carried_view(in, d, o + k * sb_sun_pixel_offset(i));
+    for (var i = 0u; i < SB_SUN_SAMPLE_POINTS; i = i + 1u) {
+        let v = carried_view(in, d, o + k * sb_sun_sample_offset(i));
         if (v.wr.z > 0.0) {
-            xyz = xyz + env_sun_point_fp(v.frame[0], v.frame[1], v.frame[2], v.wr, gr, (f32(i) + 0.5) / SB_SUN_POINTS, r + f32(i) * SB_GOLDEN, vec2<f32>(0.0), env_no_footprint());
+            xyz = xyz + env_sun_point_fp(v.frame[0], v.frame[1], v.frame[2], v.wr, gr, (f32(i) + 0.5) / f32(SB_SUN_SAMPLE_POINTS), r + f32(i) * SB_GOLDEN, vec2<f32>(0.0), env_no_footprint());
         }
     }
-    return (1.0 - dw) * xyz_to_rgb(xyz / SB_SUN_POINTS);
+    return (1.0 - dw) * xyz_to_rgb(xyz / f32(SB_SUN_SAMPLE_POINTS));
 }
 
 // The colour of a fragment (`covered`: its sample mask), whichever the
