@@ -342,23 +342,6 @@ fn env_cells_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, dw: f32) -> vec3<f3
     return (1.0 - dw) * xyz_to_rgb(env_cells(v.frame[0], v.frame[1], v.frame[2], v.wr));
 }
 
-// The sun's disc points of one shading point on a mesh with scale maps
-// (env_sun_disc_carried: an MSAA sample's quarter of the pixel, or the
-// pixel): 64, not SB_SUN_POINTS' 16. Each point pairs a place in that part
-// of the pixel with a direction in the disc, and a domed scale's glint at
-// 20 um is smaller than a quarter and as narrow as the disc: on a 16 x 16
-// crop of the scaled snake under the sky (8 x 8, 4x MSAA) p99 4.23 with 16
-// points, 2.24 with 64, for a fifth more time (docs/LIGHTING.md "Scale
-// borders"). Point i's place is a rank-1 lattice, one point in each of the
-// part's 64 rows and columns (25 and 41 are prime to 64), for the same
-// reason as sb_sun_pixel_offset's.
-const SB_SUN_SAMPLE_POINTS: u32 = 64u;
-
-fn sb_sun_sample_offset(i: u32) -> vec2<f32> {
-    let n = SB_SUN_SAMPLE_POINTS;
-    return (vec2<f32>(f32((25u * i) % n), f32((41u * i) % n)) + 0.5) / f32(n) - 0.5;
-}
-
 // The first-frame estimator's sun (linear sRGB, dw applied) on a mesh with
 // scale maps, for a point at offset o (pixels) from the pixel centre that
 // stands for `share` of the pixel along each axis: as env_sun_disc, each of

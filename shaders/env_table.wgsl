@@ -58,3 +58,21 @@ fn sb_sun_pixel_offset(i: u32) -> vec2<f32> {
     let y = f32((13u * i) % 16u) + 0.5;
     return vec2<f32>(x, y) / SB_SUN_POINTS - vec2<f32>(0.5);
 }
+
+// The sun's disc points of one shading point on a mesh with scale maps:
+// 64, not SB_SUN_POINTS' 16 (the player's env_sun_disc_carried, for an
+// MSAA sample's quarter of the pixel or the pixel; three.js for its
+// sub-pixel, through the export's sunbeam_shade_sun_sample_point). Each
+// point pairs a place in that part of the pixel with a direction in the
+// disc, and a domed scale's glint at 20 um is smaller than a quarter and
+// as narrow as the disc: on a 16 x 16 window of the scaled snake under the
+// sky (the player, 8 x 8, 4x MSAA) p99 4.23 with 16 points, 2.24 with 64
+// (docs/bench/play.md "With a 20 um pack"). Point i's place is a rank-1
+// lattice, one point in each of the part's 64 rows and columns (25 and 41
+// are prime to 64), for the same reason as sb_sun_pixel_offset's.
+const SB_SUN_SAMPLE_POINTS: u32 = 64u;
+
+fn sb_sun_sample_offset(i: u32) -> vec2<f32> {
+    let n = SB_SUN_SAMPLE_POINTS;
+    return (vec2<f32>(f32((25u * i) % n), f32((41u * i) % n)) + 0.5) / f32(n) - 0.5;
+}

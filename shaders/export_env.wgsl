@@ -240,11 +240,17 @@ fn sunbeam_sun_disc_frame(wi: vec3<f32>) -> mat3x3<f32> {
 
 // sunbeam_sun_point_dir in the disc's frame f (sunbeam_sun_disc_frame).
 fn sunbeam_sun_point_in(f: mat3x3<f32>, i: u32) -> vec3<f32> {
+    return env_sun_point_of(f, i, SB_SUN_POINTS);
+}
+
+// Point i of a Vogel spiral of `count` points over the disc, in the disc's
+// frame f.
+fn env_sun_point_of(f: mat3x3<f32>, i: u32, count: f32) -> vec3<f32> {
     let omega = sunbeam_env.sun_rgb.w;
     if (omega <= 0.0) {
         return f[2];
     }
-    return sb_sun_disc_dir(f[2], f[0], f[1], 1.0 - omega / SB_TAU, (f32(i) + 0.5) / SB_SUN_POINTS, f32(i) * SB_GOLDEN);
+    return sb_sun_disc_dir(f[2], f[0], f[1], 1.0 - omega / SB_TAU, (f32(i) + 0.5) / count, f32(i) * SB_GOLDEN);
 }
 
 // Where in the pixel disc point i is read: offset (pixels, in [-1/2, 1/2)
@@ -262,13 +268,37 @@ fn sunbeam_sun_pixel_offset(i: u32) -> vec2<f32> {
 // over i of this plus sunbeam_shade_sun_base is sunbeam_shade_sun at one
 // frame.
 fn sunbeam_shade_sun_point(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>, i: u32) -> vec3<f32> {
+    return env_sun_point_diffraction(t, b, n, sunbeam_sun_point_dir(wi, i), wr);
+}
+
+// Where in the host's part of the pixel (its sub-pixel) point i of
+// SB_SUN_SAMPLE_POINTS (64) is read: offset in [-1/2, 1/2) of that part
+// along x and y from its centre (sb_sun_sample_offset).
+fn sunbeam_sun_sample_offset(i: u32) -> vec2<f32> {
+    return sb_sun_sample_offset(i);
+}
+
+// As sunbeam_shade_sun_point for point i of SB_SUN_SAMPLE_POINTS (64) of
+// the disc, read at sunbeam_sun_sample_offset(i): what the player's first
+// frame reads on a mesh with scale maps, where a domed scale's glint at a
+// pack of real size is smaller than a sub-pixel and as narrow as the disc
+// (docs/ENGINES.md "Scale maps under an environment"). The mean over i of
+// this plus sunbeam_shade_sun_base is again sunbeam_shade_sun at one frame,
+// over 64 points of the disc.
+fn sunbeam_shade_sun_sample_point(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>, i: u32) -> vec3<f32> {
+    let d = env_sun_point_of(sunbeam_sun_disc_frame(wi), i, f32(SB_SUN_SAMPLE_POINTS));
+    return env_sun_point_diffraction(t, b, n, d, wr);
+}
+
+// The diffraction of the sun's disc point d (a world direction towards it),
+// (1 - dw) G G2 Omega E_sun in linear sRGB towards wr, in the frame (t, b, n).
+fn env_sun_point_diffraction(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, d: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
     if (sunbeam_env.sun_dir.w <= 0.0 || sunbeam_env.sun_grid.x <= 0.0 || wr_l.z <= 0.0) {
         return vec3<f32>(0.0);
     }
     let skin = SbSkin(sunbeam.skin.x, sunbeam.skin.y, sunbeam.skin.zw, sunbeam.energy);
     let gr = env_map_grid(sunbeam_env.sun_grid);
-    let d = sunbeam_sun_point_dir(wi, i);
     let xyz = env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr, vec3<f32>(0.0));
     return (1.0 - sunbeam.warp.z) * sb_xyz_to_linear_srgb(xyz);
 }

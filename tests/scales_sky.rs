@@ -14,7 +14,7 @@
 //!
 //! What it checks: the sun's disc points read with the frame the scale maps
 //! give at each point's own place in the pixel (the player's
-//! env_sun_disc_carried, three.js through `sunbeam_shade_sun_point`;
+//! env_sun_disc_carried, three.js through `sunbeam_shade_sun_sample_point`;
 //! docs/LIGHTING.md "Scale borders"). Before, with the footprint's linear
 //! model inside a scale and a point across a border, the same crop read
 //! p99 5.04 (player) and 12.5 (three.js), both at 4 x 4. Both are held to

@@ -185,7 +185,7 @@ export function adaptExportedGlsl(src) {
     out.push(l);
   }
   const text = out.join('\n');
-  for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun_footprint(', 'vec3 sunbeam_shade_sun_point(', 'vec3 sunbeam_shade_sun_base(', 'vec2 sunbeam_sun_pixel_offset(', 'const float SB_SUN_POINTS', 'vec3 sunbeam_shade_environment_footprint(', 'struct EnvFootprint', 'mat3x3 sb_frame(',
+  for (const need of ['vec3 sunbeam_shade(', 'vec3 sunbeam_shade_sun_footprint(', 'vec3 sunbeam_shade_sun_sample_point(', 'vec3 sunbeam_shade_sun_base(', 'vec2 sunbeam_sun_sample_offset(', 'const uint SB_SUN_SAMPLE_POINTS', 'vec3 sunbeam_shade_environment_footprint(', 'struct EnvFootprint', 'mat3x3 sb_frame(',
     'uniform SunbeamMaterial _group_0_binding_0_fs;', 'uniform SunbeamEnvironment _group_0_binding_8_fs;', '_group_0_binding_1_fs', '_group_0_binding_7_fs', '_group_0_binding_9_fs',
     'mat3x3 sunbeam_scale_frame(', 'float sunbeam_scale_id(', '_group_0_binding_10_fs', '_group_0_binding_11_fs']) {
     if (!text.includes(need)) throw new Error(`exported GLSL: ${need} not found (docs/ENGINES.md; export it with this sunbeam-play)`);
@@ -323,7 +323,7 @@ void main() {
   EnvFootprint fp = EnvFootprint(k * dFdx(t), k * dFdy(t), k * dFdx(b), k * dFdy(b), k * dFdx(n), k * dFdy(n), k * dFdx(wrl), k * dFdy(wrl));
   // The attributes' screen derivatives (here, in uniform control flow): on a
   // mesh with scale maps each point of the sun's disc is read with the frame
-  // and the view at its own place in the pixel (sunbeam_sun_pixel_offset),
+  // and the view at its own place in the pixel (sunbeam_sun_sample_offset, 64 points),
   // the attributes carried there along them, and the scale maps read there:
   // within a pixel the scales' domes turn the sun's orders and their borders
   // jump them, which no footprint's linear model carries (the player's
@@ -356,14 +356,14 @@ void main() {
       rgb += sunbeam_shade_environment_footprint(t, b, n, wr, fp);
       if (sbScales != 0u) {
         vec3 s = vec3(0.0);
-        for (uint i = 0u; i < uint(SB_SUN_POINTS); i++) {
-          vec2 o = sunbeam_sun_pixel_offset(i);
+        for (uint i = 0u; i < SB_SUN_SAMPLE_POINTS; i++) {
+          vec2 o = sunbeam_sun_sample_offset(i);
           mat3 fi = sunbeam_scale_frame(vNormal + o.x * dNx + o.y * dNy, vOrient + o.x * dOx + o.y * dOy,
             vTangent + o.x * dTx + o.y * dTy, vUv + o.x * dUx + o.y * dUy, sbScales);
           vec3 wri = normalize(sbEye - (vWorld + o.x * dWx + o.y * dWy));
-          s += sunbeam_shade_sun_point(fi[0], fi[1], fi[2], sun.xyz, wri, i);
+          s += sunbeam_shade_sun_sample_point(fi[0], fi[1], fi[2], sun.xyz, wri, i);
         }
-        rgb += sunbeam_shade_sun_base(t, b, n, sun.xyz) + s / SB_SUN_POINTS;
+        rgb += sunbeam_shade_sun_base(t, b, n, sun.xyz) + s / float(SB_SUN_SAMPLE_POINTS);
       } else {
         rgb += sunbeam_shade_sun_footprint(t, b, n, sun.xyz, wr, fp);
       }

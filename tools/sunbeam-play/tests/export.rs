@@ -61,6 +61,10 @@ fn glsl_passes_glslang() {
             "vec3 sunbeam_shade_sun_base(",
             "vec2 sunbeam_sun_pixel_offset(",
             "vec3 sunbeam_sun_point_dir(",
+            // and its 64 points per sub-pixel
+            "vec3 sunbeam_shade_sun_sample_point(",
+            "vec2 sunbeam_sun_sample_offset(",
+            "const uint SB_SUN_SAMPLE_POINTS = 64u;",
             "vec3 env_cells(",
             "usampler2D _group_0_binding_7_fs",
             "sampler2D _group_0_binding_3_fs",
