@@ -257,9 +257,10 @@ fn msaa_position(j: u32) -> vec2<f32> {
 // the four samples' points tile the pixel once. Half-pixel squares about
 // the sample positions would overlap and reach 1/8 pixel past its sides, a
 // kernel whose weight varies 2:1 across the pixel, which shows where the
-// sun's orders are sharp within it: the whole scaled snake with a 20 um
-// pack, 8 x 8 under the sky, reads CIEDE2000 p99 2.48 with the quarters and
-// 6.56 with the squares (docs/bench/play.md "With a 20 um pack").
+// sun's orders are sharp within it: on the whole scaled snake with a 20 um
+// pack, 8 x 8 under the sky, with 16 points a sample and the centre pass's
+// cells, the squares read CIEDE2000 p99 6.56 where the quarters read 2.48
+// (docs/bench/play.md "With a 20 um pack").
 fn msaa_quarter(j: u32) -> vec2<f32> {
     return 0.5 * vec2<f32>(f32(j & 1u) - 0.5, f32(j >> 1u) - 0.5);
 }
