@@ -117,12 +117,20 @@ fn the_scaled_snake_under_the_sky_in_the_player_and_three_js() {
     };
 
     let t = std::time::Instant::now();
-    let player = play(
-        &sky,
-        &d.join("player.exr"),
-        &["--env-estimator", "cells", "--supersample", "8"],
+    let out = run_ok(
+        Command::new(tool("sunbeam-play"))
+            .arg(&sky)
+            .args(["--headless", "-q", "--json"])
+            .args(["--env-estimator", "cells", "--supersample", "8", "-o"])
+            .arg(d.join("player.exr")),
     );
     let t_player = t.elapsed();
+    let player = LinearImage::read_exr(&d.join("player.exr")).unwrap();
+    // Every diffracting mesh has scale maps and the frame is multisampled:
+    // no fragment reads the cells' pre-passes, so there are none
+    // (docs/LIGHTING.md "One walk per pixel").
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["env_cells_rate"], 0, "{report}");
     let p = judge(&player);
     eprintln!(
         "scaled snake crop under the sky, player 8 x 8: all {}, interior {}, ring {} (reference {t_ref:.1?}, player {t_player:.1?})",

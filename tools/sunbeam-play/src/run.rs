@@ -330,6 +330,10 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
                 }
             }
             report["setup_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
+            if report.get("env_cells").is_some() {
+                // the pre-passes' grid (0: none, every fragment walks)
+                report["env_cells_rate"] = r.env_cells_rate().into();
+            }
             let k = cli.supersample.max(1);
             let mut target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;
             let state = sunbeam_render::FrameState::from_scene(&prepared);

@@ -743,17 +743,25 @@ fn grazing_pixels_walk_every_cell() {
 const LIMB_CELLS_P99: f64 = 1.46;
 
 /// One headless cells frame of `scene` at `--env-cells-rate rate` with
-/// `args`, written to and read back from `out`.
+/// `args`, written to and read back from `out`. The report names the rate
+/// the frame used: these scenes' meshes have no scale maps, so every
+/// fragment may read the pre-passes and the rate is the one asked for.
 fn cells_frame(scene: &Path, args: &[&str], rate: &str, out: &Path) -> LinearImage {
     let o = Command::new(BIN)
         .arg(scene)
-        .args(["--headless", "--frames", "1"])
+        .args(["--headless", "--frames", "1", "--json"])
         .args(args)
         .args(["--env-estimator", "cells", "--env-cells-rate", rate, "-o"])
         .arg(out)
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        report["env_cells_rate"].as_u64(),
+        rate.parse::<u64>().ok(),
+        "{report}"
+    );
     LinearImage::read_exr(out).unwrap()
 }
 

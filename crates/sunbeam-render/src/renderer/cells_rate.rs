@@ -18,7 +18,10 @@
 //! cells only where they do not (a silhouette's other surface). Without the
 //! centre pass a multisampled frame walked once per triangle touching a
 //! pixel: a dense mesh (the generated snake, several triangles per pixel)
-//! paid that about 6 times on lavapipe.
+//! paid that about 6 times on lavapipe. A mesh with scale maps under MSAA
+//! never reads it (its samples walk for themselves, shaders/environment.wgsl
+//! `env_cells_read`), so the renderer makes no pre-passes for a frame whose
+//! every diffracting mesh is one (renderer/mod.rs `reads_centre`).
 //!
 //! The walk over the cells is what a cells frame costs (docs/LIGHTING.md
 //! "Cost"); the sun, the hot spots and the diffuse part stay at every pixel.

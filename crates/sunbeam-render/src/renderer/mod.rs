@@ -403,12 +403,19 @@ impl Renderer {
         let smooth_term =
             settings.env_hot_spots > 0 || env_scene.env.as_ref().is_some_and(|e| e.sun().is_some());
         // Without a smooth term the centre pass alone (K = 1): one walk per
-        // pixel, none interpolated.
+        // pixel, none interpolated. A mesh with scale maps under MSAA never
+        // reads the pre-passes (its samples walk the cells at their mean,
+        // shaders/environment.wgsl `env_cells_read`), so a frame whose every
+        // diffracting mesh is one has none: they would walk once per pixel
+        // for nothing (docs/LIGHTING.md "One walk per pixel").
+        let reads_centre = |m: &sunbeam_frame::Material| {
+            m.pack.is_some() && !(m.scales.is_some() && settings.msaa >= 4)
+        };
         let cells_rate = (settings.mode == Mode::Default
             && env_scene.env.is_some()
             && settings.env_estimator == crate::env::EnvEstimator::Cells
             && settings.env_cells_rate > 0
-            && p.meshes.iter().any(|(_, m)| m.pack.is_some()))
+            && p.meshes.iter().any(|(_, m)| reads_centre(m)))
         .then_some(if smooth_term {
             settings.env_cells_rate
         } else {
@@ -766,7 +773,7 @@ impl Renderer {
             exposure_scale: state.exposure.exp2() as f32,
             n_lambda: self.n_lambda,
             msaa: self.msaa(),
-            cells_rate: self.cells.as_ref().map_or(0, |c| c.rate()),
+            cells_rate: self.env_cells_rate(),
         };
         if let Some(c) = &self.cells {
             c.prepare(
@@ -822,6 +829,13 @@ impl Renderer {
     }
 
     /// Multisample count of the pipeline (the colour and depth targets must match).
+    /// The cells' pre-passes' grid spacing K (docs/LIGHTING.md "Cells at a
+    /// lower rate"); 0 when the frame has none (no cells, or no fragment
+    /// would read them: every fragment walks the cells itself).
+    pub fn env_cells_rate(&self) -> u32 {
+        self.cells.as_ref().map_or(0, |c| c.rate())
+    }
+
     pub fn msaa(&self) -> u32 {
         self.settings.msaa.max(1)
     }
