@@ -100,9 +100,11 @@ pub(crate) struct Cli {
     /// of one pixel in K x K and interpolate them where the surface is smooth,
     /// once per pixel elsewhere (1..=16; 1: once per pixel; 0: once per
     /// fragment, every triangle touching a pixel, the slow path kept for
-    /// comparisons; docs/LIGHTING.md "Cells at a lower rate").
-    #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_CELLS_RATE, value_parser = clap::value_parser!(u32).range(0..=16))]
-    pub(crate) env_cells_rate: u32,
+    /// comparisons; default: 4 for a patch under 10 um, 2 from 10 um, the
+    /// finest of the scene's packs; docs/LIGHTING.md "Cells at a lower
+    /// rate").
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16))]
+    pub(crate) env_cells_rate: Option<u32>,
     /// Wavelength samples of the default mode.
     #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES)]
     pub(crate) lambda_samples: usize,

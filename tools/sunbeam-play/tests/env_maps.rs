@@ -187,7 +187,9 @@ fn the_pipelines_cells_are_read_clustered_when_missing_refused_when_damaged() {
 /// a patch of 10 um or more takes 768 cells, a smaller one 512, in the
 /// pipeline's cells file (`sunbeam-pack --response` with no
 /// `--response-cells`) and in the player alike, so the player reads the file
-/// and clusters nothing.
+/// and clusters nothing. So does the cells' grid ("Cells at a lower rate"):
+/// one pixel in 2 x 2 from 10 um, in 4 x 4 below, and with both packs in
+/// one scene the finer.
 #[test]
 fn the_default_cells_follow_the_patchs_size() {
     if !gpu_available() {
@@ -216,7 +218,7 @@ fn the_default_cells_follow_the_patchs_size() {
             .arg(&big)
             .args(["--response", "-q"]),
     );
-    for (p, want) in [(&small, 512), (&big, 768)] {
+    for (p, want, rate) in [(&small, 512, 4), (&big, 768, 2)] {
         let o = Command::new(BIN)
             .args(["--mesh", "builtin:sphere", "--pack"])
             .arg(p)
@@ -238,5 +240,26 @@ fn the_default_cells_follow_the_patchs_size() {
         assert!(!err.contains(CLUSTERED), "{p:?}: clustered at start: {err}");
         let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
         assert_eq!(r["env_cells"], want, "{p:?}: {r}");
+        assert_eq!(r["env_cells_rate"], rate, "{p:?}: {r}");
     }
+    let both = d.join("both.json");
+    std::fs::write(
+        &both,
+        format!(
+            r#"{{ "camera": {{ "eye": [0, 0, 3], "target": [0, 0, 0], "fov_y_deg": 40 }},
+  "meshes": [ {{ "mesh": "builtin:sphere", "pack": {small:?} }}, {{ "mesh": "builtin:sphere", "pack": {big:?} }} ],
+  "environment": {{ "sky": {{ "sun_elevation_deg": 35 }} }}, "size": [16, 16] }}"#
+        ),
+    )
+    .unwrap();
+    let o = Command::new(BIN)
+        .arg(&both)
+        .args(["--headless", "--env-estimator", "cells", "--json", "-o"])
+        .arg(d.join("both.exr"))
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["env_cells_rate"], 2, "{r}");
 }

@@ -36,7 +36,7 @@ pub mod uniforms;
 
 #[cfg(feature = "baselines")]
 pub use baselines::term_table;
-pub use cells_rate::DEFAULT_CELLS_RATE;
+pub use cells_rate::{default_cells_rate, DEFAULT_CELLS_RATE, DEFAULT_CELLS_RATE_LARGE};
 pub use targets::{
     colour_view, depth_view, depth_view_ms, lattice_jitter, subpixel_jitter, Offscreen,
     OFFSCREEN_FORMAT,
@@ -198,7 +198,8 @@ pub struct Settings {
     /// in K x K and interpolate where the surface is smooth, once per pixel
     /// elsewhere (1: once per pixel; 0: once per fragment, no pre-pass;
     /// docs/LIGHTING.md "Cells at a lower rate", "One walk per pixel").
-    pub env_cells_rate: u32,
+    /// None: the finest of the packs' defaults ([`default_cells_rate`]).
+    pub env_cells_rate: Option<u32>,
 }
 
 impl Settings {
@@ -234,7 +235,7 @@ impl Default for Settings {
             ),
             env_hot_spots: crate::env::DEFAULT_ENV_HOT_SPOTS,
             env_hot_threshold: crate::env::DEFAULT_ENV_HOT_THRESHOLD,
-            env_cells_rate: DEFAULT_CELLS_RATE,
+            env_cells_rate: None,
         }
     }
 }
@@ -408,19 +409,27 @@ impl Renderer {
         // shaders/environment.wgsl `env_cells_read`), so a frame whose every
         // diffracting mesh is one has none: they would walk once per pixel
         // for nothing (docs/LIGHTING.md "One walk per pixel").
+        // The rate asked for, else the finest of the packs' defaults.
+        let requested_rate = settings.env_cells_rate.unwrap_or_else(|| {
+            p.meshes
+                .iter()
+                .filter_map(|(_, m)| m.pack.as_ref())
+                .map(|pack| {
+                    let patch = &pack.manifest.patch;
+                    default_cells_rate(patch.lx_m.max(patch.ly_m))
+                })
+                .min()
+                .unwrap_or(DEFAULT_CELLS_RATE)
+        });
         let reads_centre = |m: &sunbeam_frame::Material| {
             m.pack.is_some() && !(m.scales.is_some() && settings.msaa >= 4)
         };
         let cells_rate = (settings.mode == Mode::Default
             && env_scene.env.is_some()
             && settings.env_estimator == crate::env::EnvEstimator::Cells
-            && settings.env_cells_rate > 0
+            && requested_rate > 0
             && p.meshes.iter().any(|(_, m)| reads_centre(m)))
-        .then_some(if smooth_term {
-            settings.env_cells_rate
-        } else {
-            1
-        });
+        .then_some(if smooth_term { requested_rate } else { 1 });
         // The pipelines compile on another thread while the meshes' maps are
         // read and uploaded below: neither needs the other, and each is about
         // a second of an environment scene's start-up on lavapipe
