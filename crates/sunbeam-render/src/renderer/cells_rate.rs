@@ -52,9 +52,8 @@ pub const DEFAULT_CELLS_RATE: u32 = 4;
 /// larger patch's orders are narrower, and so is the term's structure
 /// across the surface. On a sky-lit sphere's band of rows at `--supersample
 /// 8`, against every pixel (CIEDE2000 p99): 20 um 0.58 at K = 4, 0.16 at 2;
-/// 82 um 1.08 and 0.32; the whole 82 um sphere against a converged
-/// reference 2.05 at 4, 1.45 at 2 (docs/LIGHTING.md "Cells at a lower
-/// rate").
+/// 82 um 1.08 and 0.32; the whole 82 um sphere against two converged
+/// seeds 2.01 at 4, 1.46 at 2 (docs/LIGHTING.md "Cells at a lower rate").
 pub const DEFAULT_CELLS_RATE_LARGE: u32 = 2;
 
 /// The default grid spacing for a pack whose patch's longer side is
