@@ -189,7 +189,7 @@ fn the_pipelines_cells_are_read_clustered_when_missing_refused_when_damaged() {
 /// `--response-cells`) and in the player alike, so the player reads the file
 /// and clusters nothing. So does the cells' grid ("Cells at a lower rate"):
 /// one pixel in 2 x 2 from 10 um, in 4 x 4 below, and with both packs in
-/// one scene the finer.
+/// one scene the finer of those whose meshes read it.
 #[test]
 fn the_default_cells_follow_the_patchs_size() {
     if !gpu_available() {
@@ -242,24 +242,37 @@ fn the_default_cells_follow_the_patchs_size() {
         assert_eq!(r["env_cells"], want, "{p:?}: {r}");
         assert_eq!(r["env_cells_rate"], rate, "{p:?}: {r}");
     }
-    let both = d.join("both.json");
-    std::fs::write(
-        &both,
-        format!(
-            r#"{{ "camera": {{ "eye": [0, 0, 3], "target": [0, 0, 0], "fov_y_deg": 40 }},
-  "meshes": [ {{ "mesh": "builtin:sphere", "pack": {small:?} }}, {{ "mesh": "builtin:sphere", "pack": {big:?} }} ],
+    // Two meshes in one scene: the finer grid of the packs whose meshes read
+    // it. A mesh with scale maps under MSAA reads none ("One walk per
+    // pixel"), so the large pack on the scaled snake leaves the small one's 4.
+    common::ok(
+        Command::new(common::tool("sunbeam-bake"))
+            .args(["--generate-snake", "--scales", "-q", "-o"])
+            .arg(d.join("snake.glb")),
+    );
+    let rate_of = |name: &str, first: &str| {
+        let scene = d.join(format!("{name}.json"));
+        std::fs::write(
+            &scene,
+            format!(
+                r#"{{ "camera": {{ "eye": [0, 0, 3], "target": [0, 0, 0], "fov_y_deg": 40 }},
+  "meshes": [ {{ "mesh": "{first}", "pack": {big:?} }}, {{ "mesh": "builtin:sphere", "pack": {small:?} }} ],
   "environment": {{ "sky": {{ "sun_elevation_deg": 35 }} }}, "size": [16, 16] }}"#
-        ),
-    )
-    .unwrap();
-    let o = Command::new(BIN)
-        .arg(&both)
-        .args(["--headless", "--env-estimator", "cells", "--json", "-o"])
-        .arg(d.join("both.exr"))
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
+            ),
+        )
         .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
-    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(r["env_cells_rate"], 2, "{r}");
+        let o = Command::new(BIN)
+            .arg(&scene)
+            .args(["--headless", "--env-estimator", "cells", "--json", "-o"])
+            .arg(d.join(format!("{name}.exr")))
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        r["env_cells_rate"].clone()
+    };
+    assert_eq!(rate_of("both", "builtin:sphere"), 2);
+    let snake = d.join("snake.glb");
+    assert_eq!(rate_of("scaled", snake.to_str().unwrap()), 4);
 }

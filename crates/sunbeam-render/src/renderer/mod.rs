@@ -198,7 +198,8 @@ pub struct Settings {
     /// in K x K and interpolate where the surface is smooth, once per pixel
     /// elsewhere (1: once per pixel; 0: once per fragment, no pre-pass;
     /// docs/LIGHTING.md "Cells at a lower rate", "One walk per pixel").
-    /// None: the finest of the packs' defaults ([`default_cells_rate`]).
+    /// None: the finest of the defaults ([`default_cells_rate`]) of the
+    /// packs whose meshes read the pre-passes.
     pub env_cells_rate: Option<u32>,
 }
 
@@ -403,33 +404,36 @@ impl Renderer {
         // tests/threejs_render.rs' studio scene, 0.45 with its hot spots).
         let smooth_term =
             settings.env_hot_spots > 0 || env_scene.env.as_ref().is_some_and(|e| e.sun().is_some());
-        // Without a smooth term the centre pass alone (K = 1): one walk per
-        // pixel, none interpolated. A mesh with scale maps under MSAA never
-        // reads the pre-passes (its samples walk the cells at their mean,
-        // shaders/environment.wgsl `env_cells_read`), so a frame whose every
-        // diffracting mesh is one has none: they would walk once per pixel
-        // for nothing (docs/LIGHTING.md "One walk per pixel").
-        // The rate asked for, else the finest of the packs' defaults.
-        let requested_rate = settings.env_cells_rate.unwrap_or_else(|| {
-            p.meshes
-                .iter()
-                .filter_map(|(_, m)| m.pack.as_ref())
-                .map(|pack| {
-                    let patch = &pack.manifest.patch;
-                    default_cells_rate(patch.lx_m.max(patch.ly_m))
-                })
-                .min()
-                .unwrap_or(DEFAULT_CELLS_RATE)
-        });
+        // A mesh with scale maps under MSAA never reads the pre-passes (its
+        // samples walk the cells at their mean, shaders/environment.wgsl
+        // `env_cells_read`): a frame whose every diffracting mesh is one has
+        // none, which would walk once per pixel for nothing (docs/LIGHTING.md
+        // "One walk per pixel"). The default rate is the finest of the packs
+        // of the meshes that read them.
         let reads_centre = |m: &sunbeam_frame::Material| {
             m.pack.is_some() && !(m.scales.is_some() && settings.msaa >= 4)
         };
-        let cells_rate = (settings.mode == Mode::Default
-            && env_scene.env.is_some()
-            && settings.env_estimator == crate::env::EnvEstimator::Cells
-            && requested_rate > 0
-            && p.meshes.iter().any(|(_, m)| reads_centre(m)))
-        .then_some(if smooth_term { requested_rate } else { 1 });
+        let readers_rate = p
+            .meshes
+            .iter()
+            .filter(|(_, m)| reads_centre(m))
+            .filter_map(|(_, m)| m.pack.as_ref())
+            .map(|pack| {
+                let patch = &pack.manifest.patch;
+                default_cells_rate(patch.lx_m.max(patch.ly_m))
+            })
+            .min();
+        // Without a smooth term the centre pass alone (K = 1): one walk per
+        // pixel, none interpolated.
+        let cells_rate = readers_rate
+            .filter(|_| {
+                settings.mode == Mode::Default
+                    && env_scene.env.is_some()
+                    && settings.env_estimator == crate::env::EnvEstimator::Cells
+            })
+            .map(|rate| settings.env_cells_rate.unwrap_or(rate))
+            .filter(|&rate| rate > 0)
+            .map(|rate| if smooth_term { rate } else { 1 });
         // The pipelines compile on another thread while the meshes' maps are
         // read and uploaded below: neither needs the other, and each is about
         // a second of an environment scene's start-up on lavapipe
@@ -837,7 +841,6 @@ impl Renderer {
         }
     }
 
-    /// Multisample count of the pipeline (the colour and depth targets must match).
     /// The cells' pre-passes' grid spacing K (docs/LIGHTING.md "Cells at a
     /// lower rate"); 0 when the frame has none (no cells, or no fragment
     /// would read them: every fragment walks the cells itself).
@@ -845,6 +848,7 @@ impl Renderer {
         self.cells.as_ref().map_or(0, |c| c.rate())
     }
 
+    /// Multisample count of the pipeline (the colour and depth targets must match).
     pub fn msaa(&self) -> u32 {
         self.settings.msaa.max(1)
     }
