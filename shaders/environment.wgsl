@@ -636,7 +636,10 @@ fn env_cells_shared(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, cli
 // value stands for the frame at the pixel centre, its test compares normals
 // only, and a sample on the next scale has another ridge angle with a
 // normal within ENV_LOWRES_OWN (the scaled snake's crop at 20 um under the
-// sky, docs/LIGHTING.md "Scale borders").
+// sky, docs/LIGHTING.md "Scale borders"). The renderer makes no pre-passes
+// for a frame whose every diffracting mesh takes that exception
+// (crates/sunbeam-render/src/renderer/mod.rs `reads_centre`, the same
+// condition on the Rust side: change both together).
 fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
     if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS && !(mat.scales_on == 1u && g.msaa >= 4u)) {
         let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);

@@ -406,7 +406,8 @@ impl Renderer {
             settings.env_hot_spots > 0 || env_scene.env.as_ref().is_some_and(|e| e.sun().is_some());
         // A mesh with scale maps under MSAA never reads the pre-passes (its
         // samples walk the cells at their mean, shaders/environment.wgsl
-        // `env_cells_read`): a frame whose every diffracting mesh is one has
+        // `env_cells_read`, the same condition on the GPU side: change both
+        // together): a frame whose every diffracting mesh is one has
         // none, which would walk once per pixel for nothing (docs/LIGHTING.md
         // "One walk per pixel"). The default rate is the finest of the packs
         // of the meshes that read them.
