@@ -45,10 +45,11 @@ struct CellsOut {
 };
 
 // Whether the pre-passes shade the cells at a point seen from local view
-// wr_l: a mesh diffracting under the environment, the view above
-// ENV_GRAZING_COS (the frame's pass walks grazing views itself).
+// wr_l: a mesh diffracting under the environment whose fragments read them
+// (`mat.reads_cells`), the view above ENV_GRAZING_COS (the frame's pass
+// walks grazing views itself).
 fn cells_shaded_here(wr_l: vec3<f32>) -> bool {
-    return envg.on == 1u && envp.on == 1u && mat.has_pack == 1u && mat.base.w < 1.0 && wr_l.z > ENV_GRAZING_COS;
+    return envg.on == 1u && envp.on == 1u && mat.reads_cells == 1u && mat.base.w < 1.0 && wr_l.z > ENV_GRAZING_COS;
 }
 
 // The centre pass (g.cells_rate >= 1): single-sampled at the frame's size,

@@ -73,8 +73,13 @@ struct Material {
     // the scale maps' wraps (sb_scale_frame): bits 0-1 the normal map's
     // REPEAT along s and t, bits 2-3 the orientation map's
     scales_wrap: u32,
+    // 1: the frame's pass reads the cells' pre-passes at this mesh's
+    // fragments and the pre-passes shade it (shaders/environment.wgsl
+    // env_cells_read, shaders/default.wgsl cells_shaded_here); set by the
+    // renderer, the one place that decides it (crates/sunbeam-render/src/
+    // renderer/mod.rs `reads_centre`)
+    reads_cells: u32,
     _s1: f32,
-    _s2: f32,
     // the energy bound's table (SbSkin.energy)
     energy: mat4x4<f32>,
 };

@@ -630,18 +630,12 @@ fn env_cells_shared(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, cli
 // the fragment of the triangle under the pixel centre matches exactly), so
 // that a pixel walks the cells once whatever the triangles touching it:
 // (its XYZ, 1); else (another surface behind a silhouette, grazing views, no
-// centre pass) 0: the fragment walks them itself. Not on a mesh with scale
-// maps under MSAA, whose samples are there to resolve the frame's turns
-// within the pixel (shaders/diffraction.wgsl `shade`): the centre pass's
-// value stands for the frame at the pixel centre, its test compares normals
-// only, and a sample on the next scale has another ridge angle with a
-// normal within ENV_LOWRES_OWN (the scaled snake's crop at 20 um under the
-// sky, docs/LIGHTING.md "Scale borders"). The renderer makes no pre-passes
-// for a frame whose every diffracting mesh takes that exception
-// (crates/sunbeam-render/src/renderer/mod.rs `reads_centre`, the same
-// condition on the Rust side: change both together).
+// centre pass) 0: the fragment walks them itself. Only on meshes that read
+// the pre-passes (`mat.reads_cells`, decided by the renderer: not a mesh
+// with scale maps under MSAA, crates/sunbeam-render/src/renderer/mod.rs
+// `reads_centre`).
 fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
-    if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS && !(mat.scales_on == 1u && g.msaa >= 4u)) {
+    if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS && mat.reads_cells == 1u) {
         let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
         let p = clamp(vec2<i32>(floor(clip)), vec2<i32>(0), last);
         let x = textureLoad(cells_xyz, p, 0);

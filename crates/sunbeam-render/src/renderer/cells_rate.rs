@@ -19,9 +19,10 @@
 //! centre pass a multisampled frame walked once per triangle touching a
 //! pixel: a dense mesh (the generated snake, several triangles per pixel)
 //! paid that about 6 times on lavapipe. A mesh with scale maps under MSAA
-//! never reads it (its samples walk for themselves, shaders/environment.wgsl
-//! `env_cells_read`), so the renderer makes no pre-passes for a frame whose
-//! every diffracting mesh is one (renderer/mod.rs `reads_centre`).
+//! neither reads nor is shaded by the pre-passes (its samples walk for
+//! themselves; renderer/mod.rs `reads_centre` decides it once and passes it
+//! to the shaders as `MaterialU::reads_cells`), so the renderer makes no
+//! pre-passes for a frame none of whose meshes reads them.
 //!
 //! The walk over the cells is what a cells frame costs (docs/LIGHTING.md
 //! "Cost"); the sun, the hot spots and the diffuse part stay at every pixel.

@@ -404,15 +404,23 @@ impl Renderer {
         // tests/threejs_render.rs' studio scene, 0.45 with its hot spots).
         let smooth_term =
             settings.env_hot_spots > 0 || env_scene.env.as_ref().is_some_and(|e| e.sun().is_some());
-        // A mesh with scale maps under MSAA never reads the pre-passes (its
-        // samples walk the cells at their mean, shaders/environment.wgsl
-        // `env_cells_read`, the same condition on the GPU side: change both
-        // together): a frame whose every diffracting mesh is one has
-        // none, which would walk once per pixel for nothing (docs/LIGHTING.md
-        // "One walk per pixel"). The default rate is the finest of the packs
-        // of the meshes that read them.
+        // Which meshes read the cells' pre-passes: the one definition, which
+        // the shaders take from `MaterialU::reads_cells`
+        // (shaders/environment.wgsl `env_cells_read`, shaders/default.wgsl
+        // `cells_shaded_here`). Not a mesh with scale maps under MSAA: its
+        // samples resolve the frame's turns within the pixel and walk the
+        // cells once at their mean (shaders/diffraction.wgsl `shade`); the
+        // centre pass's value stands for the pixel centre, its test compares
+        // normals only, and a sample on the next scale has another ridge
+        // angle with a normal within ENV_LOWRES_OWN (docs/LIGHTING.md "Scale
+        // borders"). A frame none of whose meshes reads them makes no
+        // pre-passes, which would walk once per pixel for nothing
+        // (docs/LIGHTING.md "One walk per pixel"). The default rate is the
+        // finest of the packs of the meshes that read them.
         let reads_centre = |m: &sunbeam_frame::Material| {
-            m.pack.is_some() && !(m.scales.is_some() && settings.msaa >= 4)
+            m.pack.is_some()
+                && settings.mode != Mode::Lambert
+                && !(m.scales.is_some() && settings.msaa >= 4)
         };
         let readers_rate = p
             .meshes
@@ -494,6 +502,7 @@ impl Renderer {
                 norm: mat.skin.norm() as f32,
                 scales_on: u32::from(scales.is_some()),
                 scales_wrap: scales.map_or(0, scale_wraps),
+                reads_cells: u32::from(reads_centre(mat)),
                 ..Default::default()
             };
             let mut resp_map: Option<Arc<sunbeam_response::Response>> = None;

@@ -71,7 +71,11 @@ pub(super) struct MaterialU {
     /// The scale maps' wraps: bits 0-1 the normal map's REPEAT along s and
     /// t, bits 2-3 the orientation map's.
     pub(super) scales_wrap: u32,
-    pub(super) _s: [f32; 2],
+    /// 1 when the frame's pass reads the cells' pre-passes at this mesh's
+    /// fragments and the pre-passes shade it: `reads_centre` in
+    /// renderer/mod.rs, the one definition.
+    pub(super) reads_cells: u32,
+    pub(super) _s: f32,
     /// The energy bound's table (`sunbeam_optics::energy::EnergyBound::columns`).
     pub(super) energy: [[f32; 4]; 4],
 }
@@ -238,6 +242,7 @@ mod layout_tests {
                 resp_rho_scale,
                 resp_footprint,
                 scales_wrap,
+                reads_cells,
                 energy
             ),
         );
