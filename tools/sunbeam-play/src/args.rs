@@ -100,7 +100,7 @@ pub(crate) struct Cli {
     /// of one pixel in K x K and interpolate them where the surface is smooth,
     /// once per pixel elsewhere (1..=16; 1: once per pixel; 0: once per
     /// fragment, every triangle touching a pixel, the slow path kept for
-    /// comparisons; default: 4 for a patch under 10 um, 2 from 10 um, the
+    /// comparisons; default: 4 for a patch under 32 um, 2 from 32 um, the
     /// finest of the scene's packs; docs/LIGHTING.md "Cells at a lower
     /// rate").
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16))]

@@ -188,7 +188,8 @@ fn the_pipelines_cells_are_read_clustered_when_missing_refused_when_damaged() {
 /// pipeline's cells file (`sunbeam-pack --response` with no
 /// `--response-cells`) and in the player alike, so the player reads the file
 /// and clusters nothing. So does the cells' grid ("Cells at a lower rate"):
-/// one pixel in 2 x 2 from 10 um, in 4 x 4 below, and with both packs in
+/// one pixel in 2 x 2 from 32 um, in 4 x 4 below (the bound itself: the
+/// unit test in crates/sunbeam-render/src/renderer/cells_rate.rs), and with both packs in
 /// one scene the finer of those whose meshes read it.
 #[test]
 fn the_default_cells_follow_the_patchs_size() {
@@ -197,15 +198,18 @@ fn the_default_cells_follow_the_patchs_size() {
     }
     let d = scratch("play-env-cells-default");
     let small = pack(&d, "x", "xenopeltis");
-    // 256 px of 40 nm: 10.24 um (a quarter of the pack's time of 512 px
-    // of 20 nm; the count follows the patch's size, not its pixels)
+    // 256 px of 128 nm: 32.8 um, above both bounds (the cells' count from
+    // 10 um, the grid of 2 from 32 um); the count and the grid follow the
+    // patch's size, not its pixels, and 256 px pack in a fraction of the
+    // time of 2048 px of 16 nm (the pack warns of aliasing, which does not
+    // matter here)
     let h = d.join("big.exr");
     common::ok(Command::new(common::tool("sunbeam-import")).args([
         "synthetic:xenopeltis",
         "--synthetic-size",
         "256",
         "--synthetic-pixel",
-        "40nm",
+        "128nm",
         "-q",
         "-o",
         h.to_str().unwrap(),

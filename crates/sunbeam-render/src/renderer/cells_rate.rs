@@ -45,22 +45,28 @@ const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 const CENTRE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// Default grid spacing in pixels (`--env-cells-rate`) for a patch under
-/// [`sunbeam_response::cells::LARGE_PATCH_M`]: measured in docs/LIGHTING.md
-/// "Cells at a lower rate".
+/// [`FINE_GRID_PATCH_M`]: measured in docs/LIGHTING.md "Cells at a lower
+/// rate".
 pub const DEFAULT_CELLS_RATE: u32 = 4;
 
-/// Default grid spacing from [`sunbeam_response::cells::LARGE_PATCH_M`]: a
-/// larger patch's orders are narrower, and so is the term's structure
-/// across the surface. On a sky-lit sphere's band of rows at `--supersample
-/// 8`, against every pixel (CIEDE2000 p99): 20 um 0.58 at K = 4, 0.16 at 2;
-/// 82 um 1.08 and 0.32; the whole 82 um sphere against two converged
-/// seeds 2.01 at 4, 1.46 at 2 (docs/LIGHTING.md "Cells at a lower rate").
+/// Default grid spacing from [`FINE_GRID_PATCH_M`]: a larger patch's orders
+/// are narrower, and so is the term's structure across the surface.
 pub const DEFAULT_CELLS_RATE_LARGE: u32 = 2;
+
+/// The patch size (longer side, metres) from which the grid is
+/// [`DEFAULT_CELLS_RATE_LARGE`]. On a sky-lit sphere's band of rows at
+/// `--supersample 8`, against two converged seeds (CIEDE2000 p99, grid of 4
+/// / 2 / every pixel): 20 um 1.04 / 1.01 / 1.01, 31 um 1.06 / 0.91 / 0.99,
+/// 41 um 1.24 / 0.83 / 0.86, 82 um 1.60 / 1.13 / 1.13. So the grid of 4 is
+/// within the references' own noise of every pixel up to 31 um and costs
+/// from 41 um; the bound sits just above the largest size measured safe
+/// (docs/LIGHTING.md "Cells at a lower rate").
+pub const FINE_GRID_PATCH_M: f64 = 32e-6;
 
 /// The default grid spacing for a pack whose patch's longer side is
 /// `patch_m` metres.
 pub fn default_cells_rate(patch_m: f64) -> u32 {
-    if patch_m >= sunbeam_response::cells::LARGE_PATCH_M {
+    if patch_m >= FINE_GRID_PATCH_M {
         DEFAULT_CELLS_RATE_LARGE
     } else {
         DEFAULT_CELLS_RATE
@@ -381,5 +387,19 @@ impl CellsRate {
             draw(&mut rp);
         }
         main(enc, &g.bind);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::default_cells_rate;
+
+    /// The sizes measured against converged references ([`super::FINE_GRID_PATCH_M`])
+    /// take the grid that was measured as good as every pixel there.
+    #[test]
+    fn the_measured_sizes_take_the_grid_measured_for_them() {
+        for (patch_um, rate) in [(5.12, 4), (20.48, 4), (30.72, 4), (40.96, 2), (81.92, 2)] {
+            assert_eq!(default_cells_rate(patch_um * 1e-6), rate, "{patch_um} um");
+        }
     }
 }
