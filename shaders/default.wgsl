@@ -84,11 +84,42 @@ fn fs_cells(in: VsOut) -> CellsOut {
     let wr = normalize(g.eye.xyz - in.world);
     let wr_l = vec3<f32>(dot(wr, fr[0]), dot(wr, fr[1]), dot(wr, fr[2]));
     var o: CellsOut;
-    o.xyz = vec4<f32>(0.0);
+    // the walk follows in fs_cells_walk: here the view (world) and whether
+    // the cells are shaded here
+    o.xyz = vec4<f32>(wr, 0.0);
     if (cells_shaded_here(wr_l)) {
-        o.xyz = vec4<f32>(env_cells(fr[0], fr[1], fr[2], wr_l), 1.0);
+        o.xyz.w = 1.0;
     }
     o.nd = vec4<f32>(fr[2], length(g.eye.xyz - in.world));
-    o.t = vec4<f32>(fr[0], 0.0);
+    o.t = vec4<f32>(fr[0], f32(mat.cells_id));
     return o;
+}
+
+// A full-screen triangle (the cells' grid walk).
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let p = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(p * 2.0 - 1.0, 0.0, 1.0);
+}
+
+// The grid's walk, one full-screen pass after fs_cells: at each grid point
+// the raster pass marked, the cells' XYZ from the frame and view it wrote
+// (bindings 2-4: its targets), so that every SIMD block of the walk is full
+// whatever the triangles' size on the grid.
+@fragment
+fn fs_cells_walk(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
+    let p = vec2<i32>(floor(clip.xy));
+    let a = textureLoad(cells_xyz, p, 0);
+    let tc = textureLoad(cells_t, p, 0);
+    // this mesh's grid points where the raster pass shades the cells (the
+    // other meshes' passes walk theirs: each with its own material and pack)
+    if (a.w < 0.5 || tc.w != f32(mat.cells_id)) {
+        discard;
+    }
+    let n = textureLoad(cells_nd, p, 0).xyz;
+    let t = tc.xyz;
+    let b = cross(n, t);
+    let wr = a.xyz;
+    let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
+    return vec4<f32>(env_cells(t, b, n, wr_l), 1.0);
 }

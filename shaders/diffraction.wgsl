@@ -79,7 +79,9 @@ struct Material {
     // renderer, the one place that decides it (crates/sunbeam-render/src/
     // renderer/mod.rs `reads_centre`)
     reads_cells: u32,
-    _s1: f32,
+    // the mesh's index + 1, which the cells' grid walk compares with the
+    // grid point's (shaders/default.wgsl fs_cells_walk)
+    cells_id: u32,
     // the energy bound's table (SbSkin.energy)
     energy: mat4x4<f32>,
 };

@@ -5,8 +5,15 @@
 //!
 //! 1. At a rate K > 1, the coarse grid: every K-th pixel corner (the same
 //!    camera, a viewport K times smaller) with shaders/default.wgsl's
-//!    `fs_cells`, which writes the cells' XYZ, the frame's normal with the
-//!    distance to the eye, and its tangent into three float targets.
+//!    `fs_cells`, which writes the view and whether the cells are shaded
+//!    there, the frame's normal with the distance to the eye, and its
+//!    tangent with the mesh (`MaterialU::cells_id`) into three float
+//!    targets; then one full-screen pass per mesh (`fs_cells_walk`) walks
+//!    the cells at that mesh's points into the grid's XYZ. A walk in the
+//!    raster pass ran in SIMD blocks that triangles smaller than a few grid
+//!    pixels leave mostly empty: on lavapipe it cost twice as much at a
+//!    grid of 4 on a 512 x 512 sphere (docs/LIGHTING.md "What a grid's walk
+//!    costs").
 //! 2. The centre pass, single-sampled at the frame's size (`fs_cells_centre`):
 //!    each pixel centre takes the bilinear mix of its K x K block's corners
 //!    where they saw one smooth patch of surface and walks the cells itself
@@ -27,7 +34,7 @@
 //! The walk over the cells is what a cells frame costs (docs/LIGHTING.md
 //! "Cost"); the sun, the hot spots and the diffuse part stay at every pixel.
 
-use super::pipeline::{render_pipeline, Technique};
+use super::pipeline::{fullscreen_pipeline, render_pipeline, Technique};
 use super::SHADER;
 use crate::gpu::Gpu;
 use std::sync::Mutex;
@@ -76,6 +83,10 @@ pub fn default_cells_rate(patch_m: f64) -> u32 {
 /// The coarse grid's targets (rate K > 1).
 struct Coarse {
     xyz: wgpu::TextureView,
+    /// The walk's XYZ (fs_cells_walk), what the centre pass reads.
+    walked: wgpu::TextureView,
+    /// Bind group 0 of the walk: the raster pass's targets.
+    walk_bind: wgpu::BindGroup,
     nd: wgpu::TextureView,
     t: wgpu::TextureView,
     depth: wgpu::TextureView,
@@ -101,6 +112,7 @@ struct Grid {
 pub(super) struct CellsRate {
     rate: u32,
     coarse: Option<wgpu::RenderPipeline>,
+    walk: Option<wgpu::RenderPipeline>,
     centre: wgpu::RenderPipeline,
     pre_bind: wgpu::BindGroup,
     stand_in: wgpu::TextureView,
@@ -214,8 +226,24 @@ impl CellsRate {
             Some(render_pipeline(
                 device,
                 layouts,
-                &[XYZ_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
+                &[FRAME_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
                 1,
+                &technique,
+            )?)
+        } else {
+            None
+        };
+        let walk = if rate > 1 {
+            let technique = Technique {
+                label: "diffraction.wgsl cells grid walk",
+                source: SHADER,
+                entry: "fs_cells_walk",
+                constants: Vec::new(),
+            };
+            Some(fullscreen_pipeline(
+                device,
+                layouts,
+                &[XYZ_FORMAT],
                 &technique,
             )?)
         } else {
@@ -244,6 +272,7 @@ impl CellsRate {
         Ok(CellsRate {
             rate,
             coarse,
+            walk,
             centre,
             pre_bind,
             stand_in: stand_in.clone(),
@@ -274,10 +303,16 @@ impl CellsRate {
         // past the last pixel.
         let coarse = (self.rate > 1).then(|| {
             let (gw, gh) = (w.div_ceil(self.rate) + 1, h.div_ceil(self.rate) + 1);
+            let xyz = target(gpu, gw, gh, FRAME_FORMAT);
+            let nd = target(gpu, gw, gh, FRAME_FORMAT);
+            let t = target(gpu, gw, gh, FRAME_FORMAT);
+            let walk_bind = global_bind(&gpu.device, layout, globals, spectrum, [&xyz, &nd, &t]);
             Coarse {
-                xyz: target(gpu, gw, gh, XYZ_FORMAT),
-                nd: target(gpu, gw, gh, FRAME_FORMAT),
-                t: target(gpu, gw, gh, FRAME_FORMAT),
+                xyz,
+                walked: target(gpu, gw, gh, XYZ_FORMAT),
+                walk_bind,
+                nd,
+                t,
                 depth: super::depth_view(gpu, gw, gh),
             }
         });
@@ -291,7 +326,7 @@ impl CellsRate {
                 layout,
                 globals,
                 spectrum,
-                [&c.xyz, &c.nd, &c.t],
+                [&c.walked, &c.nd, &c.t],
             ),
             None => global_bind(&gpu.device, layout, globals, spectrum, [si, si, si]),
         };
@@ -321,6 +356,7 @@ impl CellsRate {
         enc: &mut wgpu::CommandEncoder,
         fallback: &wgpu::BindGroup,
         draw: impl Fn(&mut wgpu::RenderPass<'_>),
+        draw_full: impl Fn(&mut wgpu::RenderPass<'_>),
         main: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::BindGroup),
     ) {
         let grid = self.grid.lock().unwrap_or_else(|e| e.into_inner());
@@ -372,6 +408,20 @@ impl CellsRate {
             rp.set_pipeline(pipeline);
             rp.set_bind_group(0, &self.pre_bind, &[]);
             draw(&mut rp);
+            drop(rp);
+            if let Some(walk) = &self.walk {
+                let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("cells grid walk"),
+                    color_attachments: &[clear(&c.walked)],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                rp.set_pipeline(walk);
+                rp.set_bind_group(0, &c.walk_bind, &[]);
+                draw_full(&mut rp);
+            }
         }
         {
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {

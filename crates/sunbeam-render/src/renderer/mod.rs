@@ -311,6 +311,17 @@ struct GpuMesh {
     technique_bind: Option<wgpu::BindGroup>,
 }
 
+impl GpuMesh {
+    /// Set this mesh's bind groups 1-3 on `rp`.
+    fn bind_groups(&self, rp: &mut wgpu::RenderPass<'_>) {
+        rp.set_bind_group(1, &self.bind, &[]);
+        rp.set_bind_group(2, &self.env_bind, &[]);
+        if let Some(b) = &self.technique_bind {
+            rp.set_bind_group(3, b, &[]);
+        }
+    }
+}
+
 impl Renderer {
     pub fn new(
         gpu: &Gpu,
@@ -503,6 +514,7 @@ impl Renderer {
                 scales_on: u32::from(scales.is_some()),
                 scales_wrap: scales.map_or(0, scale_wraps),
                 reads_cells: u32::from(reads_centre(mat)),
+                cells_id: mi as u32 + 1,
                 ..Default::default()
             };
             let mut resp_map: Option<Arc<sunbeam_response::Response>> = None;
@@ -884,23 +896,25 @@ impl Renderer {
                 enc,
                 &self.global_bind,
                 |rp| self.draw_meshes(rp),
+                |rp| self.draw_fullscreen(rp),
                 |enc, g0| self.encode_frame(enc, g0, colour, resolve, depth, state),
             ),
             None => self.encode_frame(enc, &self.global_bind, colour, resolve, depth, state),
         }
     }
 
+    /// Groups 1-3 of each mesh and a full-screen triangle.
+    fn draw_fullscreen(&self, rp: &mut wgpu::RenderPass<'_>) {
+        for m in self.meshes.iter().filter(|m| m.count > 0) {
+            m.bind_groups(rp);
+            rp.draw(0..3, 0..1);
+        }
+    }
+
     /// Groups 1-3 and the draw of each mesh.
     fn draw_meshes(&self, rp: &mut wgpu::RenderPass<'_>) {
-        for m in &self.meshes {
-            if m.count == 0 {
-                continue;
-            }
-            rp.set_bind_group(1, &m.bind, &[]);
-            rp.set_bind_group(2, &m.env_bind, &[]);
-            if let Some(b) = &m.technique_bind {
-                rp.set_bind_group(3, b, &[]);
-            }
+        for m in self.meshes.iter().filter(|m| m.count > 0) {
+            m.bind_groups(rp);
             rp.set_vertex_buffer(0, m.vbuf.slice(..));
             rp.set_index_buffer(m.ibuf.slice(..), wgpu::IndexFormat::Uint32);
             rp.draw_indexed(0..m.count, 0, 0..1);

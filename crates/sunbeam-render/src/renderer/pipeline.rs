@@ -150,13 +150,35 @@ pub(super) struct Technique {
 
 /// The pipeline of `technique` for colour formats (one per target of its
 /// entry point) and a sample count, with bind groups `layouts` (0, 1, 2
-/// shared; more for the technique's own).
+/// shared; more for the technique's own), drawing the meshes.
 pub(super) fn render_pipeline(
     device: &wgpu::Device,
     layouts: &[&wgpu::BindGroupLayout],
     formats: &[wgpu::TextureFormat],
     msaa: u32,
     technique: &Technique,
+) -> Result<wgpu::RenderPipeline> {
+    pipeline_for(device, layouts, formats, msaa, technique, false)
+}
+
+/// [`render_pipeline`] drawing one full-screen triangle (`vs_fullscreen`,
+/// no vertex buffer, no depth), single-sampled: the cells' grid walk.
+pub(super) fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    layouts: &[&wgpu::BindGroupLayout],
+    formats: &[wgpu::TextureFormat],
+    technique: &Technique,
+) -> Result<wgpu::RenderPipeline> {
+    pipeline_for(device, layouts, formats, 1, technique, true)
+}
+
+fn pipeline_for(
+    device: &wgpu::Device,
+    layouts: &[&wgpu::BindGroupLayout],
+    formats: &[wgpu::TextureFormat],
+    msaa: u32,
+    technique: &Technique,
+    full_screen: bool,
 ) -> Result<wgpu::RenderPipeline> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -180,27 +202,38 @@ pub(super) fn render_pipeline(
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x2, 4 => Float32x4],
     };
+    let meshes = [Some(vlayout)];
+    let (vs, buffers, primitive, depth_stencil) = if full_screen {
+        ("vs_fullscreen", &[][..], Default::default(), None)
+    } else {
+        (
+            "vs_main",
+            &meshes[..],
+            wgpu::PrimitiveState {
+                cull_mode: Some(wgpu::Face::Back),
+                front_face: wgpu::FrontFace::Ccw,
+                ..Default::default()
+            },
+            Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+        )
+    };
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(technique.label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
             module: &module,
-            entry_point: Some("vs_main"),
+            entry_point: Some(vs),
             compilation_options: options(),
-            buffers: &[Some(vlayout)],
+            buffers,
         },
-        primitive: wgpu::PrimitiveState {
-            cull_mode: Some(wgpu::Face::Back),
-            front_face: wgpu::FrontFace::Ccw,
-            ..Default::default()
-        },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
+        primitive,
+        depth_stencil,
         multisample: wgpu::MultisampleState {
             count: msaa.max(1),
             ..Default::default()

@@ -75,7 +75,10 @@ pub(super) struct MaterialU {
     /// fragments and the pre-passes shade it: `reads_centre` in
     /// renderer/mod.rs, the one definition.
     pub(super) reads_cells: u32,
-    pub(super) _s: f32,
+    /// The mesh's index + 1: the cells' grid walk (shaders/default.wgsl
+    /// `fs_cells_walk`, one full-screen pass per mesh) walks the grid points
+    /// the raster pass marked with it.
+    pub(super) cells_id: u32,
     /// The energy bound's table (`sunbeam_optics::energy::EnergyBound::columns`).
     pub(super) energy: [[f32; 4]; 4],
 }
@@ -243,6 +246,7 @@ mod layout_tests {
                 resp_footprint,
                 scales_wrap,
                 reads_cells,
+                cells_id,
                 energy
             ),
         );
