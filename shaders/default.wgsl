@@ -33,11 +33,13 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
     return shade(in, covered);
 }
 
-// The cells' coarse pre-pass (g.cells_rate > 1; shaders/environment.wgsl
-// env_cells_shared, in the centre pass): on the coarse grid, the cells' XYZ at the pixel centre
-// (w: 1 where this mesh diffracts under the environment and the view is above
-// ENV_GRAZING_COS, else 0: the full-rate pass walks those itself), the
-// frame's normal and the distance to the eye, and its tangent.
+// The cells' coarse pre-pass (g.cells_rate > 1), its raster part: at each
+// grid point the view (world; w: 1 where this mesh diffracts under the
+// environment and the view is above ENV_GRAZING_COS, else 0: the full-rate
+// pass walks those itself), the frame's normal and the distance to the eye,
+// and its tangent with the mesh (mat.cells_id). fs_cells_walk then walks
+// the cells at the marked points; the centre pass mixes their XYZ
+// (shaders/environment.wgsl env_cells_shared).
 struct CellsOut {
     @location(0) xyz: vec4<f32>,
     @location(1) nd: vec4<f32>,

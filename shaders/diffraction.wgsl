@@ -88,9 +88,11 @@ struct Material {
 
 @group(0) @binding(0) var<uniform> g: Globals;
 // The cells' pre-passes (crates/sunbeam-render/src/renderer/cells_rate.rs):
-// in the centre pass (fs_cells_centre, read by env_cells_shared) the coarse
-// grid at 1/K of the pixels (fs_cells): the cells' XYZ (w: 1 where shaded),
-// the frame's normal with the distance to the eye, its tangent; in the
+// in the grid's walk (fs_cells_walk) the grid's raster targets (fs_cells:
+// the view with the mark, the frame's normal with the distance to the eye,
+// its tangent with the mesh); in the centre pass (fs_cells_centre, read by
+// env_cells_shared) the coarse grid at 1/K of the pixels: the walk's XYZ (w:
+// 1 where shaded), the normal with the distance, the tangent; in the
 // frame's pass (read by env_cells_pixel) the centre pass's XYZ and normal
 // with the distance, per pixel (binding 4 unused). 1 x 1 stand-ins where
 // none ran.

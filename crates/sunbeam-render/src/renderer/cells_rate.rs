@@ -82,6 +82,7 @@ pub fn default_cells_rate(patch_m: f64) -> u32 {
 
 /// The coarse grid's targets (rate K > 1).
 struct Coarse {
+    /// The raster pass's view with the mark (fs_cells).
     xyz: wgpu::TextureView,
     /// The walk's XYZ (fs_cells_walk), what the centre pass reads.
     walked: wgpu::TextureView,
