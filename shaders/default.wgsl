@@ -114,14 +114,21 @@ fn fs_cells_walk(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
     let a = textureLoad(cells_xyz, p, 0);
     let tc = textureLoad(cells_t, p, 0);
     // this mesh's grid points where the raster pass shades the cells (the
-    // other meshes' passes walk theirs: each with its own material and pack)
-    if (a.w < 0.5 || tc.w != f32(mat.cells_id)) {
+    // other meshes' passes walk theirs: each with its own material and
+    // pack). The walk is inside the branch, not after a discard: WGSL's
+    // discard demotes the invocation to a helper, which goes on running the
+    // walk's loop beside the live lanes, so every point of the grid (the
+    // background, the other meshes') would walk.
+    var o = vec4<f32>(0.0);
+    if (a.w > 0.5 && tc.w == f32(mat.cells_id)) {
+        let n = textureLoad(cells_nd, p, 0).xyz;
+        let t = tc.xyz;
+        let b = cross(n, t);
+        let wr = a.xyz;
+        let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
+        o = vec4<f32>(env_cells(t, b, n, wr_l), 1.0);
+    } else {
         discard;
     }
-    let n = textureLoad(cells_nd, p, 0).xyz;
-    let t = tc.xyz;
-    let b = cross(n, t);
-    let wr = a.xyz;
-    let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
-    return vec4<f32>(env_cells(t, b, n, wr_l), 1.0);
+    return o;
 }
