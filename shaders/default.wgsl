@@ -121,12 +121,12 @@ fn fs_cells_walk(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
     // background, the other meshes') would walk.
     var o = vec4<f32>(0.0);
     if (a.w > 0.5 && tc.w == f32(mat.cells_id)) {
-        let n = textureLoad(cells_nd, p, 0).xyz;
-        let t = tc.xyz;
-        let b = cross(n, t);
+        // the frame the raster pass had (shaders/material.wgsl sb_frame, as
+        // frame_at builds it: b = n x t)
+        let fr = sb_frame(textureLoad(cells_nd, p, 0).xyz, tc.xyz);
         let wr = a.xyz;
-        let wr_l = vec3<f32>(dot(wr, t), dot(wr, b), dot(wr, n));
-        o = vec4<f32>(env_cells(t, b, n, wr_l), 1.0);
+        let wr_l = vec3<f32>(dot(wr, fr[0]), dot(wr, fr[1]), dot(wr, fr[2]));
+        o = vec4<f32>(env_cells(fr[0], fr[1], fr[2], wr_l), 1.0);
     } else {
         discard;
     }

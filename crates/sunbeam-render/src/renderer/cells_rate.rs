@@ -112,8 +112,8 @@ struct Grid {
 /// last frame size.
 pub(super) struct CellsRate {
     rate: u32,
-    coarse: Option<wgpu::RenderPipeline>,
-    walk: Option<wgpu::RenderPipeline>,
+    /// The grid's raster pass and its full-screen walk (rate K > 1).
+    coarse: Option<(wgpu::RenderPipeline, wgpu::RenderPipeline)>,
     centre: wgpu::RenderPipeline,
     pre_bind: wgpu::BindGroup,
     stand_in: wgpu::TextureView,
@@ -217,36 +217,28 @@ impl CellsRate {
         stand_in: &wgpu::TextureView,
     ) -> Result<CellsRate> {
         check_targets(adapter)?;
+        // The grid's raster pass and its walk: both or neither.
         let coarse = if rate > 1 {
-            let technique = Technique {
-                label: "diffraction.wgsl cells pre-pass",
+            let pass = |label, entry| Technique {
+                label,
                 source: SHADER,
-                entry: "fs_cells",
+                entry,
                 constants: Vec::new(),
             };
-            Some(render_pipeline(
+            let raster = render_pipeline(
                 device,
                 layouts,
                 &[FRAME_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
                 1,
-                &technique,
-            )?)
-        } else {
-            None
-        };
-        let walk = if rate > 1 {
-            let technique = Technique {
-                label: "diffraction.wgsl cells grid walk",
-                source: SHADER,
-                entry: "fs_cells_walk",
-                constants: Vec::new(),
-            };
-            Some(fullscreen_pipeline(
+                &pass("diffraction.wgsl cells pre-pass", "fs_cells"),
+            )?;
+            let walk = fullscreen_pipeline(
                 device,
                 layouts,
                 &[XYZ_FORMAT],
-                &technique,
-            )?)
+                &pass("diffraction.wgsl cells grid walk", "fs_cells_walk"),
+            )?;
+            Some((raster, walk))
         } else {
             None
         };
@@ -273,7 +265,6 @@ impl CellsRate {
         Ok(CellsRate {
             rate,
             coarse,
-            walk,
             centre,
             pre_bind,
             stand_in: stand_in.clone(),
@@ -386,7 +377,7 @@ impl CellsRate {
                 stencil_ops: None,
             })
         };
-        if let (Some(c), Some(pipeline)) = (&g.coarse, &self.coarse) {
+        if let (Some(c), Some((pipeline, walk))) = (&g.coarse, &self.coarse) {
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("cells pre-pass"),
                 color_attachments: &[clear(&c.xyz), clear(&c.nd), clear(&c.t)],
@@ -410,19 +401,17 @@ impl CellsRate {
             rp.set_bind_group(0, &self.pre_bind, &[]);
             draw(&mut rp);
             drop(rp);
-            if let Some(walk) = &self.walk {
-                let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("cells grid walk"),
-                    color_attachments: &[clear(&c.walked)],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                rp.set_pipeline(walk);
-                rp.set_bind_group(0, &c.walk_bind, &[]);
-                draw_full(&mut rp);
-            }
+            let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("cells grid walk"),
+                color_attachments: &[clear(&c.walked)],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            rp.set_pipeline(walk);
+            rp.set_bind_group(0, &c.walk_bind, &[]);
+            draw_full(&mut rp);
         }
         {
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
