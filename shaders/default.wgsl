@@ -39,7 +39,7 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
 // pass walks those itself), the frame's normal and the distance to the eye,
 // and its tangent with the mesh (mat.cells_id). fs_cells_walk then walks
 // the cells at the marked points; the centre pass mixes their XYZ
-// (shaders/environment.wgsl env_cells_shared).
+// (shaders/environment.wgsl env_cells_mixed).
 struct CellsOut {
     @location(0) xyz: vec4<f32>,
     @location(1) nd: vec4<f32>,
@@ -55,14 +55,19 @@ fn cells_shaded_here(wr_l: vec3<f32>) -> bool {
 }
 
 // The centre pass (g.cells_rate >= 1): single-sampled at the frame's size,
-// the cells' XYZ at each pixel centre, from the coarse grid where it serves
-// (shaders/environment.wgsl env_cells_shared), else one walk (w: 1 where
-// shaded, as fs_cells), and the frame's normal with the distance to the eye.
-// The frame's pass reads them (env_cells_pixel) instead of walking once per
+// the cells' XYZ at each pixel centre from the coarse grid where it serves
+// (shaders/environment.wgsl env_cells_mixed; w: 1), else 0 with the pixel
+// marked for the centre's walk, and what that walk and the frame's pass
+// read: the frame's normal with the distance to the eye, the view with the
+// mark and the tangent with the mesh (as fs_cells). fs_cells_walk then
+// walks the marked pixels into the XYZ (loaded, not cleared), and the
+// frame's pass reads it (env_cells_pixel) instead of walking once per
 // triangle that touches the pixel.
 struct CentreOut {
     @location(0) xyz: vec4<f32>,
     @location(1) nd: vec4<f32>,
+    @location(2) view: vec4<f32>,
+    @location(3) t: vec4<f32>,
 };
 
 @fragment
@@ -73,10 +78,13 @@ fn fs_cells_centre(in: VsOut) -> CentreOut {
     let dist = length(g.eye.xyz - in.world);
     var o: CentreOut;
     o.xyz = vec4<f32>(0.0);
+    o.view = vec4<f32>(wr, 0.0);
     if (cells_shaded_here(wr_l)) {
-        o.xyz = vec4<f32>(env_cells_shared(fr[0], fr[1], fr[2], wr_l, in.clip.xy, dist), 1.0);
+        o.xyz = env_cells_mixed(fr[2], wr_l, in.clip.xy, dist);
+        o.view.w = 1.0 - o.xyz.w;
     }
     o.nd = vec4<f32>(fr[2], dist);
+    o.t = vec4<f32>(fr[0], f32(mat.cells_id));
     return o;
 }
 
@@ -104,10 +112,11 @@ fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> 
     return vec4<f32>(p * 2.0 - 1.0, 0.0, 1.0);
 }
 
-// The grid's walk, one full-screen pass after fs_cells: at each grid point
-// the raster pass marked, the cells' XYZ from the frame and view it wrote
-// (bindings 2-4: its targets), so that every SIMD block of the walk is full
-// whatever the triangles' size on the grid.
+// The cells' walk, one full-screen pass per mesh after fs_cells (the grid)
+// and after fs_cells_centre (the pixels the grid does not serve): at each
+// point the raster pass marked, the cells' XYZ from the frame and view it
+// wrote (bindings 2-4: its targets), so that every SIMD block of the walk
+// is full whatever the triangles' size.
 @fragment
 fn fs_cells_walk(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
     let p = vec2<i32>(floor(clip.xy));

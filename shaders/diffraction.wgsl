@@ -40,7 +40,7 @@ struct Globals {
     n_lambda: u32,
     // samples per pixel of the colour target (1 or 4)
     msaa: u32,
-    // the cells' rate (shaders/environment.wgsl env_cells_shared,
+    // the cells' rate (shaders/environment.wgsl env_cells_mixed,
     // env_cells_pixel): K >= 1 when the centre pass ran (after a coarse grid
     // of K x K pixels for K > 1), else 0
     cells_rate: u32,
@@ -91,11 +91,12 @@ struct Material {
 // in the grid's walk (fs_cells_walk) the grid's raster targets (fs_cells:
 // the view with the mark, the frame's normal with the distance to the eye,
 // its tangent with the mesh); in the centre pass (fs_cells_centre, read by
-// env_cells_shared) the coarse grid at 1/K of the pixels: the walk's XYZ (w:
+// env_cells_mixed) the coarse grid at 1/K of the pixels: the walk's XYZ (w:
 // 1 where shaded), the normal with the distance, the tangent; in the
-// frame's pass (read by env_cells_pixel) the centre pass's XYZ and normal
-// with the distance, per pixel (binding 4 unused). 1 x 1 stand-ins where
-// none ran.
+// centre's walk (fs_cells_walk) the centre pass's view with the mark,
+// normal with the distance and tangent with the mesh; in the frame's pass
+// (read by env_cells_pixel) the centre's XYZ and normal with the distance,
+// per pixel (binding 4 unused). 1 x 1 stand-ins where none ran.
 @group(0) @binding(2) var cells_xyz: texture_2d<f32>;
 @group(0) @binding(3) var cells_nd: texture_2d<f32>;
 @group(0) @binding(4) var cells_t: texture_2d<f32>;

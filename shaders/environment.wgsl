@@ -558,11 +558,13 @@ fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
 // distances to the eye within ENV_LOWRES_DEPTH of each other, and the pixel
 // on that patch (its normal within ENV_LOWRES_OWN (10 degrees), its distance within
 // ENV_LOWRES_DEPTH). Elsewhere (silhouettes, limbs, scale borders, where the
-// surface turns faster than the cone across a block) the pixel walks the
-// cells itself. This runs in the centre pass (fs_cells_centre, once per
-// pixel; the frame's pass reads its result through env_cells_pixel below).
-// The test is on the block's corners, so a block's pixels
-// decide alike (a SIMD group that mixed both would pay for the walk). The
+// surface turns faster than the cone across a block) the centre pass marks
+// the pixel, and a full-screen pass per mesh walks the cells at the marked
+// pixels (fs_cells_walk, the grid's walk), so that the walks fill whole SIMD
+// blocks whatever the triangles' size and wherever mixed and walked pixels
+// meet. This runs in the centre pass (fs_cells_centre, once per pixel; the
+// frame's pass reads its result through env_cells_pixel below). The test is
+// on the block's corners, so a block's pixels decide alike. The
 // cells' term is a smooth function of the frame and the view on the scale
 // of a cell's spread, a few degrees (the sun and the hot spots have their
 // own exact paths at every pixel), so its error is second order in the
@@ -578,7 +580,11 @@ fn env_same_surface(n_seen: vec3<f32>, d_seen: f32, n: vec3<f32>, dist: f32) -> 
     return dot(n_seen, n) >= ENV_LOWRES_OWN && abs(dist - d_seen) <= ENV_LOWRES_DEPTH * d_seen;
 }
 
-fn env_cells_shared(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec3<f32> {
+// The centre pass's value at a pixel from the coarse grid: (the bilinear
+// mix, 1) where the block's corners saw one smooth patch of this pixel's
+// surface, else 0 (the pixel is walked in the centre's full-screen walk,
+// fs_cells_walk).
+fn env_cells_mixed(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
     let k = g.cells_rate;
     if (k > 1u && wr.z > ENV_GRAZING_COS) {
         let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
@@ -618,10 +624,10 @@ fn env_cells_shared(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, cli
         }
         let d_mid = 0.5 * (d_lo + d_hi);
         if (one_patch && env_same_surface(nm, d_mid, n, dist)) {
-            return acc;
+            return vec4<f32>(acc, 1.0);
         }
     }
-    return env_cells(t, b, n, wr);
+    return vec4<f32>(0.0);
 }
 
 // The frame's pass after the centre pass (g.cells_rate >= 1): the centre

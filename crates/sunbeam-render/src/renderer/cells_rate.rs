@@ -16,9 +16,13 @@
 //!    costs").
 //! 2. The centre pass, single-sampled at the frame's size (`fs_cells_centre`):
 //!    each pixel centre takes the bilinear mix of its K x K block's corners
-//!    where they saw one smooth patch of surface and walks the cells itself
-//!    elsewhere (shaders/environment.wgsl `env_cells_shared`); it writes the
-//!    XYZ and the normal with the distance.
+//!    where they saw one smooth patch of surface (shaders/environment.wgsl
+//!    `env_cells_mixed`) and marks the pixel elsewhere; it writes the XYZ,
+//!    the normal with the distance, and the view and tangent as the grid's
+//!    raster pass does. Then one full-screen pass per mesh walks the marked
+//!    pixels into the XYZ (`fs_cells_walk` again, the target loaded, not
+//!    cleared): walked in the raster pass, those walks ran in SIMD blocks
+//!    half filled by pixels that mixed, on triangles a few pixels wide.
 //!
 //! The frame's pass (bind group 0, bindings 2-3) then reads its pixel's
 //! centre value where its own normal and distance match it, and walks the
@@ -101,8 +105,14 @@ struct Grid {
     centre_xyz: wgpu::TextureView,
     centre_nd: wgpu::TextureView,
     centre_depth: wgpu::TextureView,
+    /// The centre pass's view with the mark and tangent with the mesh, which
+    /// its walk reads.
+    centre_view: wgpu::TextureView,
+    centre_t: wgpu::TextureView,
     /// Bind group 0 of the centre pass: the coarse grid (stand-ins at K = 1).
     centre_bind: wgpu::BindGroup,
+    /// Bind group 0 of the centre's walk: the centre pass's targets.
+    centre_walk_bind: wgpu::BindGroup,
     /// Bind group 0 of the frame's pass: globals, spectrum and the centres.
     bind: wgpu::BindGroup,
 }
@@ -114,7 +124,8 @@ pub(super) struct CellsRate {
     rate: u32,
     /// The grid's raster pass and its full-screen walk (rate K > 1).
     coarse: Option<(wgpu::RenderPipeline, wgpu::RenderPipeline)>,
-    centre: wgpu::RenderPipeline,
+    /// The centre pass and its full-screen walk.
+    centre: (wgpu::RenderPipeline, wgpu::RenderPipeline),
     pre_bind: wgpu::BindGroup,
     stand_in: wgpu::TextureView,
     grid: Mutex<Option<Grid>>,
@@ -218,13 +229,13 @@ impl CellsRate {
     ) -> Result<CellsRate> {
         check_targets(adapter)?;
         // The grid's raster pass and its walk: both or neither.
+        let pass = |label, entry| Technique {
+            label,
+            source: SHADER,
+            entry,
+            constants: Vec::new(),
+        };
         let coarse = if rate > 1 {
-            let pass = |label, entry| Technique {
-                label,
-                source: SHADER,
-                entry,
-                constants: Vec::new(),
-            };
             let raster = render_pipeline(
                 device,
                 layouts,
@@ -242,19 +253,21 @@ impl CellsRate {
         } else {
             None
         };
-        let technique = Technique {
-            label: "diffraction.wgsl cells centre pass",
-            source: SHADER,
-            entry: "fs_cells_centre",
-            constants: Vec::new(),
-        };
-        let centre = render_pipeline(
-            device,
-            layouts,
-            &[CENTRE_FORMAT, FRAME_FORMAT],
-            1,
-            &technique,
-        )?;
+        let centre = (
+            render_pipeline(
+                device,
+                layouts,
+                &[CENTRE_FORMAT, FRAME_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
+                1,
+                &pass("diffraction.wgsl cells centre pass", "fs_cells_centre"),
+            )?,
+            fullscreen_pipeline(
+                device,
+                layouts,
+                &[CENTRE_FORMAT],
+                &pass("diffraction.wgsl cells centre walk", "fs_cells_walk"),
+            )?,
+        );
         let pre_bind = global_bind(
             device,
             layouts[0],
@@ -311,6 +324,15 @@ impl CellsRate {
         let centre_xyz = target(gpu, w, h, CENTRE_FORMAT);
         let centre_nd = target(gpu, w, h, FRAME_FORMAT);
         let centre_depth = super::depth_view(gpu, w, h);
+        let centre_view = target(gpu, w, h, FRAME_FORMAT);
+        let centre_t = target(gpu, w, h, FRAME_FORMAT);
+        let centre_walk_bind = global_bind(
+            &gpu.device,
+            layout,
+            globals,
+            spectrum,
+            [&centre_view, &centre_nd, &centre_t],
+        );
         let si = &self.stand_in;
         let centre_bind = match &coarse {
             Some(c) => global_bind(
@@ -335,7 +357,10 @@ impl CellsRate {
             centre_xyz,
             centre_nd,
             centre_depth,
+            centre_view,
+            centre_t,
             centre_bind,
+            centre_walk_bind,
             bind,
         });
     }
@@ -416,15 +441,42 @@ impl CellsRate {
         {
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("cells centre pass"),
-                color_attachments: &[clear(&g.centre_xyz), clear(&g.centre_nd)],
+                color_attachments: &[
+                    clear(&g.centre_xyz),
+                    clear(&g.centre_nd),
+                    clear(&g.centre_view),
+                    clear(&g.centre_t),
+                ],
                 depth_stencil_attachment: depth(&g.centre_depth),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            rp.set_pipeline(&self.centre);
+            rp.set_pipeline(&self.centre.0);
             rp.set_bind_group(0, &g.centre_bind, &[]);
             draw(&mut rp);
+            drop(rp);
+            // the pixels the grid does not serve, walked into the XYZ the
+            // centre pass wrote (loaded: its mixed pixels stay)
+            let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("cells centre walk"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &g.centre_xyz,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            rp.set_pipeline(&self.centre.1);
+            rp.set_bind_group(0, &g.centre_walk_bind, &[]);
+            draw_full(&mut rp);
         }
         main(enc, &g.bind);
     }
