@@ -87,6 +87,12 @@ struct Material {
 };
 
 @group(0) @binding(0) var<uniform> g: Globals;
+// Clip-space x and y shrink by this factor about the frame's centre: 1,
+// except in the cells' grid pass, which widens its viewport to match, so
+// that its grid points on the frame's right and bottom edges (exactly on
+// the clip volume's border, outside by the rasteriser's rule) are drawn
+// (crates/sunbeam-render/src/renderer/cells_rate.rs GRID_PAD).
+override SB_CLIP_SCALE: f32 = 1.0;
 // The cells' pre-passes (crates/sunbeam-render/src/renderer/cells_rate.rs):
 // in the grid's walk (fs_cells_walk) the grid's raster targets (fs_cells:
 // the view with the mark, the frame's normal with the distance to the eye,
@@ -137,6 +143,7 @@ struct VsOut {
 fn vs_main(v: VsIn) -> VsOut {
     var o: VsOut;
     o.clip = g.view_proj * vec4<f32>(v.pos, 1.0);
+    o.clip = vec4<f32>(o.clip.xy * SB_CLIP_SCALE, o.clip.zw);
     o.world = v.pos;
     o.normal = v.normal;
     o.tangent = v.tangent.xyz;

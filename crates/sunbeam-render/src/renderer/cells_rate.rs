@@ -51,6 +51,17 @@ use sunbeam_common::Result;
 const XYZ_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
+/// The grid pass's clip volume reaches this share of the frame's width and
+/// height past each edge (the vertex shader's `SB_CLIP_SCALE` is 1 / (1 + 2
+/// GRID_PAD), the viewport as much wider). The grid's points lie on the
+/// frame's pixel corners 0, K, ... w, and the last, on the frame's edge,
+/// would lie on the clip volume's border, which the rasteriser leaves out:
+/// the last K rows and columns of pixels then had no corners and walked the
+/// cells each (on a 512 x 512 sphere at K = 4, half of the pixels that
+/// walked). An eighth also covers the point past a frame whose size is not
+/// a multiple of K from 8 grid points across.
+const GRID_PAD: f64 = 0.125;
+
 /// The centre pass's XYZ: used as it is (not interpolated), so in 32-bit
 /// floats like the frame's own walk.
 const CENTRE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -241,7 +252,10 @@ impl CellsRate {
                 layouts,
                 &[FRAME_FORMAT, FRAME_FORMAT, FRAME_FORMAT],
                 1,
-                &pass("diffraction.wgsl cells pre-pass", "fs_cells"),
+                &Technique {
+                    constants: vec![("SB_CLIP_SCALE", 1.0 / (1.0 + 2.0 * GRID_PAD))],
+                    ..pass("diffraction.wgsl cells pre-pass", "fs_cells")
+                },
             )?;
             let walk = fullscreen_pipeline(
                 device,
@@ -413,12 +427,18 @@ impl CellsRate {
             });
             // The frame's projection onto a viewport K times smaller, half a
             // grid pixel in: grid pixel i's centre is the frame's x = i K.
-            let k = self.rate as f32;
+            // The clip volume, shrunk by SB_CLIP_SCALE, reaches GRID_PAD
+            // past the frame: the viewport grows by as much on each side.
+            let pad = GRID_PAD as f32;
+            let (gw, gh) = (
+                g.full[0] as f32 / self.rate as f32,
+                g.full[1] as f32 / self.rate as f32,
+            );
             rp.set_viewport(
-                0.5,
-                0.5,
-                g.full[0] as f32 / k,
-                g.full[1] as f32 / k,
+                0.5 - pad * gw,
+                0.5 - pad * gh,
+                gw * (1.0 + 2.0 * pad),
+                gh * (1.0 + 2.0 * pad),
                 0.0,
                 1.0,
             );
