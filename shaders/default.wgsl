@@ -112,22 +112,14 @@ fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> 
     return vec4<f32>(p * 2.0 - 1.0, 0.0, 1.0);
 }
 
-// The cells' walk, one full-screen pass per mesh after fs_cells (the grid)
-// and after fs_cells_centre (the pixels the grid does not serve): at each
-// point the raster pass marked, the cells' XYZ from the frame and view it
-// wrote (bindings 2-4: its targets), so that every SIMD block of the walk
-// is full whatever the triangles' size.
-@fragment
-fn fs_cells_walk(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(clip.xy));
+// The cells' XYZ at point p of the pass's targets (bindings 2-4) where the
+// raster pass marked it with this mesh: (XYZ, 1), else 0. The walk is
+// inside the branch: after a discard WGSL demotes the invocation to a
+// helper, which goes on running the walk's loop beside the live lanes, so
+// every point (the background, the other meshes') would walk.
+fn cells_walk_at(p: vec2<i32>) -> vec4<f32> {
     let a = textureLoad(cells_xyz, p, 0);
     let tc = textureLoad(cells_t, p, 0);
-    // this mesh's grid points where the raster pass shades the cells (the
-    // other meshes' passes walk theirs: each with its own material and
-    // pack). The walk is inside the branch, not after a discard: WGSL's
-    // discard demotes the invocation to a helper, which goes on running the
-    // walk's loop beside the live lanes, so every point of the grid (the
-    // background, the other meshes') would walk.
     var o = vec4<f32>(0.0);
     if (a.w > 0.5 && tc.w == f32(mat.cells_id)) {
         // the frame the raster pass had (shaders/material.wgsl sb_frame, as
@@ -136,7 +128,68 @@ fn fs_cells_walk(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
         let wr = a.xyz;
         let wr_l = vec3<f32>(dot(wr, fr[0]), dot(wr, fr[1]), dot(wr, fr[2]));
         o = vec4<f32>(env_cells(fr[0], fr[1], fr[2], wr_l), 1.0);
-    } else {
+    }
+    return o;
+}
+
+// Whether the grid's walk first mixes its points from the half grid
+// (fs_cells_walk_half): set for the grid's walk when the packs are small
+// enough (crates/sunbeam-render/src/renderer/cells_rate.rs HALF_GRID_PATCH_M).
+override SB_WALK_FROM_HALF: bool = false;
+
+// The half grid: the grid's even points (2i, 2j), walked into a target half
+// the grid's size, so that its SIMD blocks are full.
+@fragment
+fn fs_cells_walk_half(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
+    let o = cells_walk_at(vec2<i32>(floor(clip.xy)) * 2);
+    if (o.w < 0.5) {
+        discard;
+    }
+    return o;
+}
+
+// Grid point p of this mesh from the half grid (binding 5): its own walk at
+// an even point; elsewhere the bilinear mix of the four even points around
+// it where they saw one smooth patch with p on it (shaders/environment.wgsl
+// env_block_smooth, as a pixel's block). (XYZ, 1), else 0: p walks for
+// itself.
+fn cells_from_half(p: vec2<i32>) -> vec4<f32> {
+    let a = textureLoad(cells_xyz, p, 0);
+    let tp = textureLoad(cells_t, p, 0);
+    if (!(a.w > 0.5 && tp.w == f32(mat.cells_id))) {
+        return vec4<f32>(0.0);
+    }
+    let h = p / 2;
+    let odd = p - 2 * h;
+    if (odd.x == 0 && odd.y == 0) {
+        return vec4<f32>(textureLoad(cells_half, h, 0).xyz, 1.0);
+    }
+    let nd = textureLoad(cells_nd, p, 0);
+    if (env_block_smooth(2 * h, 2, nd.xyz, nd.w)) {
+        return vec4<f32>(env_bilinear(cells_half, h, 0.5 * vec2<f32>(odd)), 1.0);
+    }
+    return vec4<f32>(0.0);
+}
+
+// The cells' walk, one full-screen pass per mesh after fs_cells (the grid:
+// its points mixed from the half grid where SB_WALK_FROM_HALF and its
+// blocks allow) and after fs_cells_centre (the pixels the grid does not
+// serve): at each point the raster pass marked, the cells' XYZ from the
+// frame and view it wrote (bindings 2-4: its targets), so that every SIMD
+// block of the walk is full whatever the triangles' size.
+@fragment
+fn fs_cells_walk(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
+    let p = vec2<i32>(floor(clip.xy));
+    var o = vec4<f32>(0.0);
+    if (SB_WALK_FROM_HALF) {
+        o = cells_from_half(p);
+    }
+    if (o.w < 0.5) {
+        o = cells_walk_at(p);
+    }
+    // after the walk: the other meshes' points and the background keep
+    // what their own passes write
+    if (o.w < 0.5) {
         discard;
     }
     return o;

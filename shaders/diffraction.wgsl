@@ -106,6 +106,9 @@ override SB_CLIP_SCALE: f32 = 1.0;
 @group(0) @binding(2) var cells_xyz: texture_2d<f32>;
 @group(0) @binding(3) var cells_nd: texture_2d<f32>;
 @group(0) @binding(4) var cells_t: texture_2d<f32>;
+// In the grid's walk, the half grid's walks (fs_cells_walk_half); else a
+// 1 x 1 stand-in.
+@group(0) @binding(5) var cells_half: texture_2d<f32>;
 // xyz: colour weight of the sample, w: 1 / lambda in 1/um (the per-fragment
 // baselines' wavelengths)
 @group(0) @binding(1) var<storage, read> spectrum: array<vec4<f32>>;

@@ -587,47 +587,68 @@ fn env_same_surface(n_seen: vec3<f32>, d_seen: f32, n: vec3<f32>, dist: f32) -> 
 fn env_cells_mixed(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
     let k = g.cells_rate;
     if (k > 1u && wr.z > ENV_GRAZING_COS) {
-        let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
         let q = clip / f32(k);
         let q0 = floor(q);
-        let f = q - q0;
-        var acc = vec3<f32>(0.0);
-        var ns = vec3<f32>(0.0);
-        var ts = vec3<f32>(0.0);
-        var d_lo = 3.4e38;
-        var d_hi = 0.0;
-        var shaded = true;
-        var nn: array<vec3<f32>, 4>;
-        var tt: array<vec3<f32>, 4>;
-        for (var j = 0; j < 4; j = j + 1) {
-            let o = vec2<i32>(j & 1, j >> 1u);
-            let c = clamp(vec2<i32>(q0) + o, vec2<i32>(0), last);
-            let x = textureLoad(cells_xyz, c, 0);
-            let nd = textureLoad(cells_nd, c, 0);
-            let tc = textureLoad(cells_t, c, 0);
-            shaded = shaded && x.w > 0.5;
-            nn[j] = nd.xyz;
-            tt[j] = tc.xyz;
-            ns = ns + nd.xyz;
-            ts = ts + tc.xyz;
-            d_lo = min(d_lo, nd.w);
-            d_hi = max(d_hi, nd.w);
-            let wx = select(1.0 - f.x, f.x, o.x == 1);
-            let wy = select(1.0 - f.y, f.y, o.y == 1);
-            acc = acc + (wx * wy) * x.xyz;
-        }
-        let nm = ns / max(length(ns), 1e-12);
-        let tm = ts / max(length(ts), 1e-12);
-        var one_patch = shaded && d_hi - d_lo <= ENV_LOWRES_DEPTH * d_lo;
-        for (var j = 0; j < 4; j = j + 1) {
-            one_patch = one_patch && dot(nn[j], nm) >= ENV_LOWRES_CONE && dot(tt[j], tm) >= ENV_LOWRES_CONE;
-        }
-        let d_mid = 0.5 * (d_lo + d_hi);
-        if (one_patch && env_same_surface(nm, d_mid, n, dist)) {
-            return vec4<f32>(acc, 1.0);
+        let c0 = vec2<i32>(q0);
+        if (env_block_smooth(c0, 1, n, dist)) {
+            return vec4<f32>(env_bilinear(cells_xyz, c0, q - q0), 1.0);
         }
     }
     return vec4<f32>(0.0);
+}
+
+// Whether the grid's points c0 + step o, o in {0, 1}^2 (bindings 2-4: the
+// mark in binding 2's w, the mesh in binding 4's), saw one smooth patch of
+// this mesh's surface on which a point with normal n at distance dist lies:
+// all inside the grid and marked with this mesh, their normals and tangents
+// within ENV_LOWRES_CONE of their mean, their distances within
+// ENV_LOWRES_DEPTH of each other, and the point on that patch
+// (env_same_surface). For a pixel's block (env_cells_mixed) and for a grid
+// point's block of the half grid (shaders/default.wgsl cells_from_half).
+fn env_block_smooth(c0: vec2<i32>, step: i32, n: vec3<f32>, dist: f32) -> bool {
+    let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
+    var ok = true;
+    var ns = vec3<f32>(0.0);
+    var ts = vec3<f32>(0.0);
+    var d_lo = 3.4e38;
+    var d_hi = 0.0;
+    var nn: array<vec3<f32>, 4>;
+    var tt: array<vec3<f32>, 4>;
+    for (var j = 0; j < 4; j = j + 1) {
+        let c = c0 + step * vec2<i32>(j & 1, j >> 1u);
+        ok = ok && c.x <= last.x && c.y <= last.y;
+        let cc = min(c, last);
+        let nd = textureLoad(cells_nd, cc, 0);
+        let tc = textureLoad(cells_t, cc, 0);
+        ok = ok && textureLoad(cells_xyz, cc, 0).w > 0.5 && tc.w == f32(mat.cells_id);
+        nn[j] = nd.xyz;
+        tt[j] = tc.xyz;
+        ns = ns + nd.xyz;
+        ts = ts + tc.xyz;
+        d_lo = min(d_lo, nd.w);
+        d_hi = max(d_hi, nd.w);
+    }
+    let nm = ns / max(length(ns), 1e-12);
+    let tm = ts / max(length(ts), 1e-12);
+    ok = ok && d_hi - d_lo <= ENV_LOWRES_DEPTH * d_lo;
+    for (var j = 0; j < 4; j = j + 1) {
+        ok = ok && dot(nn[j], nm) >= ENV_LOWRES_CONE && dot(tt[j], tm) >= ENV_LOWRES_CONE;
+    }
+    return ok && env_same_surface(nm, 0.5 * (d_lo + d_hi), n, dist);
+}
+
+// The bilinear mix at fraction f of the block of texels c0 + o, o in
+// {0, 1}^2, of `tex`, clamped to its last texel.
+fn env_bilinear(tex: texture_2d<f32>, c0: vec2<i32>, f: vec2<f32>) -> vec3<f32> {
+    let last = vec2<i32>(textureDimensions(tex)) - vec2<i32>(1);
+    var acc = vec3<f32>(0.0);
+    for (var j = 0; j < 4; j = j + 1) {
+        let o = vec2<i32>(j & 1, j >> 1u);
+        let wx = select(1.0 - f.x, f.x, o.x == 1);
+        let wy = select(1.0 - f.y, f.y, o.y == 1);
+        acc = acc + (wx * wy) * textureLoad(tex, min(c0 + o, last), 0).xyz;
+    }
+    return acc;
 }
 
 // The frame's pass after the centre pass (g.cells_rate >= 1): the centre

@@ -105,6 +105,13 @@ pub(crate) struct Cli {
     /// rate").
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16))]
     pub(crate) env_cells_rate: Option<u32>,
+    /// Environment scenes, `--env-estimator cells`, a grid of 2 and up: mix
+    /// the grid's own points from every other grid point where those blocks
+    /// of 2K pixels are smooth, and walk the rest (true or false; default:
+    /// true where every pack is under 10 um, the size it was measured at;
+    /// docs/LIGHTING.md "The half grid").
+    #[arg(long)]
+    pub(crate) env_cells_half: Option<bool>,
     /// Wavelength samples of the default mode.
     #[arg(long, default_value_t = sunbeam_render::renderer::DEFAULT_LAMBDA_SAMPLES)]
     pub(crate) lambda_samples: usize,

@@ -133,6 +133,7 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
         env_hot_spots: cli.env_hot_spots as usize,
         env_hot_threshold: cli.env_hot_threshold,
         env_cells_rate: cli.env_cells_rate,
+        env_cells_half: cli.env_cells_half,
         env_cells: (
             cli.env_cells.map(|n| n as usize),
             sunbeam_render::env::ENV_CELLS_DEPTH,
@@ -333,6 +334,8 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             if report.get("env_cells").is_some() {
                 // the pre-passes' grid (0: none, every fragment walks)
                 report["env_cells_rate"] = r.env_cells_rate().into();
+                // the grid mixed from every other point where smooth
+                report["env_cells_half"] = r.env_cells_half().into();
             }
             let k = cli.supersample.max(1);
             let mut target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;

@@ -9,7 +9,10 @@
 //!    there, the frame's normal with the distance to the eye, and its
 //!    tangent with the mesh (`MaterialU::cells_id`) into three float
 //!    targets; then one full-screen pass per mesh (`fs_cells_walk`) walks
-//!    the cells at that mesh's points into the grid's XYZ. A walk in the
+//!    the cells at that mesh's points into the grid's XYZ (with the half
+//!    grid, [`half_grid`], a pass before it walks every other point, and
+//!    the grid's walk mixes its other points from them where their blocks
+//!    are smooth). A walk in the
 //!    raster pass ran in SIMD blocks that triangles smaller than a few grid
 //!    pixels leave mostly empty: on lavapipe it cost twice as much at a
 //!    grid of 4 on a 512 x 512 sphere (docs/LIGHTING.md "What a grid's walk
@@ -85,6 +88,21 @@ pub const DEFAULT_CELLS_RATE_LARGE: u32 = 2;
 /// (docs/LIGHTING.md "Cells at a lower rate").
 pub const FINE_GRID_PATCH_M: f64 = 32e-6;
 
+/// Below this patch size (longer side, metres) the grid's points mix from
+/// the half grid (every other point) where its blocks of 2K pixels pass the
+/// same test as a pixel's block ([`CellsGrid`]'s `half`). Measured at 5 um
+/// (the 512 x 512 sky-lit sphere of docs/LIGHTING.md "The half grid"); a
+/// 20 um pack's orders are too narrow for the 2-degree cone across blocks
+/// of 8 pixels (a flat grid of 8: CIEDE2000 p99 2.30 from the converged
+/// reference against 1.04 for the grid of 4).
+pub const HALF_GRID_PATCH_M: f64 = 10e-6;
+
+/// Whether a frame whose reading packs' largest patch side is `patch_m`
+/// metres mixes its grid from the half grid.
+pub fn half_grid(patch_m: f64) -> bool {
+    patch_m < HALF_GRID_PATCH_M
+}
+
 /// The default grid spacing for a pack whose patch's longer side is
 /// `patch_m` metres.
 pub fn default_cells_rate(patch_m: f64) -> u32 {
@@ -101,8 +119,12 @@ struct Coarse {
     xyz: wgpu::TextureView,
     /// The walk's XYZ (fs_cells_walk), what the centre pass reads.
     walked: wgpu::TextureView,
-    /// Bind group 0 of the walk: the raster pass's targets.
+    /// Bind group 0 of the walk: the raster pass's targets and the half
+    /// grid's XYZ (a stand-in without it).
     walk_bind: wgpu::BindGroup,
+    /// The half grid's XYZ and the bind group of its walk (the raster
+    /// pass's targets), with [`CellsRate`]'s half grid.
+    half: Option<(wgpu::TextureView, wgpu::BindGroup)>,
     nd: wgpu::TextureView,
     t: wgpu::TextureView,
     depth: wgpu::TextureView,
@@ -133,8 +155,8 @@ struct Grid {
 /// last frame size.
 pub(super) struct CellsRate {
     rate: u32,
-    /// The grid's raster pass and its full-screen walk (rate K > 1).
-    coarse: Option<(wgpu::RenderPipeline, wgpu::RenderPipeline)>,
+    /// The grid's passes (rate K > 1).
+    coarse: Option<CoarsePipelines>,
     /// The centre pass and its full-screen walk.
     centre: (wgpu::RenderPipeline, wgpu::RenderPipeline),
     pre_bind: wgpu::BindGroup,
@@ -142,13 +164,30 @@ pub(super) struct CellsRate {
     grid: Mutex<Option<Grid>>,
 }
 
+/// The pre-passes' grid: one pixel in `rate` x `rate` (>= 1; 1: the centre
+/// pass alone), mixed from the half grid where it can (`half`,
+/// [`half_grid`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CellsGrid {
+    pub(super) rate: u32,
+    pub(super) half: bool,
+}
+
+/// The grid's raster pass, its full-screen walk, and the half grid's walk
+/// before it where the packs are small enough ([`half_grid`]).
+struct CoarsePipelines {
+    raster: wgpu::RenderPipeline,
+    walk: wgpu::RenderPipeline,
+    half: Option<wgpu::RenderPipeline>,
+}
+
 /// Group 0's entries: the globals, the spectrum and three grid textures.
 fn group0<'a>(
     globals: &'a wgpu::Buffer,
     spectrum: &'a wgpu::Buffer,
-    views: [&'a wgpu::TextureView; 3],
-) -> [wgpu::BindGroupEntry<'a>; 5] {
-    let [a, b, c] = views;
+    views: [&'a wgpu::TextureView; 4],
+) -> [wgpu::BindGroupEntry<'a>; 6] {
+    let [a, b, c, d] = views;
     [
         wgpu::BindGroupEntry {
             binding: 0,
@@ -170,6 +209,10 @@ fn group0<'a>(
             binding: 4,
             resource: wgpu::BindingResource::TextureView(c),
         },
+        wgpu::BindGroupEntry {
+            binding: 5,
+            resource: wgpu::BindingResource::TextureView(d),
+        },
     ]
 }
 
@@ -179,7 +222,7 @@ pub(super) fn global_bind(
     layout: &wgpu::BindGroupLayout,
     globals: &wgpu::Buffer,
     spectrum: &wgpu::Buffer,
-    views: [&wgpu::TextureView; 3],
+    views: [&wgpu::TextureView; 4],
 ) -> wgpu::BindGroup {
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("globals"),
@@ -226,14 +269,14 @@ fn check_targets(adapter: &wgpu::Adapter) -> Result<()> {
 }
 
 impl CellsRate {
-    /// The pre-passes at one pixel in `rate` x `rate` (>= 1; 1: the centre
-    /// pass alone), with the default pipeline's bind group layouts;
+    /// The pre-passes on `grid`, with the default pipeline's bind group
+    /// layouts;
     /// `stand_in` is bound as the grids while a pass cannot read them.
     pub(super) fn new(
         adapter: &wgpu::Adapter,
         device: &wgpu::Device,
         layouts: &[&wgpu::BindGroupLayout],
-        rate: u32,
+        grid: CellsGrid,
         globals: &wgpu::Buffer,
         spectrum: &wgpu::Buffer,
         stand_in: &wgpu::TextureView,
@@ -246,6 +289,7 @@ impl CellsRate {
             entry,
             constants: Vec::new(),
         };
+        let CellsGrid { rate, half } = grid;
         let coarse = if rate > 1 {
             let raster = render_pipeline(
                 device,
@@ -261,9 +305,22 @@ impl CellsRate {
                 device,
                 layouts,
                 &[XYZ_FORMAT],
-                &pass("diffraction.wgsl cells grid walk", "fs_cells_walk"),
+                &Technique {
+                    constants: vec![("SB_WALK_FROM_HALF", f64::from(u8::from(half)))],
+                    ..pass("diffraction.wgsl cells grid walk", "fs_cells_walk")
+                },
             )?;
-            Some((raster, walk))
+            let half = if half {
+                Some(fullscreen_pipeline(
+                    device,
+                    layouts,
+                    &[XYZ_FORMAT],
+                    &pass("diffraction.wgsl cells half walk", "fs_cells_walk_half"),
+                )?)
+            } else {
+                None
+            };
+            Some(CoarsePipelines { raster, walk, half })
         } else {
             None
         };
@@ -287,7 +344,7 @@ impl CellsRate {
             layouts[0],
             globals,
             spectrum,
-            [stand_in, stand_in, stand_in],
+            [stand_in, stand_in, stand_in, stand_in],
         );
         Ok(CellsRate {
             rate,
@@ -302,6 +359,11 @@ impl CellsRate {
     /// The grid spacing K.
     pub(super) fn rate(&self) -> u32 {
         self.rate
+    }
+
+    /// Whether the grid mixes from the half grid.
+    pub(super) fn half(&self) -> bool {
+        self.coarse.as_ref().is_some_and(|p| p.half.is_some())
     }
 
     /// Make the targets for a `w x h` frame (kept while the size stays).
@@ -325,11 +387,31 @@ impl CellsRate {
             let xyz = target(gpu, gw, gh, FRAME_FORMAT);
             let nd = target(gpu, gw, gh, FRAME_FORMAT);
             let t = target(gpu, gw, gh, FRAME_FORMAT);
-            let walk_bind = global_bind(&gpu.device, layout, globals, spectrum, [&xyz, &nd, &t]);
+            let bind = |half| {
+                global_bind(
+                    &gpu.device,
+                    layout,
+                    globals,
+                    spectrum,
+                    [&xyz, &nd, &t, half],
+                )
+            };
+            // the grid's even points, (2i, 2j)
+            let half = self
+                .coarse
+                .as_ref()
+                .is_some_and(|p| p.half.is_some())
+                .then(|| {
+                    let view = target(gpu, gw.div_ceil(2), gh.div_ceil(2), XYZ_FORMAT);
+                    let walk_bind = bind(&self.stand_in);
+                    (view, walk_bind)
+                });
+            let walk_bind = bind(half.as_ref().map_or(&self.stand_in, |(v, _)| v));
             Coarse {
                 xyz,
                 walked: target(gpu, gw, gh, XYZ_FORMAT),
                 walk_bind,
+                half,
                 nd,
                 t,
                 depth: super::depth_view(gpu, gw, gh),
@@ -345,7 +427,7 @@ impl CellsRate {
             layout,
             globals,
             spectrum,
-            [&centre_view, &centre_nd, &centre_t],
+            [&centre_view, &centre_nd, &centre_t, &self.stand_in],
         );
         let si = &self.stand_in;
         let centre_bind = match &coarse {
@@ -354,16 +436,16 @@ impl CellsRate {
                 layout,
                 globals,
                 spectrum,
-                [&c.walked, &c.nd, &c.t],
+                [&c.walked, &c.nd, &c.t, &self.stand_in],
             ),
-            None => global_bind(&gpu.device, layout, globals, spectrum, [si, si, si]),
+            None => global_bind(&gpu.device, layout, globals, spectrum, [si, si, si, si]),
         };
         let bind = global_bind(
             &gpu.device,
             layout,
             globals,
             spectrum,
-            [&centre_xyz, &centre_nd, si],
+            [&centre_xyz, &centre_nd, si, si],
         );
         *grid = Some(Grid {
             full: [w, h],
@@ -416,7 +498,7 @@ impl CellsRate {
                 stencil_ops: None,
             })
         };
-        if let (Some(c), Some((pipeline, walk))) = (&g.coarse, &self.coarse) {
+        if let (Some(c), Some(p)) = (&g.coarse, &self.coarse) {
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("cells pre-pass"),
                 color_attachments: &[clear(&c.xyz), clear(&c.nd), clear(&c.t)],
@@ -442,10 +524,23 @@ impl CellsRate {
                 0.0,
                 1.0,
             );
-            rp.set_pipeline(pipeline);
+            rp.set_pipeline(&p.raster);
             rp.set_bind_group(0, &self.pre_bind, &[]);
             draw(&mut rp);
             drop(rp);
+            if let (Some((view, bind)), Some(half)) = (&c.half, &p.half) {
+                let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("cells half grid walk"),
+                    color_attachments: &[clear(view)],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                rp.set_pipeline(half);
+                rp.set_bind_group(0, bind, &[]);
+                draw_full(&mut rp);
+            }
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("cells grid walk"),
                 color_attachments: &[clear(&c.walked)],
@@ -454,7 +549,7 @@ impl CellsRate {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            rp.set_pipeline(walk);
+            rp.set_pipeline(&p.walk);
             rp.set_bind_group(0, &c.walk_bind, &[]);
             draw_full(&mut rp);
         }
@@ -504,7 +599,7 @@ impl CellsRate {
 
 #[cfg(test)]
 mod tests {
-    use super::default_cells_rate;
+    use super::{default_cells_rate, half_grid};
 
     /// The sizes measured against converged references ([`super::FINE_GRID_PATCH_M`])
     /// take the grid that was measured as good as every pixel there.
@@ -512,6 +607,15 @@ mod tests {
     fn the_measured_sizes_take_the_grid_measured_for_them() {
         for (patch_um, rate) in [(5.12, 4), (20.48, 4), (30.72, 4), (40.96, 2), (81.92, 2)] {
             assert_eq!(default_cells_rate(patch_um * 1e-6), rate, "{patch_um} um");
+        }
+    }
+
+    /// The half grid at the size measured with it (5 um), not at the sizes
+    /// whose grid of 8 was measured too coarse (20 um) or not measured.
+    #[test]
+    fn the_half_grid_only_where_it_was_measured() {
+        for (patch_um, half) in [(3.2, true), (5.12, true), (20.48, false), (81.92, false)] {
+            assert_eq!(half_grid(patch_um * 1e-6), half, "{patch_um} um");
         }
     }
 }

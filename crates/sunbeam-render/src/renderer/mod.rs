@@ -36,7 +36,9 @@ pub mod uniforms;
 
 #[cfg(feature = "baselines")]
 pub use baselines::term_table;
-pub use cells_rate::{default_cells_rate, DEFAULT_CELLS_RATE, DEFAULT_CELLS_RATE_LARGE};
+pub use cells_rate::{
+    default_cells_rate, half_grid, DEFAULT_CELLS_RATE, DEFAULT_CELLS_RATE_LARGE, HALF_GRID_PATCH_M,
+};
 pub use targets::{
     colour_view, depth_view, depth_view_ms, lattice_jitter, subpixel_jitter, Offscreen,
     OFFSCREEN_FORMAT,
@@ -201,6 +203,11 @@ pub struct Settings {
     /// None: the finest of the defaults ([`default_cells_rate`]) of the
     /// packs whose meshes read the pre-passes.
     pub env_cells_rate: Option<u32>,
+    /// Environment, cells estimator, a grid of K > 1: mix the grid's own
+    /// points from every other grid point where those blocks of 2K pixels
+    /// are smooth. None: where every reading pack is under
+    /// [`HALF_GRID_PATCH_M`] ([`half_grid`]).
+    pub env_cells_half: Option<bool>,
 }
 
 impl Settings {
@@ -237,6 +244,7 @@ impl Default for Settings {
             env_hot_spots: crate::env::DEFAULT_ENV_HOT_SPOTS,
             env_hot_threshold: crate::env::DEFAULT_ENV_HOT_THRESHOLD,
             env_cells_rate: None,
+            env_cells_half: None,
         }
     }
 }
@@ -405,7 +413,7 @@ impl Renderer {
             &gl0,
             &globals,
             &spectrum,
-            [&dummy_2d, &dummy_2d, &dummy_2d],
+            [&dummy_2d, &dummy_2d, &dummy_2d, &dummy_2d],
         );
 
         // The cells at a lower rate need a smooth term: the sky (its sun has
@@ -433,16 +441,18 @@ impl Renderer {
                 && settings.mode != Mode::Lambert
                 && !(m.scales.is_some() && settings.msaa >= 4)
         };
-        let readers_rate = p
+        let readers_patch = p
             .meshes
             .iter()
             .filter(|(_, m)| reads_centre(m))
             .filter_map(|(_, m)| m.pack.as_ref())
-            .map(|pack| {
-                let patch = &pack.manifest.patch;
-                default_cells_rate(patch.lx_m.max(patch.ly_m))
-            })
-            .min();
+            .map(|pack| pack.manifest.patch.lx_m.max(pack.manifest.patch.ly_m))
+            .reduce(f64::max);
+        let readers_rate = readers_patch.map(default_cells_rate);
+        // The half grid where every reading pack is small enough.
+        let half = settings
+            .env_cells_half
+            .unwrap_or_else(|| readers_patch.is_some_and(half_grid));
         // Without a smooth term the centre pass alone (K = 1): one walk per
         // pixel, none interpolated.
         let cells_rate = readers_rate
@@ -482,7 +492,13 @@ impl Renderer {
                             render_pipeline(&device, &layouts, &[format], msaa, &technique)?;
                         let cells = match cells_rate {
                             Some(rate) => Some(cells_rate::CellsRate::new(
-                                &adapter, &device, &layouts, rate, &globals, &spectrum, &stand_in,
+                                &adapter,
+                                &device,
+                                &layouts,
+                                cells_rate::CellsGrid { rate, half },
+                                &globals,
+                                &spectrum,
+                                &stand_in,
                             )?),
                             None => None,
                         };
@@ -868,6 +884,13 @@ impl Renderer {
     /// would read them: every fragment walks the cells itself).
     pub fn env_cells_rate(&self) -> u32 {
         self.cells.as_ref().map_or(0, |c| c.rate())
+    }
+
+    /// Whether the cells' grid mixes its points from the half grid where
+    /// its blocks of 2K pixels are smooth (packs under
+    /// [`HALF_GRID_PATCH_M`]).
+    pub fn env_cells_half(&self) -> bool {
+        self.cells.as_ref().is_some_and(|c| c.half())
     }
 
     /// Multisample count of the pipeline (the colour and depth targets must match).

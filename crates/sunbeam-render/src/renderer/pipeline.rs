@@ -24,6 +24,7 @@ pub(super) fn bind_group_layouts(device: &wgpu::Device) -> [wgpu::BindGroupLayou
             texture_2d_unfiltered_entry(2),
             texture_2d_unfiltered_entry(3),
             texture_2d_unfiltered_entry(4),
+            texture_2d_unfiltered_entry(5),
         ],
     });
     let gl1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
