@@ -90,7 +90,7 @@ pub const FINE_GRID_PATCH_M: f64 = 32e-6;
 
 /// Below this patch size (longer side, metres) the grid's points mix from
 /// the half grid (every other point) where its blocks of 2K pixels pass the
-/// same test as a pixel's block ([`CellsGrid`]'s `half`). Measured at 5 um
+/// same test as a pixel's block (`CellsGrid::half`). Measured at 5 um
 /// (the 512 x 512 sky-lit sphere of docs/LIGHTING.md "The half grid"); a
 /// 20 um pack's orders are too narrow for the 2-degree cone across blocks
 /// of 8 pixels (a flat grid of 8: CIEDE2000 p99 2.30 from the converged
