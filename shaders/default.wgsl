@@ -80,7 +80,7 @@ fn fs_cells_centre(in: VsOut) -> CentreOut {
     o.xyz = vec4<f32>(0.0);
     o.view = vec4<f32>(wr, 0.0);
     if (cells_shaded_here(wr_l)) {
-        o.xyz = env_cells_mixed(fr[2], wr_l, in.clip.xy, dist);
+        o.xyz = env_cells_mixed(fr[0], fr[2], wr_l, in.clip.xy);
         o.view.w = 1.0 - o.xyz.w;
     }
     o.nd = vec4<f32>(fr[2], dist);
@@ -137,11 +137,33 @@ fn cells_walk_at(p: vec2<i32>) -> vec4<f32> {
 // enough (crates/sunbeam-render/src/renderer/cells_rate.rs HALF_GRID_PATCH_M).
 override SB_WALK_FROM_HALF: bool = false;
 
-// The half grid: the grid's even points (2i, 2j), walked into a target half
-// the grid's size, so that its SIMD blocks are full.
+// Whether the walk's target is laid out in bands (band_point): set for the
+// grid's walk; the centre's walk writes the frame's layout.
+override SB_WALK_BANDED: bool = false;
+
+// The point of a grid `w` points wide at pixel s of a target laid out in
+// bands: the grid's rows cut into bands of g.cells_band rows, put side by
+// side (crates/sunbeam-render/src/renderer/cells_rate.rs `Bands`, which
+// copies them back). A CPU rasteriser (lavapipe) shares a pass among its
+// threads by tiles of 64 x 64 pixels: a grid 65 points square was one tile
+// and its slivers, walked by one thread.
+fn band_point(s: vec2<i32>, w: i32) -> vec2<i32> {
+    let band = s.x / w;
+    return vec2<i32>(s.x - band * w, band * i32(g.cells_band) + s.y);
+}
+
+// The half grid: the grid's even points (2i, 2j), walked into a target
+// laid out in bands (band_point) of the half grid's rows.
 @fragment
 fn fs_cells_walk_half(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
-    let o = cells_walk_at(vec2<i32>(floor(clip.xy)) * 2);
+    let half = (vec2<i32>(textureDimensions(cells_xyz)) + vec2<i32>(1)) / 2;
+    let h = band_point(vec2<i32>(floor(clip.xy)), half.x);
+    // no discard before the walk (cells_walk_at): the band's rows past the
+    // grid skip it in a branch
+    var o = vec4<f32>(0.0);
+    if (h.y < half.y) {
+        o = cells_walk_at(h * 2);
+    }
     if (o.w < 0.5) {
         discard;
     }
@@ -164,28 +186,33 @@ fn cells_from_half(p: vec2<i32>) -> vec4<f32> {
     if (odd.x == 0 && odd.y == 0) {
         return vec4<f32>(textureLoad(cells_half, h, 0).xyz, 1.0);
     }
-    let nd = textureLoad(cells_nd, p, 0);
-    if (env_block_smooth(2 * h, 2, nd.xyz, nd.w)) {
+    if (env_block_smooth(2 * h, 2, tp.xyz, textureLoad(cells_nd, p, 0).xyz)) {
         return vec4<f32>(env_bilinear(cells_half, h, 0.5 * vec2<f32>(odd)), 1.0);
     }
     return vec4<f32>(0.0);
 }
 
-// The cells' walk, one full-screen pass per mesh after fs_cells (the grid:
-// its points mixed from the half grid where SB_WALK_FROM_HALF and its
-// blocks allow) and after fs_cells_centre (the pixels the grid does not
+// The cells' walk, one full-screen pass per mesh after fs_cells (the grid,
+// into a target laid out in bands: its points mixed from the half grid
+// where SB_WALK_FROM_HALF and its blocks allow) and after fs_cells_centre (the pixels the grid does not
 // serve): at each point the raster pass marked, the cells' XYZ from the
 // frame and view it wrote (bindings 2-4: its targets), so that every SIMD
 // block of the walk is full whatever the triangles' size.
 @fragment
 fn fs_cells_walk(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(clip.xy));
-    var o = vec4<f32>(0.0);
-    if (SB_WALK_FROM_HALF) {
-        o = cells_from_half(p);
+    var p = vec2<i32>(floor(clip.xy));
+    let dims = vec2<i32>(textureDimensions(cells_xyz));
+    if (SB_WALK_BANDED) {
+        p = band_point(p, dims.x);
     }
-    if (o.w < 0.5) {
-        o = cells_walk_at(p);
+    var o = vec4<f32>(0.0);
+    if (p.y < dims.y) {
+        if (SB_WALK_FROM_HALF) {
+            o = cells_from_half(p);
+        }
+        if (o.w < 0.5) {
+            o = cells_walk_at(p);
+        }
     }
     // after the walk: the other meshes' points and the background keep
     // what their own passes write

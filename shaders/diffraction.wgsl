@@ -31,7 +31,9 @@ struct Globals {
     xyz_to_rgb: array<vec4<f32>, 3>,
     background: vec4<f32>,
     n_lights: u32,
-    _g1: u32,
+    // the rows of one band of the cells' walk targets laid out in bands
+    // (shaders/default.wgsl band_point), for K > 1
+    cells_band: u32,
     curve: u32,
     // 0: write display values (UNORM/float target); 1: write their linear value (sRGB target);
     // 2: write linear light times the exposure (offscreen; the display transform follows on the CPU)

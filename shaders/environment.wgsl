@@ -554,17 +554,20 @@ fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
 // coordinates (i K, j K)); a pixel in the block [i K, (i + 1) K) takes the
 // bilinear mix of the block's four corners when they saw one smooth patch
 // of surface: all shaded (a diffracting mesh, views above ENV_GRAZING_COS),
-// their normals and tangents within ENV_LOWRES_CONE (2 degrees) of their mean, their
-// distances to the eye within ENV_LOWRES_DEPTH of each other, and the pixel
-// on that patch (its normal within ENV_LOWRES_OWN (10 degrees), its distance within
-// ENV_LOWRES_DEPTH). Elsewhere (silhouettes, limbs, scale borders, where the
+// their normals and tangents within ENV_LOWRES_CONE (2 degrees) of their
+// mean, and the pixel's own normal and tangent within the cone of that mean.
+// Not their distances: the term depends on the frame and the view alone
+// (the environment is unoccluded), and the view turns by no more than the
+// block's angular size whatever the depth, so two surfaces at different
+// depths with one frame take one value; a distance test failed wherever
+// the surface recedes (docs/LIGHTING.md "The block test: frames, not
+// distances"). Elsewhere (silhouettes, limbs, scale borders, where the
 // surface turns faster than the cone across a block) the centre pass marks
 // the pixel, and a full-screen pass per mesh walks the cells at the marked
 // pixels (fs_cells_walk, the grid's walk), so that the walks fill whole SIMD
 // blocks whatever the triangles' size and wherever mixed and walked pixels
 // meet. This runs in the centre pass (fs_cells_centre, once per pixel; the
-// frame's pass reads its result through env_cells_pixel below). The test is
-// on the block's corners, so a block's pixels decide alike. The
+// frame's pass reads its result through env_cells_pixel below). The
 // cells' term is a smooth function of the frame and the view on the scale
 // of a cell's spread, a few degrees (the sun and the hot spots have their
 // own exact paths at every pixel), so its error is second order in the
@@ -580,17 +583,17 @@ fn env_same_surface(n_seen: vec3<f32>, d_seen: f32, n: vec3<f32>, dist: f32) -> 
     return dot(n_seen, n) >= ENV_LOWRES_OWN && abs(dist - d_seen) <= ENV_LOWRES_DEPTH * d_seen;
 }
 
-// The centre pass's value at a pixel from the coarse grid: (the bilinear
-// mix, 1) where the block's corners saw one smooth patch of this pixel's
-// surface, else 0 (the pixel is walked in the centre's full-screen walk,
-// fs_cells_walk).
-fn env_cells_mixed(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
+// The centre pass's value at a pixel with tangent t and normal n from the
+// coarse grid: (the bilinear mix, 1) where the block's corners saw one
+// smooth patch of this pixel's frame, else 0 (the pixel is walked in the
+// centre's full-screen walk, fs_cells_walk).
+fn env_cells_mixed(t: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>) -> vec4<f32> {
     let k = g.cells_rate;
     if (k > 1u && wr.z > ENV_GRAZING_COS) {
         let q = clip / f32(k);
         let q0 = floor(q);
         let c0 = vec2<i32>(q0);
-        if (env_block_smooth(c0, 1, n, dist)) {
+        if (env_block_smooth(c0, 1, t, n)) {
             return vec4<f32>(env_bilinear(cells_xyz, c0, q - q0), 1.0);
         }
     }
@@ -599,42 +602,35 @@ fn env_cells_mixed(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> v
 
 // Whether the grid's points c0 + step o, o in {0, 1}^2 (bindings 2-4: the
 // mark in binding 2's w, the mesh in binding 4's), saw one smooth patch of
-// this mesh's surface on which a point with normal n at distance dist lies:
-// all inside the grid and marked with this mesh, their normals and tangents
-// within ENV_LOWRES_CONE of their mean, their distances within
-// ENV_LOWRES_DEPTH of each other, and the point on that patch
-// (env_same_surface). For a pixel's block (env_cells_mixed) and for a grid
-// point's block of the half grid (shaders/default.wgsl cells_from_half).
-fn env_block_smooth(c0: vec2<i32>, step: i32, n: vec3<f32>, dist: f32) -> bool {
+// this mesh's frames that a point with tangent t and normal n shares: all
+// inside the grid and marked with this mesh, their normals and tangents
+// within ENV_LOWRES_CONE of their mean, and t and n too. For a pixel's
+// block (env_cells_mixed) and for a grid point's block of the half grid
+// (shaders/default.wgsl cells_from_half).
+fn env_block_smooth(c0: vec2<i32>, step: i32, t: vec3<f32>, n: vec3<f32>) -> bool {
     let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
     var ok = true;
     var ns = vec3<f32>(0.0);
     var ts = vec3<f32>(0.0);
-    var d_lo = 3.4e38;
-    var d_hi = 0.0;
     var nn: array<vec3<f32>, 4>;
     var tt: array<vec3<f32>, 4>;
     for (var j = 0; j < 4; j = j + 1) {
         let c = c0 + step * vec2<i32>(j & 1, j >> 1u);
         ok = ok && c.x <= last.x && c.y <= last.y;
         let cc = min(c, last);
-        let nd = textureLoad(cells_nd, cc, 0);
         let tc = textureLoad(cells_t, cc, 0);
         ok = ok && textureLoad(cells_xyz, cc, 0).w > 0.5 && tc.w == f32(mat.cells_id);
-        nn[j] = nd.xyz;
+        nn[j] = textureLoad(cells_nd, cc, 0).xyz;
         tt[j] = tc.xyz;
-        ns = ns + nd.xyz;
-        ts = ts + tc.xyz;
-        d_lo = min(d_lo, nd.w);
-        d_hi = max(d_hi, nd.w);
+        ns = ns + nn[j];
+        ts = ts + tt[j];
     }
     let nm = ns / max(length(ns), 1e-12);
     let tm = ts / max(length(ts), 1e-12);
-    ok = ok && d_hi - d_lo <= ENV_LOWRES_DEPTH * d_lo;
     for (var j = 0; j < 4; j = j + 1) {
         ok = ok && dot(nn[j], nm) >= ENV_LOWRES_CONE && dot(tt[j], tm) >= ENV_LOWRES_CONE;
     }
-    return ok && env_same_surface(nm, 0.5 * (d_lo + d_hi), n, dist);
+    return ok && dot(n, nm) >= ENV_LOWRES_CONE && dot(t, tm) >= ENV_LOWRES_CONE;
 }
 
 // The bilinear mix at fraction f of the block of texels c0 + o, o in

@@ -16,7 +16,8 @@
 //!    raster pass ran in SIMD blocks that triangles smaller than a few grid
 //!    pixels leave mostly empty: on lavapipe it cost twice as much at a
 //!    grid of 4 on a 512 x 512 sphere (docs/LIGHTING.md "What a grid's walk
-//!    costs").
+//!    costs"). Both walks render into targets laid out in bands ([`Bands`])
+//!    and copy them back into the grid's layout.
 //! 2. The centre pass, single-sampled at the frame's size (`fs_cells_centre`):
 //!    each pixel centre takes the bilinear mix of its K x K block's corners
 //!    where they saw one smooth patch of surface (shaders/environment.wgsl
@@ -64,6 +65,85 @@ const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// walked). An eighth also covers the point past a frame whose size is not
 /// a multiple of K from 8 grid points across.
 const GRID_PAD: f64 = 0.125;
+
+/// The rows of a band of the walk targets, at the least ([`Bands`]): a
+/// multiple of the 4 x 4 pixels a CPU rasteriser shades together.
+const BAND_ROWS: u32 = 8;
+
+/// The grid's walks render into targets laid out in bands: the grid's rows
+/// cut into bands of `rows` rows, put side by side (shaders/default.wgsl
+/// `band_point`, `Globals::cells_band`), then copied back into the grid's
+/// layout ([`Bands::unband`]). A CPU rasteriser (lavapipe) shares a pass
+/// among its threads by tiles of 64 x 64 pixels: the half grid of a 512 x
+/// 512 frame (65 x 65 points) was one tile and three slivers, so one
+/// thread walked it all (on 2 cores it cost as much as on 1, 5.6 s of an
+/// 11.3 s frame, docs/LIGHTING.md "The walks' layout"). In bands of 8 rows
+/// the same points are 10 tiles of 64 x 8. The rows double from
+/// [`BAND_ROWS`] until the strip fits the device's widest texture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Bands {
+    /// Rows of one band.
+    pub(super) rows: u32,
+}
+
+impl Bands {
+    /// The bands of a grid `size` points, for a device whose textures are
+    /// at most `max` texels wide.
+    pub(super) fn new(size: [u32; 2], max: u32) -> Bands {
+        let mut rows = BAND_ROWS;
+        while rows < size[1] && size[0] * size[1].div_ceil(rows) > max {
+            rows *= 2;
+        }
+        Bands { rows }
+    }
+
+    /// The size of the banded target of a grid `size` points.
+    fn strip(self, size: [u32; 2]) -> [u32; 2] {
+        [
+            size[0] * size[1].div_ceil(self.rows),
+            self.rows.min(size[1]),
+        ]
+    }
+
+    /// Copy the bands of `strip` back into the grid's layout in `grid`
+    /// (`size` points).
+    fn unband(
+        self,
+        enc: &mut wgpu::CommandEncoder,
+        strip: &wgpu::TextureView,
+        grid: &wgpu::TextureView,
+        size: [u32; 2],
+    ) {
+        for b in 0..size[1].div_ceil(self.rows) {
+            let at = |texture, x, y| wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x, y, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            };
+            enc.copy_texture_to_texture(
+                at(strip.texture(), b * size[0], 0),
+                at(grid.texture(), 0, b * self.rows),
+                wgpu::Extent3d {
+                    width: size[0],
+                    height: self.rows.min(size[1] - b * self.rows),
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+    }
+}
+
+/// The grid's size in points for a `w x h` frame at rate `rate` > 1: the
+/// frame's pixel corners 0, K, 2K, ... up to and past the last pixel.
+fn grid_size(rate: u32, w: u32, h: u32) -> [u32; 2] {
+    [w.div_ceil(rate) + 1, h.div_ceil(rate) + 1]
+}
+
+/// The half grid's size for a grid `size` points: its even points.
+fn half_size(size: [u32; 2]) -> [u32; 2] {
+    [size[0].div_ceil(2), size[1].div_ceil(2)]
+}
 
 /// The centre pass's XYZ: used as it is (not interpolated), so in 32-bit
 /// floats like the frame's own walk.
@@ -115,16 +195,22 @@ pub fn default_cells_rate(patch_m: f64) -> u32 {
 
 /// The coarse grid's targets (rate K > 1).
 struct Coarse {
+    /// The grid's size in points, and its bands.
+    size: [u32; 2],
+    bands: Bands,
     /// The raster pass's view with the mark (fs_cells).
     xyz: wgpu::TextureView,
-    /// The walk's XYZ (fs_cells_walk), what the centre pass reads.
+    /// The walk's XYZ (fs_cells_walk) in bands, and in the grid's layout
+    /// (what the centre pass reads).
+    strip: wgpu::TextureView,
     walked: wgpu::TextureView,
     /// Bind group 0 of the walk: the raster pass's targets and the half
     /// grid's XYZ (a stand-in without it).
     walk_bind: wgpu::BindGroup,
-    /// The half grid's XYZ and the bind group of its walk (the raster
-    /// pass's targets), with [`CellsRate`]'s half grid.
-    half: Option<(wgpu::TextureView, wgpu::BindGroup)>,
+    /// The half grid's XYZ in bands and in the half grid's layout, and the
+    /// bind group of its walk (the raster pass's targets), with
+    /// [`CellsRate`]'s half grid.
+    half: Option<(wgpu::TextureView, wgpu::TextureView, wgpu::BindGroup)>,
     nd: wgpu::TextureView,
     t: wgpu::TextureView,
     depth: wgpu::TextureView,
@@ -155,6 +241,8 @@ struct Grid {
 /// last frame size.
 pub(super) struct CellsRate {
     rate: u32,
+    /// The device's widest 2D texture (texels).
+    max_width: u32,
     /// The grid's passes (rate K > 1).
     coarse: Option<CoarsePipelines>,
     /// The centre pass and its full-screen walk.
@@ -232,6 +320,17 @@ pub(super) fn global_bind(
 }
 
 fn target(gpu: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::TextureView {
+    target_for(gpu, [w, h], format, wgpu::TextureUsages::TEXTURE_BINDING)
+}
+
+/// A target `size` texels that is also used as `usage`.
+fn target_for(
+    gpu: &Gpu,
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::TextureView {
+    let [w, h] = size;
     gpu.device
         .create_texture(&wgpu::TextureDescriptor {
             label: Some("cells grid"),
@@ -244,7 +343,7 @@ fn target(gpu: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Textu
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
             view_formats: &[],
         })
         .create_view(&Default::default())
@@ -306,7 +405,10 @@ impl CellsRate {
                 layouts,
                 &[XYZ_FORMAT],
                 &Technique {
-                    constants: vec![("SB_WALK_FROM_HALF", f64::from(u8::from(half)))],
+                    constants: vec![
+                        ("SB_WALK_FROM_HALF", f64::from(u8::from(half))),
+                        ("SB_WALK_BANDED", 1.0),
+                    ],
                     ..pass("diffraction.wgsl cells grid walk", "fs_cells_walk")
                 },
             )?;
@@ -348,6 +450,7 @@ impl CellsRate {
         );
         Ok(CellsRate {
             rate,
+            max_width: device.limits().max_texture_dimension_2d,
             coarse,
             centre,
             pre_bind,
@@ -359,6 +462,16 @@ impl CellsRate {
     /// The grid spacing K.
     pub(super) fn rate(&self) -> u32 {
         self.rate
+    }
+
+    /// The rows of a band of the walk targets for a `w x h` frame
+    /// (`Globals::cells_band`); 0 without a grid.
+    pub(super) fn band_rows(&self, w: u32, h: u32) -> u32 {
+        if self.rate > 1 {
+            Bands::new(grid_size(self.rate, w, h), self.max_width).rows
+        } else {
+            0
+        }
     }
 
     /// Whether the grid mixes from the half grid.
@@ -380,10 +493,11 @@ impl CellsRate {
         if grid.as_ref().is_some_and(|g| g.full == [w, h]) {
             return;
         }
-        // Grid points at the frame's pixel corners 0, K, 2K, ... up to and
-        // past the last pixel.
+        let copied = |size, usage| target_for(gpu, size, XYZ_FORMAT, usage);
         let coarse = (self.rate > 1).then(|| {
-            let (gw, gh) = (w.div_ceil(self.rate) + 1, h.div_ceil(self.rate) + 1);
+            let size = grid_size(self.rate, w, h);
+            let bands = Bands::new(size, self.max_width);
+            let [gw, gh] = size;
             let xyz = target(gpu, gw, gh, FRAME_FORMAT);
             let nd = target(gpu, gw, gh, FRAME_FORMAT);
             let t = target(gpu, gw, gh, FRAME_FORMAT);
@@ -402,14 +516,25 @@ impl CellsRate {
                 .as_ref()
                 .is_some_and(|p| p.half.is_some())
                 .then(|| {
-                    let view = target(gpu, gw.div_ceil(2), gh.div_ceil(2), XYZ_FORMAT);
+                    let hs = half_size(size);
+                    let strip = copied(bands.strip(hs), wgpu::TextureUsages::COPY_SRC);
+                    let view = copied(
+                        hs,
+                        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                    );
                     let walk_bind = bind(&self.stand_in);
-                    (view, walk_bind)
+                    (strip, view, walk_bind)
                 });
-            let walk_bind = bind(half.as_ref().map_or(&self.stand_in, |(v, _)| v));
+            let walk_bind = bind(half.as_ref().map_or(&self.stand_in, |(_, v, _)| v));
             Coarse {
+                size,
+                bands,
                 xyz,
-                walked: target(gpu, gw, gh, XYZ_FORMAT),
+                strip: copied(bands.strip(size), wgpu::TextureUsages::COPY_SRC),
+                walked: copied(
+                    size,
+                    wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                ),
                 walk_bind,
                 half,
                 nd,
@@ -528,10 +653,10 @@ impl CellsRate {
             rp.set_bind_group(0, &self.pre_bind, &[]);
             draw(&mut rp);
             drop(rp);
-            if let (Some((view, bind)), Some(half)) = (&c.half, &p.half) {
+            if let (Some((strip, view, bind)), Some(half)) = (&c.half, &p.half) {
                 let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("cells half grid walk"),
-                    color_attachments: &[clear(view)],
+                    color_attachments: &[clear(strip)],
                     depth_stencil_attachment: None,
                     timestamp_writes: None,
                     occlusion_query_set: None,
@@ -540,10 +665,12 @@ impl CellsRate {
                 rp.set_pipeline(half);
                 rp.set_bind_group(0, bind, &[]);
                 draw_full(&mut rp);
+                drop(rp);
+                c.bands.unband(enc, strip, view, half_size(c.size));
             }
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("cells grid walk"),
-                color_attachments: &[clear(&c.walked)],
+                color_attachments: &[clear(&c.strip)],
                 depth_stencil_attachment: None,
                 timestamp_writes: None,
                 occlusion_query_set: None,
@@ -552,6 +679,8 @@ impl CellsRate {
             rp.set_pipeline(&p.walk);
             rp.set_bind_group(0, &c.walk_bind, &[]);
             draw_full(&mut rp);
+            drop(rp);
+            c.bands.unband(enc, &c.strip, &c.walked, c.size);
         }
         {
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -599,7 +728,7 @@ impl CellsRate {
 
 #[cfg(test)]
 mod tests {
-    use super::{default_cells_rate, half_grid};
+    use super::{default_cells_rate, half_grid, Bands, BAND_ROWS};
 
     /// The sizes measured against converged references ([`super::FINE_GRID_PATCH_M`])
     /// take the grid that was measured as good as every pixel there.
@@ -608,6 +737,30 @@ mod tests {
         for (patch_um, rate) in [(5.12, 4), (20.48, 4), (30.72, 4), (40.96, 2), (81.92, 2)] {
             assert_eq!(default_cells_rate(patch_um * 1e-6), rate, "{patch_um} um");
         }
+    }
+
+    /// A strip of bands holds every row of the grid, fits the widest
+    /// texture, and keeps the rows a multiple of the rasteriser's 4 x 4
+    /// blocks; a grid that fits in one band keeps its layout.
+    #[test]
+    fn the_bands_hold_the_grid_within_the_widest_texture() {
+        // 512 x 512 and 1920 x 1080 at K = 4 and 2, a 4k frame at K = 2,
+        // and a grid of 3 x 3 (a 8 x 8 frame at K = 4)
+        for size in [[129, 129], [481, 271], [961, 541], [1921, 1081], [3, 3]] {
+            for max in [2048, 8192, 16384] {
+                let b = Bands::new(size, max);
+                let [w, h] = b.strip(size);
+                assert!(w <= max.max(size[0]), "{size:?} {max}: {w}");
+                assert_eq!(b.rows % BAND_ROWS, 0, "{size:?} {max}");
+                assert!(h * (w / size[0]) >= size[1], "{size:?} {max}: {w} x {h}");
+                assert_eq!(w % size[0], 0, "{size:?} {max}");
+                if size[1] <= BAND_ROWS {
+                    assert_eq!([w, h], size);
+                }
+            }
+        }
+        // the half grid of a 512 x 512 frame: ten tiles of 64 x 8, not one
+        assert_eq!(Bands::new([129, 129], 8192).strip([65, 65]), [585, 8]);
     }
 
     /// The half grid at the size measured with it (5 um), not at the sizes

@@ -811,7 +811,7 @@ impl Renderer {
                 [b[0] as f32, b[1] as f32, b[2] as f32, 1.0]
             },
             n_lights: n as u32,
-            _g1: 0,
+            cells_band: self.cells.as_ref().map_or(0, |c| c.band_rows(w, h)),
             curve: match self.settings.curve {
                 ToneCurve::Clamp => 0,
                 ToneCurve::Reinhard => 1,

@@ -33,7 +33,9 @@ pub(super) struct Globals {
     pub(super) xyz_to_rgb: [[f32; 4]; 3],
     pub(super) background: [f32; 4],
     pub(super) n_lights: u32,
-    pub(super) _g1: u32,
+    /// The rows of one band of the grid's walk targets ([`super::cells_rate`]
+    /// `Bands`; 0 without a grid).
+    pub(super) cells_band: u32,
     pub(super) curve: u32,
     pub(super) output: u32,
     pub(super) exposure_scale: f32,
@@ -211,6 +213,7 @@ mod layout_tests {
                 xyz_to_rgb,
                 background,
                 n_lights,
+                cells_band,
                 curve,
                 output,
                 exposure_scale,
