@@ -194,8 +194,8 @@ fn cells_from_half(p: vec2<i32>) -> vec4<f32> {
 
 // The cells' walk, one full-screen pass per mesh after fs_cells (the grid,
 // into a target laid out in bands: its points mixed from the half grid
-// where SB_WALK_FROM_HALF and its blocks allow) and after fs_cells_centre (the pixels the grid does not
-// serve): at each point the raster pass marked, the cells' XYZ from the
+// where SB_WALK_FROM_HALF and its blocks allow) and after fs_cells_centre
+// (the pixels the grid does not serve): at each point the raster pass marked, the cells' XYZ from the
 // frame and view it wrote (bindings 2-4: its targets), so that every SIMD
 // block of the walk is full whatever the triangles' size.
 @fragment
