@@ -866,11 +866,11 @@ fn env_sun_point_plane(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, 
     if (wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    // the point's offset from the centre as a share of the disc's radius,
-    // along the disc's axes (sb_sun_disc_dir)
-    let ct = 1.0 - u * (1.0 - envg.sun_dir.w);
-    let k = sqrt(max(1.0 - ct * ct, 0.0) / max(1.0 - envg.sun_dir.w * envg.sun_dir.w, 1e-20));
-    return (gp.x + k * (cos(ph) * gp.y + sin(ph) * gp.z)) * env_sun_read(d, wi, wr, gr, o, fp);
+    // the point's offset from the centre along the disc's axes, as a share
+    // of the disc's radius (sb_sun_disc_dir: st (cos ph t + sin ph b))
+    let rad = max(sqrt(max(1.0 - envg.sun_dir.w * envg.sun_dir.w, 0.0)), 1e-10);
+    let k = vec2<f32>(dot(d, envg.sun_t.xyz), dot(d, envg.sun_b.xyz)) / rad;
+    return (gp.x + k.x * gp.y + k.y * gp.z) * env_sun_read(d, wi, wr, gr, o, fp);
 }
 
 // The sun's disc above the surface's horizon by at least this cosine (about
@@ -893,11 +893,9 @@ fn env_sun_gain_plane(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -
     if (cz < ENV_SUN_PLANE_COS) {
         return vec4<f32>(0.0);
     }
-    // the disc's edge along its axes (sb_sun_disc_dir at u = 1)
-    let ct = envg.sun_dir.w;
-    let st = sqrt(max(1.0 - ct * ct, 0.0));
-    let et = st * envg.sun_t.xyz + ct * c;
-    let eb = st * envg.sun_b.xyz + ct * c;
+    // the disc's edge along its axes
+    let et = sb_sun_disc_dir(c, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w, 1.0, 0.0);
+    let eb = sb_sun_disc_dir(c, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w, 1.0, 0.5 * ENV_PI);
     let g0 = gain(vec3<f32>(dot(c, t), dot(c, b), cz), wr);
     let gt = gain(vec3<f32>(dot(et, t), dot(et, b), dot(et, n)), wr);
     let gb = gain(vec3<f32>(dot(eb, t), dot(eb, b), dot(eb, n)), wr);
