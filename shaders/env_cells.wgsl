@@ -72,17 +72,30 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
     let view = env_cells_view(wr);
     var id = 0u;
     for (var visit = 0u; visit < n_nodes && id != ENV_CELL_NONE; visit = visit + 1u) {
-        let o = id * stride;
-        let uv = vec2<f32>(env_cell_f32(o), env_cell_f32(o + 1u));
-        let spread = env_cell_f32(o + 2u);
-        let first = env_cell_u32(o + 3u);
-        let wxy = -uv - wr.xy;
-        let l = length(wxy);
-        let dist = 1.0 - l;
-        if (first != ENV_CELL_NONE && dist < ENV_REFINE * spread) {
+        // down to the first node that does not refine (a node whose spread
+        // reaches the horizon is replaced by its children), in a loop of its
+        // own: on llvmpipe a refined node then costs this loop's body, not
+        // the leaf's ("What a branch costs on llvmpipe"); each step goes one
+        // level down. A walk counts a leaf twice against llvmpipe's loop
+        // limit (CPU_CELL_NODES in crates/sunbeam-render).
+        var o = 0u;
+        var uv = vec2<f32>(0.0);
+        var spread = 0.0;
+        var wxy = vec2<f32>(0.0);
+        var l = 0.0;
+        for (var depth = 0u; depth < n_nodes; depth = depth + 1u) {
+            o = id * stride;
+            uv = vec2<f32>(env_cell_f32(o), env_cell_f32(o + 1u));
+            spread = env_cell_f32(o + 2u);
+            wxy = -uv - wr.xy;
+            l = length(wxy);
+            let first = env_cell_u32(o + 3u);
+            if (first == ENV_CELL_NONE || 1.0 - l >= ENV_REFINE * spread) {
+                break;
+            }
             id = first;
-            continue;
         }
+        let dist = 1.0 - l;
         id = env_cell_u32(o + 4u);
         var inside = select(0.0, 1.0, dist > 0.0);
         if (spread > 0.0) {
@@ -105,47 +118,41 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         // the footprint: a disc of the area of the width's ellipse (cells::Cells::estimate)
         let omega = max(SB_TAU * sqrt(max(wq.x * wq.z - wq.y * wq.y, 0.0)) / wi.z, 1e-9);
         let c = env_prefiltered(wi.x * t + wi.y * b + wi.z * n, omega);
+        // G is read once per cell, at the rim's weighted mean or at the
+        // centroid: llvmpipe runs both sides of every branch (docs/LIGHTING.md
+        // "What a branch costs on llvmpipe"), so the rim's path and the
+        // inner one share their reads
+        let rg = env_rim_point(dist, sigma);
+        var wg = wi;
+        var k = 1.0 / wi.z;
         if (rim) {
-            // G / cos integrated across the cell (cells::rim_gain), G and
-            // the layer read where that integral puts its weight
-            let rg = env_rim_gain(dist, sigma, dir, wr, view);
-            let gr = rg.x;
-            let wz = rg.y;
-            if (!(gr > 0.0)) {
+            if (!(rg.x > 0.0)) {
                 continue;
             }
-            let lr = env_cell_layer(wz, wr.z, r, ns);
-            let mr0 = o + ENV_CELL_HEADER + lr.k0 * 9u;
-            // a cell that straddles the horizon integrates each value about
-            // its own centroid (env_cell_rim_gain, as env_cell_inside shares it)
-            let straddles_rim = inside < ENV_CELL_STRADDLE && spread > 0.0;
-            // the three bases written out: llvmpipe counts every loop
-            // iteration of an invocation ("One walk per fragment")
-            xyz = xyz + env_cell_rim_basis(o, 0u, mr0, lr.f, c[0], gr, straddles_rim, dist, sigma, dir, wr, view);
-            xyz = xyz + env_cell_rim_basis(o, 1u, mr0, lr.f, c[1], gr, straddles_rim, dist, sigma, dir, wr, view);
-            xyz = xyz + env_cell_rim_basis(o, 2u, mr0, lr.f, c[2], gr, straddles_rim, dist, sigma, dir, wr, view);
-            continue;
+            wg = vec3<f32>(dir * (1.0 - rg.z), rg.w);
+            k = rg.y;
         }
-        let gw = env_cells_gain(wi, wr, view) / wi.z;
+        let g0 = env_cells_gain(wg, wr, view);
+        let gw = g0 * k;
         if (!(gw > 0.0)) {
             continue;
         }
         let straddles = inside < ENV_CELL_STRADDLE && spread > 0.0;
-        let ly = env_cell_layer(wi.z, wr.z, r, ns);
+        // a rim cell that straddles reads each mass's G on a line through G
+        // at the cell's mean (env_rim_slope)
+        let slope = env_rim_slope(rg, sigma, dir, wr, view, g0);
+        let ly = env_cell_layer(wg.z, wr.z, r, ns);
         let m0 = o + ENV_CELL_HEADER + ly.k0 * 9u;
-        var e = vec3<f32>(0.0);
-        for (var bb = 0u; bb < 3u; bb = bb + 1u) {
-            var share = vec3<f32>(inside);
-            if (straddles) {
-                let q = o + 5u + 6u * bb;
-                share = vec3<f32>(
-                    env_cell_inside(uv, spread, vec2<f32>(env_cell_f32(q), env_cell_f32(q + 1u)), wr),
-                    env_cell_inside(uv, spread, vec2<f32>(env_cell_f32(q + 2u), env_cell_f32(q + 3u)), wr),
-                    env_cell_inside(uv, spread, vec2<f32>(env_cell_f32(q + 4u), env_cell_f32(q + 5u)), wr));
-            }
-            e = e + c[bb] * env_cell_mass(m0, bb, ly.f) * share;
+        var gc = gw * inside;
+        if (rim) {
+            gc = gw;
         }
-        xyz = xyz + gw * e;
+        // the three bases written out: llvmpipe counts every loop iteration
+        // of an invocation ("One walk per fragment")
+        let cs = EnvCellShare(o, uv, spread, dist, sigma, dir, rg.w, g0, slope, gw, gc, rim, straddles);
+        xyz = xyz + env_cell_basis(cs, 0u, m0, ly.f, c[0], wr);
+        xyz = xyz + env_cell_basis(cs, 1u, m0, ly.f, c[1], wr);
+        xyz = xyz + env_cell_basis(cs, 2u, m0, ly.f, c[2], wr);
     }
     return xyz;
 }
@@ -162,19 +169,51 @@ fn env_rim_moments(a: f32) -> vec2<f32> {
     return vec2<f32>((sqrt(hi) - sqrt(lo)) / ENV_RIM_BOX, (hi * sqrt(hi) - lo * sqrt(lo)) / (3.0 * ENV_RIM_BOX));
 }
 
-// Basis bb's XYZ of a cell at the horizon: its masses at layer mr0 (and the
-// next, mixed by fr) times the basis' coefficient cb and the rim's G / cos,
-// gr, or each mass's own (env_cell_rim_gain) when the cell straddles.
-fn env_cell_rim_basis(o: u32, bb: u32, mr0: u32, fr: f32, cb: f32, gr: f32, straddles: bool, dist: f32, sigma: f32, dir: vec2<f32>, wr: vec3<f32>, view: vec2<f32>) -> vec3<f32> {
-    var g3 = vec3<f32>(gr);
-    if (straddles) {
-        let q = o + 5u + 6u * bb;
-        g3 = vec3<f32>(
-            env_cell_rim_gain(dist, sigma, dir, vec2<f32>(env_cell_f32(q), env_cell_f32(q + 1u)), wr, view),
-            env_cell_rim_gain(dist, sigma, dir, vec2<f32>(env_cell_f32(q + 2u), env_cell_f32(q + 3u)), wr, view),
-            env_cell_rim_gain(dist, sigma, dir, vec2<f32>(env_cell_f32(q + 4u), env_cell_f32(q + 5u)), wr, view));
+// What a leaf's masses share, for env_cell_basis.
+struct EnvCellShare {
+    // the node's offset in the cells' data
+    o: u32,
+    uv: vec2<f32>,
+    spread: f32,
+    // the rim's: its distance inside the horizon, width and direction, cos
+    // at its weighted mean, G there and its slope (env_rim_slope)
+    dist: f32,
+    sigma: f32,
+    dir: vec2<f32>,
+    wz0: f32,
+    g0: f32,
+    slope: f32,
+    // G / cos, and G / cos times the share inside (the rim's integral at a rim)
+    gw: f32,
+    gc: f32,
+    rim: bool,
+    straddles: bool,
+}
+
+// Basis bb's XYZ of a leaf: its masses at layer m0 (and the next, mixed by
+// f) times the basis' coefficient cb and the leaf's G / cos and share, or,
+// when the leaf straddles the horizon, each mass's own about its own
+// centroid (env_cell_rim_gain at the rim, else env_cell_inside).
+fn env_cell_basis(cs: EnvCellShare, bb: u32, m0: u32, f: f32, cb: f32, wr: vec3<f32>) -> vec3<f32> {
+    var share = vec3<f32>(cs.gc);
+    if (cs.straddles) {
+        let q = cs.o + 5u + 6u * bb;
+        let o0 = vec2<f32>(env_cell_f32(q), env_cell_f32(q + 1u));
+        let o1 = vec2<f32>(env_cell_f32(q + 2u), env_cell_f32(q + 3u));
+        let o2 = vec2<f32>(env_cell_f32(q + 4u), env_cell_f32(q + 5u));
+        if (cs.rim) {
+            share = vec3<f32>(
+                env_cell_rim_gain(cs.dist, cs.sigma, cs.dir, o0, cs.wz0, cs.g0, cs.slope),
+                env_cell_rim_gain(cs.dist, cs.sigma, cs.dir, o1, cs.wz0, cs.g0, cs.slope),
+                env_cell_rim_gain(cs.dist, cs.sigma, cs.dir, o2, cs.wz0, cs.g0, cs.slope));
+        } else {
+            share = cs.gw * vec3<f32>(
+                env_cell_inside(cs.uv, cs.spread, o0, wr),
+                env_cell_inside(cs.uv, cs.spread, o1, wr),
+                env_cell_inside(cs.uv, cs.spread, o2, wr));
+        }
     }
-    return cb * env_cell_mass(mr0, bb, fr) * g3;
+    return cb * env_cell_mass(m0, bb, f) * share;
 }
 
 // The layer of the cells' masses at cos(theta_i) = wz (Cells::estimate's
@@ -200,28 +239,48 @@ fn env_cell_mass(m0: u32, bb: u32, f: f32) -> vec3<f32> {
     return mix(a0, a1, f);
 }
 
-// G / cos integrated across a cell at the horizon, times its share inside,
-// and cos(theta_i) where that integral puts its weight (cells::rim_gain): a
-// box of rms sigma in x = 1 - |wi_xy| about dist, cut at x = 0.
-fn env_rim_gain(dist: f32, sigma: f32, dir: vec2<f32>, wr: vec3<f32>, view: vec2<f32>) -> vec2<f32> {
+// Where G / cos integrated across a cell at the horizon puts its weight
+// (cells::rim_point): a box of rms sigma in x = 1 - |wi_xy| about dist, cut
+// at x = 0. Returns (the share inside, 0 when none; the factor that
+// multiplies G; the weighted mean x; cos(theta_i) there).
+fn env_rim_point(dist: f32, sigma: f32) -> vec4<f32> {
     let hm = env_rim_moments(dist / sigma);
     if (!(hm.x > 0.0)) {
-        return vec2<f32>(0.0);
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
     let x = min(sigma * hm.y / hm.x, 1.0);
     let d = 1.0 - x;
     let wz = max(sqrt(max(1.0 - d * d, 0.0)), 1e-6);
-    let g = env_cells_gain(vec3<f32>(dir * d, wz), wr, view) * hm.x / sqrt(2.0 * sigma) * sqrt(2.0 / (2.0 - x));
-    return vec2<f32>(g, wz);
+    return vec4<f32>(hm.x, hm.x / sqrt(2.0 * sigma) * sqrt(2.0 / (2.0 - x)), x, wz);
 }
 
-// env_rim_gain for one mass of a straddling cell, about the mass's own
-// centroid (the cell's plus `off`) with the cell's width less the offset, at
-// least a quarter of it.
-fn env_cell_rim_gain(dist: f32, sigma: f32, dir: vec2<f32>, off: vec2<f32>, wr: vec3<f32>, view: vec2<f32>) -> f32 {
+// The slope in cos(theta_i) of the line on which a straddling rim cell's
+// masses read G: through G at the cell's mean rg (env_rim_point), g0, and at
+// a quarter of the mean's x, or a width further in where the mean is within
+// a quarter width of the horizon (cells::rim_slope: why).
+fn env_rim_slope(rg: vec4<f32>, sigma: f32, dir: vec2<f32>, wr: vec3<f32>, view: vec2<f32>, g0: f32) -> f32 {
+    var x2 = min(rg.z + sigma, 1.0);
+    if (rg.z > 0.25 * sigma) {
+        x2 = 0.25 * rg.z;
+    }
+    let d2 = 1.0 - x2;
+    let wz2 = max(sqrt(max(1.0 - d2 * d2, 0.0)), 1e-6);
+    let dz = wz2 - rg.w;
+    if (!(abs(dz) > 1e-7)) {
+        return 0.0;
+    }
+    return (env_cells_gain(vec3<f32>(dir * d2, wz2), wr, view) - g0) / dz;
+}
+
+// G / cos integrated across one mass of a straddling rim cell, about the
+// mass's own centroid (the cell's plus `off`) with the cell's width less the
+// offset, at least a quarter of it; G on the line g0 + slope (wz - wz0)
+// (cells::mass_rim_gain).
+fn env_cell_rim_gain(dist: f32, sigma: f32, dir: vec2<f32>, off: vec2<f32>, wz0: f32, g0: f32, slope: f32) -> f32 {
     let po = dot(dir, off);
     let sq = sqrt(max(sigma * sigma - po * po, sigma * sigma / 16.0));
-    return env_rim_gain(dist + po, sq, dir, wr, view).x;
+    let rg = env_rim_point(dist + po, sq);
+    return max(g0 + slope * (rg.w - wz0), 0.0) * rg.y;
 }
 
 // The share of one mass inside the disc for view wr: a Gaussian about the

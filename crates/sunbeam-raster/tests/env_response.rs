@@ -629,7 +629,7 @@ fn first_frame_cells_agree_with_the_quadrature_over_views() {
 /// environment over the spread's circle instead of the width's ellipse:
 /// -1.45 % and +1.13 %; with the rim's mass as a Gaussian instead of a box
 /// (`cells::rim_moments`) -2.0 % and +1.5 %; without the rim's integral
-/// (`cells::rim_gain`: `G / cos` at the centroid times a Gaussian share
+/// (`cells::rim_point`: `G / cos` at the centroid times a Gaussian share
 /// inside) -3.7 % and +1.0 %, means 0.990 and 0.991, and more cells did not
 /// lower it (docs/LIGHTING.md "Accuracy per view").
 const CELLS_VIEW_TOL: f64 = 0.0135;

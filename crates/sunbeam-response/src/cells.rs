@@ -87,10 +87,10 @@ pub fn first_frame_top_for(manifest: &sunbeam_pack::Manifest) -> usize {
 /// Floats per node in [`Cells::gpu_data`] before its layers' masses.
 pub const GPU_HEADER: usize = 5 + 18 + 3;
 /// Leaves whose centroid lies within this many of their widths of the view's
-/// horizon take [`rim_gain`]'s integral of `G / cos` across them.
+/// horizon take [`rim_point`]'s integral of `G / cos` across them.
 pub const RIM_WIDTHS: f64 = 5.0;
 /// Leaves whose centroid lies outside the disc by less than this still count
-/// (through [`rim_gain`]): the maps' interpolation spreads their texels
+/// (through [`rim_point`]): the maps' interpolation spreads their texels
 /// across the horizon, where `1 / cos` is largest.
 pub const RIM_OUTSIDE: f64 = 0.05;
 /// Half-width of [`rim_moments`]' box in units of the cell's rms width
@@ -114,7 +114,7 @@ pub struct Cell {
     /// Per value of `mass`: its own centroid less `uv`, over all layers
     /// (`int E (uv - centroid) / int E`), at most `2 spread` long.
     pub offsets: [[f64; 2]; 9],
-    /// The cell's extent for the horizon ([`rim_gain`]): the mass-weighted
+    /// The cell's extent for the horizon ([`rim_point`]): the mass-weighted
     /// covariance of its texels' centres in `(u, v)` (uu, uv, vv) plus, on
     /// the diagonal, the maps' texel extents at the centroid, `(dr^2 +
     /// (r dtheta)^2) / 12`, over which their interpolation spreads a texel
@@ -593,22 +593,26 @@ impl Cells {
             let ck = coeffs(world(wi), omega);
             let straddles = inside < STRADDLE && c.spread > 0.0;
             if rim {
-                // G / cos integrated across the cell ([`rim_gain`]), G and the
+                // G / cos integrated across the cell ([`rim_point`]), G and the
                 // layer read where that integral puts its weight; a cell that
                 // straddles it integrates each value about its own centroid
-                // (as [`channel_inside`] shares it)
-                if let Some((gw, wz)) = rim_gain(dist, sigma, dir, wr, masking, skin) {
-                    let (k0, f) = layer(wz);
+                // (as [`channel_inside`] shares it), G on a line ([`rim_slope`])
+                if let Some(p) = rim_point(dist, sigma) {
+                    let wg = [dir[0] * (1.0 - p.x), dir[1] * (1.0 - p.x), p.wz];
+                    let g0 = masking.gain(wg, wr, skin);
+                    let slope = if straddles {
+                        rim_slope(&p, sigma, dir, wr, masking, skin, g0)
+                    } else {
+                        0.0
+                    };
+                    let (k0, f) = layer(p.wz);
                     for (bb, cb) in ck.iter().enumerate() {
                         for (a, x) in xyz.iter_mut().enumerate() {
                             let q = 3 * bb + a;
                             let g = if straddles {
-                                let off = c.offsets[q];
-                                let po = dir[0] * off[0] + dir[1] * off[1];
-                                let sq = (sigma * sigma - po * po).max(sigma * sigma / 16.0).sqrt();
-                                rim_gain(dist + po, sq, dir, wr, masking, skin).map_or(0.0, |v| v.0)
+                                mass_rim_gain(dist, sigma, dir, c.offsets[q], &p, g0, slope)
                             } else {
-                                gw
+                                g0 * p.factor
                             };
                             *x += g * cb * c.mass_at(k0, f, q);
                         }
@@ -659,35 +663,100 @@ fn rim_moments(a: f64) -> (f64, f64) {
     )
 }
 
-/// `G / cos(theta_i)` integrated across a cell near the view's horizon,
-/// times its share inside: the cell's mass along `dir` (the unit direction of
-/// its centroid's `wi_xy`) as a box of rms `sigma` in `x = 1 - |wi_xy|`
-/// about `dist` ([`rim_moments`]), cut at `x = 0`. Near the horizon `1 / cos = 1 / sqrt(x (2 -
-/// x))`; with `1 / sqrt(2 x)` the integral is `h(dist / sigma) / sqrt(2
-/// sigma)` ([`rim_moments`]), and `G`, the rest of `1 / cos` and the caller's
-/// layer are read once at the weighted mean `x = sigma h1 / h`. A midpoint
-/// rule at the centroid misses the integrable peak (-4 % to +2 % of a view's
-/// Y on the 5 um pack; docs/LIGHTING.md "Accuracy per view"). Returns the
-/// factor and `cos(theta_i)` at that mean, or none when nothing is inside.
-fn rim_gain(
-    dist: f64,
-    sigma: f64,
-    dir: [f64; 2],
-    wr: [f64; 3],
-    masking: Masking,
-    skin: gain::Material,
-) -> Option<(f64, f64)> {
+/// Where `G / cos(theta_i)` integrated across a cell near the view's horizon
+/// puts its weight, times its share inside: the cell's mass along `dir`
+/// (the unit direction of its centroid's `wi_xy`) as a box of rms `sigma` in
+/// `x = 1 - |wi_xy|` about `dist` ([`rim_moments`]), cut at `x = 0`. Near
+/// the horizon `1 / cos = 1 / sqrt(x (2 - x))`; with `1 / sqrt(2 x)` the
+/// integral is `h(dist / sigma) / sqrt(2 sigma)` ([`rim_moments`]), and `G`,
+/// the rest of `1 / cos` and the caller's layer are read once at the
+/// weighted mean `x = sigma h1 / h`. A midpoint rule at the centroid misses
+/// the integrable peak (-4 % to +2 % of a view's Y on the 5 um pack;
+/// docs/LIGHTING.md "Accuracy per view"). None when nothing is inside. As
+/// shaders/env_cells.wgsl `env_rim_point`.
+fn rim_point(dist: f64, sigma: f64) -> Option<RimPoint> {
     let (h, h1) = rim_moments(dist / sigma);
     // zero (or NaN from a NaN width) means nothing of the cell is inside
     if h.is_nan() || h <= 0.0 {
         return None;
     }
     let x = (sigma * h1 / h).min(1.0);
+    Some(RimPoint {
+        factor: h / (2.0 * sigma).sqrt() * (2.0 / (2.0 - x)).sqrt(),
+        x,
+        wz: rim_cos(x),
+    })
+}
+
+/// [`rim_point`]'s result: `G / cos` integrated is `G(x) factor`.
+struct RimPoint {
+    /// What multiplies `G` read at `x`.
+    factor: f64,
+    /// The weighted mean of `x = 1 - |wi_xy|`.
+    x: f64,
+    /// `cos(theta_i)` there.
+    wz: f64,
+}
+
+/// `cos(theta_i)` at `x = 1 - |wi_xy|`, at least 1e-6.
+fn rim_cos(x: f64) -> f64 {
     let d = 1.0 - x;
-    let wz = (1.0 - d * d).max(0.0).sqrt().max(1e-6);
-    let wi = [dir[0] * d, dir[1] * d, wz];
-    let factor = h / (2.0 * sigma).sqrt() * (2.0 / (2.0 - x)).sqrt();
-    Some((masking.gain(wi, wr, skin) * factor, wz))
+    (1.0 - d * d).max(0.0).sqrt().max(1e-6)
+}
+
+/// The slope in `cos(theta_i)` of the line on which the values of a rim
+/// cell that straddles the horizon read `G` ([`mass_rim_gain`]): through
+/// `G` at the cell's weighted mean `p` (`g0`) and at a second point along
+/// `dir`, at a quarter of the mean's `x` (towards the horizon, where a
+/// straddling cell's values mostly lie and the masking takes `G` down), or,
+/// where the mean is within a quarter width of the horizon, a width further
+/// in. Two reads of `G` per cell instead of one per value: on llvmpipe every
+/// leaf the walk reads pays for all of them (docs/LIGHTING.md "What a
+/// branch costs on llvmpipe"). The 20 um synthetic pack, Smith masking, views
+/// 0.02-0.6 from grazing, white map, per point against the quadrature
+/// (benches/cells.rs): CIEDE2000 p99 2.40 against 2.73 with each value's own
+/// `G` (a secant half a width further in: 3.18); the thesis patch 0.32
+/// against 0.26. As shaders/env_cells.wgsl `env_rim_slope`.
+fn rim_slope(
+    p: &RimPoint,
+    sigma: f64,
+    dir: [f64; 2],
+    wr: [f64; 3],
+    masking: Masking,
+    skin: gain::Material,
+    g0: f64,
+) -> f64 {
+    let x2 = if p.x > 0.25 * sigma {
+        0.25 * p.x
+    } else {
+        (p.x + sigma).min(1.0)
+    };
+    let d2 = 1.0 - x2;
+    let wz2 = rim_cos(x2);
+    let dz = wz2 - p.wz;
+    if dz.is_nan() || dz.abs() <= 1e-7 {
+        return 0.0;
+    }
+    let g2 = masking.gain([dir[0] * d2, dir[1] * d2, wz2], wr, skin);
+    (g2 - g0) / dz
+}
+
+/// `G / cos` integrated across one value of a straddling rim cell, about the
+/// value's own centroid (the cell's plus `off`) with the cell's width less
+/// the offset, at least a quarter of it; `G` on the line through `g0` at
+/// `p` ([`rim_slope`]). As shaders/env_cells.wgsl `env_cell_rim_gain`.
+fn mass_rim_gain(
+    dist: f64,
+    sigma: f64,
+    dir: [f64; 2],
+    off: [f64; 2],
+    p: &RimPoint,
+    g0: f64,
+    slope: f64,
+) -> f64 {
+    let po = dir[0] * off[0] + dir[1] * off[1];
+    let sq = (sigma * sigma - po * po).max(sigma * sigma / 16.0).sqrt();
+    rim_point(dist + po, sq).map_or(0.0, |m| (g0 + slope * (m.wz - p.wz)).max(0.0) * m.factor)
 }
 
 /// A cell whose share inside the disc is below this straddles the horizon:

@@ -43,9 +43,12 @@ pub(super) type BuiltMaps = Vec<(*const Pack, Arc<crate::env::EnvMaps>)>;
 pub(crate) const CPU_LOOP_LIMIT: usize = 65_535;
 
 /// Cells' nodes above which a CPU rasteriser may cut a walk: a grazing view
-/// refines most of the tree, and the invocation's other loops (lights, MSAA
-/// samples, hot spots) take their share of [`CPU_LOOP_LIMIT`].
-pub(crate) const CPU_CELL_NODES: usize = 60_000;
+/// refines most of the tree, a walk counts up to two iterations per node
+/// (each leaf's and each step of the descent to it: shaders/env_cells.wgsl
+/// `env_cells`, docs/LIGHTING.md "What a branch costs on llvmpipe"), and the
+/// invocation's other loops (lights, MSAA samples, hot spots) take their
+/// share of [`CPU_LOOP_LIMIT`].
+pub(crate) const CPU_CELL_NODES: usize = 30_000;
 
 /// The extended-light maps of `pack` (meshes[`mi`], read from `path`) under
 /// `env` on the GPU, once per pack (`built`; [`response`] reads or builds
