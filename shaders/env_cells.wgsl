@@ -249,9 +249,13 @@ fn env_rim_point(dist: f32, sigma: f32) -> vec4<f32> {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
     let x = min(sigma * hm.y / hm.x, 1.0);
+    return vec4<f32>(hm.x, hm.x / sqrt(2.0 * sigma) * sqrt(2.0 / (2.0 - x)), x, env_rim_cos(x));
+}
+
+// cos(theta_i) at x = 1 - |wi_xy|, at least 1e-6 (cells::rim_cos).
+fn env_rim_cos(x: f32) -> f32 {
     let d = 1.0 - x;
-    let wz = max(sqrt(max(1.0 - d * d, 0.0)), 1e-6);
-    return vec4<f32>(hm.x, hm.x / sqrt(2.0 * sigma) * sqrt(2.0 / (2.0 - x)), x, wz);
+    return max(sqrt(max(1.0 - d * d, 0.0)), 1e-6);
 }
 
 // The slope in cos(theta_i) of the line on which a straddling rim cell's
@@ -263,13 +267,12 @@ fn env_rim_slope(rg: vec4<f32>, sigma: f32, dir: vec2<f32>, wr: vec3<f32>, view:
     if (rg.z > 0.25 * sigma) {
         x2 = 0.25 * rg.z;
     }
-    let d2 = 1.0 - x2;
-    let wz2 = max(sqrt(max(1.0 - d2 * d2, 0.0)), 1e-6);
+    let wz2 = env_rim_cos(x2);
     let dz = wz2 - rg.w;
     if (!(abs(dz) > 1e-7)) {
         return 0.0;
     }
-    return (env_cells_gain(vec3<f32>(dir * d2, wz2), wr, view) - g0) / dz;
+    return (env_cells_gain(vec3<f32>(dir * (1.0 - x2), wz2), wr, view) - g0) / dz;
 }
 
 // G / cos integrated across one mass of a straddling rim cell, about the
