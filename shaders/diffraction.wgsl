@@ -173,7 +173,7 @@ fn skin() -> SbSkin {
 // ---------------------------------------------------------------- colour
 // The mesh's gain with its masking, G G2 (sunbeam_optics::masking::Masking::gain).
 fn gain(wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    return sb_gain(wi, wr, skin()) * masking(wi, wr);
+    return sb_gain_masked(wi, wr, skin());
 }
 
 // The mesh's Smith masking G2 (1 when off).

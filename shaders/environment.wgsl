@@ -860,46 +860,20 @@ fn env_sun_read(d: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>, gr: SbGrid, o: vec2<
 
 // As env_sun_point_fp, with G and the masking from the disc's plane gp
 // (env_sun_gain_plane).
-fn env_sun_point_plane(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: SbGrid, u: f32, ph: f32, o: vec2<f32>, fp: EnvFootprint, gp: vec3<f32>) -> vec3<f32> {
+fn env_sun_point_plane(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: SbGrid, u: f32, ph: f32, o: vec2<f32>, fp: EnvFootprint, gp: vec4<f32>) -> vec3<f32> {
     let d = sb_sun_disc_dir(envg.sun_dir.xyz, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w, u, ph);
     let wi = vec3<f32>(dot(d, t), dot(d, b), dot(d, n));
     if (wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    // the point's offset from the centre along the disc's axes, as a share
-    // of the disc's radius (sb_sun_disc_dir: st (cos ph t + sin ph b))
-    let rad = max(sqrt(max(1.0 - envg.sun_dir.w * envg.sun_dir.w, 0.0)), 1e-10);
-    let k = vec2<f32>(dot(d, envg.sun_t.xyz), dot(d, envg.sun_b.xyz)) / rad;
-    return (gp.x + k.x * gp.y + k.y * gp.z) * env_sun_read(d, wi, wr, gr, o, fp);
+    return sb_sun_gain_at(gp, d, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w) * env_sun_read(d, wi, wr, gr, o, fp);
 }
 
-// The sun's disc above the surface's horizon by at least this cosine (about
-// 6 degrees, 20 radii of the disc) takes G and the masking from their plane
-// over the disc (env_sun_gain_plane).
-const ENV_SUN_PLANE_COS: f32 = 0.1;
-
-// G and the masking over the sun's disc to first order about its centre,
-// for frame (t, b, n) and local view wr: (G at the centre, its change from
-// the centre to the disc's edge along the disc's t, and along its b, 1)
-// where the centre is at least ENV_SUN_PLANE_COS above the horizon, else 0
-// (each point takes its own). Three evaluations of G for the disc's 16
-// points: G was most of the sun's cost (1.0 of its 1.2 s on a 512 x 512
-// sky-lit sphere on lavapipe, docs/LIGHTING.md "The sun's gain over its
-// disc"). G is smooth on the disc's 0.27 degrees away from the horizon;
-// what the plane leaves out is second order in that radius.
+// The sky's sun's plane of G over its disc for frame (t, b, n) and local
+// view wr (sun_gain.wgsl sb_sun_gain_plane): w 1 where the disc is at least
+// SB_SUN_PLANE_COS above the horizon, else 0.
 fn env_sun_gain_plane(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec4<f32> {
-    let c = envg.sun_dir.xyz;
-    let cz = dot(c, n);
-    if (cz < ENV_SUN_PLANE_COS) {
-        return vec4<f32>(0.0);
-    }
-    // the disc's edge along its axes
-    let et = sb_sun_disc_dir(c, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w, 1.0, 0.0);
-    let eb = sb_sun_disc_dir(c, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w, 1.0, 0.5 * ENV_PI);
-    let g0 = gain(vec3<f32>(dot(c, t), dot(c, b), cz), wr);
-    let gt = gain(vec3<f32>(dot(et, t), dot(et, b), dot(et, n)), wr);
-    let gb = gain(vec3<f32>(dot(eb, t), dot(eb, b), dot(eb, n)), wr);
-    return vec4<f32>(g0, gt - g0, gb - g0, 1.0);
+    return sb_sun_gain_plane(envg.sun_dir.xyz, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w, t, b, n, wr, skin());
 }
 
 // The first-frame estimator's sun: the mean over SB_SUN_POINTS points of
@@ -929,22 +903,21 @@ fn env_sun_disc(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, gr: SbG
         }
         return e / SB_SUN_POINTS;
     }
-    let g = gp.xyz;
-    var s = env_sun_point_plane(t, b, n, wr, gr, 0.5 / SB_SUN_POINTS, r, sb_sun_pixel_offset(0u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 1.5 / SB_SUN_POINTS, r + 1.0 * SB_GOLDEN, sb_sun_pixel_offset(1u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 2.5 / SB_SUN_POINTS, r + 2.0 * SB_GOLDEN, sb_sun_pixel_offset(2u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 3.5 / SB_SUN_POINTS, r + 3.0 * SB_GOLDEN, sb_sun_pixel_offset(3u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 4.5 / SB_SUN_POINTS, r + 4.0 * SB_GOLDEN, sb_sun_pixel_offset(4u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 5.5 / SB_SUN_POINTS, r + 5.0 * SB_GOLDEN, sb_sun_pixel_offset(5u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 6.5 / SB_SUN_POINTS, r + 6.0 * SB_GOLDEN, sb_sun_pixel_offset(6u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 7.5 / SB_SUN_POINTS, r + 7.0 * SB_GOLDEN, sb_sun_pixel_offset(7u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 8.5 / SB_SUN_POINTS, r + 8.0 * SB_GOLDEN, sb_sun_pixel_offset(8u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 9.5 / SB_SUN_POINTS, r + 9.0 * SB_GOLDEN, sb_sun_pixel_offset(9u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 10.5 / SB_SUN_POINTS, r + 10.0 * SB_GOLDEN, sb_sun_pixel_offset(10u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 11.5 / SB_SUN_POINTS, r + 11.0 * SB_GOLDEN, sb_sun_pixel_offset(11u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 12.5 / SB_SUN_POINTS, r + 12.0 * SB_GOLDEN, sb_sun_pixel_offset(12u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 13.5 / SB_SUN_POINTS, r + 13.0 * SB_GOLDEN, sb_sun_pixel_offset(13u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 14.5 / SB_SUN_POINTS, r + 14.0 * SB_GOLDEN, sb_sun_pixel_offset(14u), fp, g);
-    s = s + env_sun_point_plane(t, b, n, wr, gr, 15.5 / SB_SUN_POINTS, r + 15.0 * SB_GOLDEN, sb_sun_pixel_offset(15u), fp, g);
+    var s = env_sun_point_plane(t, b, n, wr, gr, 0.5 / SB_SUN_POINTS, r, sb_sun_pixel_offset(0u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 1.5 / SB_SUN_POINTS, r + 1.0 * SB_GOLDEN, sb_sun_pixel_offset(1u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 2.5 / SB_SUN_POINTS, r + 2.0 * SB_GOLDEN, sb_sun_pixel_offset(2u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 3.5 / SB_SUN_POINTS, r + 3.0 * SB_GOLDEN, sb_sun_pixel_offset(3u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 4.5 / SB_SUN_POINTS, r + 4.0 * SB_GOLDEN, sb_sun_pixel_offset(4u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 5.5 / SB_SUN_POINTS, r + 5.0 * SB_GOLDEN, sb_sun_pixel_offset(5u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 6.5 / SB_SUN_POINTS, r + 6.0 * SB_GOLDEN, sb_sun_pixel_offset(6u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 7.5 / SB_SUN_POINTS, r + 7.0 * SB_GOLDEN, sb_sun_pixel_offset(7u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 8.5 / SB_SUN_POINTS, r + 8.0 * SB_GOLDEN, sb_sun_pixel_offset(8u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 9.5 / SB_SUN_POINTS, r + 9.0 * SB_GOLDEN, sb_sun_pixel_offset(9u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 10.5 / SB_SUN_POINTS, r + 10.0 * SB_GOLDEN, sb_sun_pixel_offset(10u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 11.5 / SB_SUN_POINTS, r + 11.0 * SB_GOLDEN, sb_sun_pixel_offset(11u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 12.5 / SB_SUN_POINTS, r + 12.0 * SB_GOLDEN, sb_sun_pixel_offset(12u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 13.5 / SB_SUN_POINTS, r + 13.0 * SB_GOLDEN, sb_sun_pixel_offset(13u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 14.5 / SB_SUN_POINTS, r + 14.0 * SB_GOLDEN, sb_sun_pixel_offset(14u), fp, gp);
+    s = s + env_sun_point_plane(t, b, n, wr, gr, 15.5 / SB_SUN_POINTS, r + 15.0 * SB_GOLDEN, sb_sun_pixel_offset(15u), fp, gp);
     return s / SB_SUN_POINTS;
 }

@@ -174,7 +174,8 @@ fn sunbeam_shade_environment_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>,
 // (the sun's spectrum: a white light tinted by its RGB would not do, a
 // diffraction colour is nearly monochromatic), averaged over SB_SUN_POINTS
 // points of the disc of solid angle sun_rgb.w about wi as the player's first
-// frame does (0: the point wi alone), plus the base lit by the disc, dw *
+// frame does, G from its plane over the disc where the disc is at least
+// SB_SUN_PLANE_COS above the horizon (0: the point wi alone), plus the base lit by the disc, dw *
 // base * Omega L cos (1 - F) / pi at wi. 0 without a sun.
 fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     return sunbeam_shade_sun_footprint(t, b, n, wi, wr, env_no_footprint());
@@ -197,11 +198,20 @@ fn sunbeam_shade_sun_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec
         let gr = env_map_grid(sunbeam_env.sun_grid);
         if (sunbeam_env.sun_rgb.w > 0.0) {
             let df = sunbeam_sun_disc_frame(wi);
+            // G from its plane over the disc well above the horizon, as the
+            // player's first frame (sun_gain.wgsl)
+            let cos_cap = 1.0 - sunbeam_env.sun_rgb.w / SB_TAU;
+            let gp = sb_sun_gain_plane(wi, df[0], df[1], cos_cap, t, b, n, wr_l, skin);
             for (var i = 0u; i < u32(SB_SUN_POINTS); i = i + 1u) {
                 let d = sunbeam_sun_point_in(df, i);
                 let o = sb_sun_pixel_offset(i);
                 let shift = o.x * env_footprint_dx(d, fp) + o.y * env_footprint_dy(d, fp);
-                diff = diff + env_sun_at(vec3<f32>(dot(d, t), dot(d, b), dot(d, n)), wr_l, skin, gr, shift);
+                let wi_l = vec3<f32>(dot(d, t), dot(d, b), dot(d, n));
+                if (gp.w > 0.5) {
+                    diff = diff + env_sun_map_at(wi_l, wr_l, gr, shift) * sb_sun_gain_at(gp, d, df[0], df[1], cos_cap);
+                } else {
+                    diff = diff + env_sun_at(wi_l, wr_l, skin, gr, shift);
+                }
             }
             diff = diff / SB_SUN_POINTS;
         } else {
@@ -307,10 +317,15 @@ fn env_sun_point_diffraction(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, d: vec3<f
 // `shift` (a place in the pixel's footprint), times G and the masking (XYZ;
 // 0 for a direction below the horizon).
 fn env_sun_at(wi: vec3<f32>, wr: vec3<f32>, skin: SbSkin, gr: SbGrid, shift: vec3<f32>) -> vec3<f32> {
+    return env_sun_map_at(wi, wr, gr, shift) * sb_gain_masked(wi, wr, skin);
+}
+
+// The sun's map alone at local wi, wr and shift (env_sun_at without G; 0 for
+// a direction below the horizon).
+fn env_sun_map_at(wi: vec3<f32>, wr: vec3<f32>, gr: SbGrid, shift: vec3<f32>) -> vec3<f32> {
     if (wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
     let at = sb_resp_uvw(sb_resp_coords(-wi - wr + shift, gr), gr);
-    let e = textureSampleLevel(env_sun_map, resp_smp, at, 0.0).xyz;
-    return e * sb_gain(wi, wr, skin) * sb_masking(wi, wr, skin.slope);
+    return textureSampleLevel(env_sun_map, resp_smp, at, 0.0).xyz;
 }

@@ -139,6 +139,12 @@ fn sb_masking(wi: vec3<f32>, wr: vec3<f32>, slope: vec2<f32>) -> f32 {
     return sb_masking_with(wi, wr.z, sb_smith_lambda(wr, slope), slope);
 }
 
+// G with the masking, G G2 (sunbeam_optics::masking::Masking::gain): what
+// light from wi sends towards wr, before the response.
+fn sb_gain_masked(wi: vec3<f32>, wr: vec3<f32>, skin: SbSkin) -> f32 {
+    return sb_gain(wi, wr, skin) * sb_masking(wi, wr, skin.slope);
+}
+
 // sb_masking with the view's Lambda given (lambda_r = sb_smith_lambda(wr,
 // slope)): a sum over many wi at one view computes it once.
 fn sb_masking_with(wi: vec3<f32>, cos_r: f32, lambda_r: f32, slope: vec2<f32>) -> f32 {

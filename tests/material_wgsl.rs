@@ -11,14 +11,13 @@
 
 mod gpu;
 
-use gpu::gpu;
+use gpu::{compute, gpu};
 use sunbeam_common::rng::SplitMix64;
 use sunbeam_optics::energy::EnergyBound;
 use sunbeam_optics::gain::{self, Material, Reflectance};
 use sunbeam_optics::masking::Masking;
 use sunbeam_render::renderer::MATERIAL_WGSL;
 use sunbeam_render::Gpu;
-use wgpu::util::DeviceExt;
 
 /// Random cases besides the fixed ones.
 const RANDOM: usize = 12_000;
@@ -45,16 +44,7 @@ struct Out {
     n: vec4<f32>,
 };
 
-@group(0) @binding(0) var<storage, read> cases: array<Case>;
-@group(0) @binding(1) var<storage, read_write> outs: array<Out>;
-
-@compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
-    if (i >= arrayLength(&cases)) {
-        return;
-    }
-    let c = cases[i];
+fn run_case(c: Case) -> Out {
     let skin = SbSkin(c.skin.x, c.skin.y, c.skin.zw, c.energy);
     let f = sb_frame(c.normal.xyz, c.tangent.xyz);
     var o: Out;
@@ -67,7 +57,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     o.t = vec4<f32>(f[0], 0.0);
     o.b = vec4<f32>(f[1], 0.0);
     o.n = vec4<f32>(f[2], 0.0);
-    outs[i] = o;
+    return o;
 }
 "#;
 
@@ -200,74 +190,12 @@ fn cases() -> Vec<Case> {
 }
 
 fn run(gpu: &Gpu, cases: &[Case]) -> Vec<Out> {
-    let device = &gpu.device;
-    let src = format!("{MATERIAL_WGSL}\n{ENTRY}");
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("material test"),
-        source: wgpu::ShaderSource::Wgsl(src.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("material test"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    if let Some(e) = pollster::block_on(scope.pop()) {
-        panic!("the material's compute pipeline: {e}");
-    }
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("cases"),
-        contents: bytemuck::cast_slice(cases),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (cases.len() * std::mem::size_of::<Out>()) as u64;
-    let output = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("outs"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("material test"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: input.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: output.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(cases.len().div_ceil(64) as u32, 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&output, 0, &readback, 0, size);
-    gpu.queue.submit([enc.finish()]);
-    let (tx, rx) = std::sync::mpsc::channel();
-    readback.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
-    gpu.wait().unwrap();
-    rx.recv().unwrap().unwrap();
-    gpu.take_errors().unwrap();
-    let data = readback.get_mapped_range(..).unwrap();
-    bytemuck::cast_slice::<u8, Out>(&data).to_vec()
+    compute(
+        gpu,
+        "material test",
+        &format!("{MATERIAL_WGSL}\n{ENTRY}"),
+        cases,
+    )
 }
 
 /// The worst relative error of one quantity, and how many values it checked.

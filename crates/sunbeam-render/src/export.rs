@@ -24,6 +24,7 @@ pub const SOURCE: &str = concat!(
     include_str!("../../../shaders/scales.wgsl"),
     include_str!("../../../shaders/export_scales.wgsl"),
     include_str!("../../../shaders/env_table.wgsl"),
+    include_str!("../../../shaders/sun_gain.wgsl"),
     include_str!("../../../shaders/export_env.wgsl"),
     include_str!("../../../shaders/env_cells.wgsl"),
     include_str!("../../../shaders/env_hotspots.wgsl")

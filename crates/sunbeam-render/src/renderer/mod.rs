@@ -62,7 +62,8 @@ use wgpu::util::DeviceExt;
 /// material functions (shaders/material.wgsl: Fresnel, G, masking, the
 /// diffuse base's share, the frame), the response-map material
 /// (shaders/response_map.wgsl; both also what `--export-shader` translates),
-/// the scale maps' frame (shaders/scales.wgsl), the shared shading
+/// the scale maps' frame (shaders/scales.wgsl), the environment's table and
+/// the sun's disc (shaders/env_table.wgsl, shaders/sun_gain.wgsl), the shared shading
 /// (shaders/diffraction.wgsl), the technique's file, and the environment's
 /// estimators (shaders/environment.wgsl; shaders/env_cells.wgsl: the cells,
 /// shared with the export; shaders/env_hotspots.wgsl: a map's hot spots as
@@ -74,6 +75,7 @@ macro_rules! player_shader {
             include_str!("../../../../shaders/scales.wgsl"),
             include_str!("../../../../shaders/display.wgsl"),
             include_str!("../../../../shaders/env_table.wgsl"),
+            include_str!("../../../../shaders/sun_gain.wgsl"),
             include_str!("../../../../shaders/response_map.wgsl"),
             include_str!("../../../../shaders/diffraction.wgsl"),
             include_str!($technique),
@@ -90,6 +92,17 @@ use player_shader;
 /// The default technique's WGSL: the shared shading with shaders/default.wgsl
 /// (the response map; `fs_main`).
 pub const SHADER: &str = player_shader!("../../../../shaders/default.wgsl");
+
+/// shaders/env_table.wgsl alone: the environment table's texel, the
+/// equirectangular mapping and the sun's disc points (`sb_sun_disc_dir`),
+/// which the player, the export and the background pass include.
+pub const ENV_TABLE_WGSL: &str = include_str!("../../../../shaders/env_table.wgsl");
+
+/// shaders/sun_gain.wgsl alone: G with the masking over the sun's disc as a
+/// plane (`sb_sun_gain_plane`, `sb_sun_gain_at`; needs [`MATERIAL_WGSL`] and
+/// [`ENV_TABLE_WGSL`]), the player's first-frame sun; the root package's
+/// tests/sun_gain_wgsl.rs runs it against float64.
+pub const SUN_GAIN_WGSL: &str = include_str!("../../../../shaders/sun_gain.wgsl");
 
 /// shaders/material.wgsl alone: the skin's functions every shader calls
 /// (`sb_fresnel`, `sb_gain`, `sb_masking`, `sb_base_transmission`, `sb_frame`);
