@@ -175,8 +175,9 @@ fn sunbeam_shade_environment_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>,
 // diffraction colour is nearly monochromatic), averaged over SB_SUN_POINTS
 // points of the disc of solid angle sun_rgb.w about wi as the player's first
 // frame does, G from its plane over the disc where the disc is at least
-// SB_SUN_PLANE_COS above the horizon (0: the point wi alone), plus the base lit by the disc, dw *
-// base * Omega L cos (1 - F) / pi at wi. 0 without a sun.
+// SB_SUN_PLANE_COS above the horizon (0: the point wi alone), plus the base
+// lit by the disc, dw * base * Omega L cos (1 - F) / pi at wi. 0 without a
+// sun.
 fn sunbeam_shade_sun(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     return sunbeam_shade_sun_footprint(t, b, n, wi, wr, env_no_footprint());
 }
