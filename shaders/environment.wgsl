@@ -866,7 +866,7 @@ fn env_sun_point_plane(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, 
     if (wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    return sb_sun_gain_at(gp, d, envg.sun_t.xyz, envg.sun_b.xyz, envg.sun_dir.w) * env_sun_read(d, wi, wr, gr, o, fp);
+    return sb_sun_gain_at(gp, d, envg.sun_t.xyz, envg.sun_b.xyz) * env_sun_read(d, wi, wr, gr, o, fp);
 }
 
 // The sky's sun's plane of G over its disc for frame (t, b, n) and local

@@ -209,7 +209,7 @@ fn sunbeam_shade_sun_footprint(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wi: vec
                 let shift = o.x * env_footprint_dx(d, fp) + o.y * env_footprint_dy(d, fp);
                 let wi_l = vec3<f32>(dot(d, t), dot(d, b), dot(d, n));
                 if (gp.w > 0.5) {
-                    diff = diff + env_sun_map_at(wi_l, wr_l, gr, shift) * sb_sun_gain_at(gp, d, df[0], df[1], cos_cap);
+                    diff = diff + env_sun_map_at(wi_l, wr_l, gr, shift) * sb_sun_gain_at(gp, d, df[0], df[1]);
                 } else {
                     diff = diff + env_sun_at(wi_l, wr_l, skin, gr, shift);
                 }

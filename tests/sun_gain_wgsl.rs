@@ -69,7 +69,7 @@ fn run_case(c: Case) -> Out {
     o.plane = sb_sun_gain_plane(c.c.xyz, c.st.xyz, c.sb.xyz, c.c.w, c.t.xyz, c.b.xyz, c.n.xyz, c.wr.xyz, skin);
     for (var k = 0u; k < 16u; k = k + 1u) {
         let d = sb_sun_disc_dir(c.c.xyz, c.st.xyz, c.sb.xyz, c.c.w, (f32(k) + 0.5) / SB_SUN_POINTS, f32(k) * SB_GOLDEN);
-        o.g[k / 4u][k % 4u] = sb_sun_gain_at(o.plane, d, c.st.xyz, c.sb.xyz, c.c.w);
+        o.g[k / 4u][k % 4u] = sb_sun_gain_at(o.plane, d, c.st.xyz, c.sb.xyz);
         o.d[k] = vec4<f32>(d, 0.0);
     }
     return o;
