@@ -399,9 +399,21 @@ fn env_sun_disc_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, share: f32, dw: 
     return (1.0 - dw) * xyz_to_rgb(xyz / f32(SB_SUN_SAMPLE_POINTS));
 }
 
-// The colour of a fragment (`covered`: its sample mask), whichever the
+// The colour of a fragment (`covered_px`: its sample mask), whichever the
 // technique: each technique's entry point returns it.
-fn shade(in: VsOut, covered: u32) -> vec4<f32> {
+fn shade(in: VsOut, covered_px: u32) -> vec4<f32> {
+    // A frame of a running mean under MSAA is read at one sample
+    // (EnvGlobals::frame_sample), which its jitter put where the pixel
+    // centre is without MSAA: the fragment stands for that sample alone,
+    // shaded there (the samples' loops below with one sample), and one that
+    // does not cover it skips the environment (its value is not read).
+    // Resolved, the four samples around each jittered centre widened the
+    // sum's filter to 1.75 pixels (docs/PLAY.md "Environment").
+    var covered = covered_px;
+    let one_sample = envg.frame_sample < 4u;
+    if (one_sample) {
+        covered = covered_px & (1u << envg.frame_sample);
+    }
     let fr = frame_at(in.normal, in.tangent, in.uv, in.uv_tangent);
     let t = fr[0];
     let b = fr[1];
@@ -447,13 +459,20 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
     // the reference shades each covered sub-pixel position (docs/PLAY.md
     // "Where a pixel shades"; crates/sunbeam-render/tests/silhouette.rs).
     let n_cov = countOneBits(covered & 15u);
+    // each sample's share of the pixel along each axis: a quarter of it
+    // (half the footprint) when the samples make the pixel; the frame's share
+    // when one sample is read (the frames' jitter spreads it over the pixel)
+    var sample_share = 0.5;
+    if (one_sample) {
+        sample_share = envg.frame_share;
+    }
     // On a mesh with scale maps every pixel does so (with MSAA), each sample
     // reading the maps at its own uv: the frame varies at the maps' texels
     // and jumps at the scale borders, where the screen derivatives of
     // (u, v, w), the footprint filter's linear model, fail (across a border
     // they spread the response over both scales' lobes instead of mixing
     // the two); the samples resolve the variation (docs/PLAY.md "Scale maps").
-    let at_samples = g.msaa >= 4u && n_cov > 0u && ((n_cov < 4u && dot(wr, n) <= ENV_GRAZING_COS) || mat.scales_on == 1u);
+    let at_samples = g.msaa >= 4u && n_cov > 0u && ((n_cov < 4u && dot(wr, n) <= ENV_GRAZING_COS) || mat.scales_on == 1u || one_sample);
     var rgb = vec3<f32>(0.0);
     for (var i = 0u; i < g.n_lights; i = i + 1u) {
         let wi = g.lights[i].xyz;
@@ -476,9 +495,8 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
                 if (((covered >> j) & 1u) == 1u) {
                     let c = carried(in, da, msaa_position(j));
                     let wr_s = normalize(g.eye.xyz - c.world);
-                    // each sample stands for a quarter of the pixel: half the
-                    // footprint along each axis
-                    acc = acc + shade_light(i, c.frame, wr_s, diffract, dw, 0.5 * duv_x, 0.5 * duv_y, 0.5 * dw_x, 0.5 * dw_y, 0.5 * jx, 0.5 * jy);
+                    let k = sample_share;
+                    acc = acc + shade_light(i, c.frame, wr_s, diffract, dw, k * duv_x, k * duv_y, k * dw_x, k * dw_y, k * jx, k * jy);
                 }
             }
             rgb = rgb + acc / f32(n_cov);
@@ -489,7 +507,7 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
     // The scene's environment (shaders/environment.wgsl): one Monte Carlo
     // estimate per frame, accumulated by the caller, or the first-frame
     // estimator's cells.
-    if (envg.on == 1u) {
+    if (envg.on == 1u && !(one_sample && n_cov == 0u)) {
         // Where the environment's Monte Carlo estimate shades: the pixel centre,
         // except in a partly covered pixel whose centre sees the surface at a
         // grazing angle or from below (a silhouette): there the centre
@@ -543,13 +561,19 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
                 var acc = vec3<f32>(0.0);
                 var at = vec2<f32>(0.0);
                 var k = 0.0;
-                // each sample stands for a quarter of the pixel
-                let sample_fp = env_footprint_times(env_fp, 0.5);
+                // each sample's share of the pixel (the frame's share is
+                // applied in env_shade)
+                var sample_fp = env_footprint_times(env_fp, 0.5);
+                if (one_sample) {
+                    sample_fp = env_fp;
+                }
                 for (var j = 0u; j < 4u; j = j + 1u) {
                     if (((covered >> j) & 1u) == 1u) {
                         let sj = env_shade_carried_nowalk(in, da, msaa_position(j), base, dw, diffract, sample_fp, !scaled);
                         acc = acc + sj.xyz;
-                        if (scaled) {
+                        if (scaled && one_sample) {
+                            acc = acc + env_sun_disc_carried(in, da, msaa_position(j), 1.0, dw);
+                        } else if (scaled) {
                             acc = acc + env_sun_disc_carried(in, da, msaa_quarter(j), 0.5, dw);
                         }
                         at = at + sj.w * msaa_position(j);
@@ -568,7 +592,7 @@ fn shade(in: VsOut, covered: u32) -> vec4<f32> {
             }
         } else {
             var off = vec2<f32>(0.0);
-            if (g.msaa >= 4u && dot(wr, n) <= ENV_GRAZING_COS) {
+            if (g.msaa >= 4u && (one_sample || dot(wr, n) <= ENV_GRAZING_COS)) {
                 env_seed_at(vec2<u32>(in.clip.xy), envg.frame);
                 off = covered_pick(covered, env_qmc(envg.frame + 1u, 31u));
             }

@@ -65,6 +65,9 @@ struct EnvGlobals {
     // the part of the pixel along each axis one frame of a running mean
     // stands for: the footprint's scale (EnvGlobals::frame_share)
     frame_share: f32,
+    // under MSAA, the one sample of each pixel a frame of a running mean is
+    // read at (EnvGlobals::frame_sample); 4: the resolved pixel
+    frame_sample: u32,
 };
 
 struct EnvProposal {
@@ -658,7 +661,7 @@ fn env_bilinear(tex: texture_2d<f32>, c0: vec2<i32>, f: vec2<f32>) -> vec3<f32> 
 // with scale maps under MSAA, crates/sunbeam-render/src/renderer/mod.rs
 // `reads_centre`).
 fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
-    if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS && mat.reads_cells == 1u) {
+    if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS && mat.reads_cells == 1u && envg.frame_sample >= 4u) {
         let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
         let p = clamp(vec2<i32>(floor(clip)), vec2<i32>(0), last);
         let x = textureLoad(cells_xyz, p, 0);

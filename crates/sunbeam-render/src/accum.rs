@@ -1,7 +1,8 @@
 //! Progressive accumulation of the environment mode (docs/PLAY.md
 //! "Environment"): every frame draws one set of Monte Carlo samples (seeded by
 //! the frame index) into the RGBA16F frame target; a compute pass
-//! (shaders/accumulate.wgsl) adds it into an RGBA32F sum (a storage buffer, one
+//! (shaders/accumulate.wgsl) adds it (under MSAA one sample of it, or the
+//! samples' mean: `Accumulator::add`) into an RGBA32F sum (a storage buffer, one
 //! `vec4<f32>` per pixel, so no float blending or storage-texture format is
 //! needed); headless frames read the sum back and divide by the count, the
 //! window resolves it onto the surface (shaders/resolve.wgsl). Any change of
@@ -20,7 +21,7 @@ pub(crate) struct AccU {
     pub(crate) width: u32,
     pub(crate) height: u32,
     pub(crate) count: u32,
-    pub(crate) _a0: u32,
+    pub(crate) sample: u32,
 }
 
 /// The resolve shader's uniform (shaders/resolve.wgsl `ResolveU`).
@@ -52,11 +53,14 @@ pub struct Accumulator {
 }
 
 impl Accumulator {
-    /// A sum for `frame` (a single-sample float texture of `width x height`);
-    /// `readback`: headless (the sum can be copied back).
+    /// A sum for `frame` (a single-sample float texture of `width x height`)
+    /// or, with `msaa`, for that multisampled target (4 samples) of which
+    /// `frame` is the resolve; `readback`: headless (the sum can be copied
+    /// back).
     pub fn new(
         gpu: &Gpu,
         frame: &wgpu::TextureView,
+        msaa: Option<&wgpu::TextureView>,
         width: u32,
         height: u32,
         readback: bool,
@@ -81,7 +85,7 @@ impl Accumulator {
                 width,
                 height,
                 count: 0,
-                _a0: 0,
+                sample: 4,
             }),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
@@ -94,7 +98,11 @@ impl Accumulator {
             label: Some("accumulate"),
             layout: None,
             module: &module,
-            entry_point: Some("cs_add"),
+            entry_point: Some(if msaa.is_some() {
+                "cs_add_ms"
+            } else {
+                "cs_add"
+            }),
             compilation_options: Default::default(),
             cache: None,
         });
@@ -111,9 +119,15 @@ impl Accumulator {
                     binding: 1,
                     resource: sum.as_entire_binding(),
                 },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(frame),
+                match msaa {
+                    Some(ms) => wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(ms),
+                    },
+                    None => wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(frame),
+                    },
                 },
             ],
         });
@@ -150,13 +164,15 @@ impl Accumulator {
         self.count.set(0);
     }
 
-    /// Record adding the frame (drawn earlier in `enc`) to the sum.
-    pub fn add(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder) {
+    /// Record adding the frame (drawn earlier in `enc`) to the sum: under
+    /// MSAA its `sample` (0..4), or with 4 the mean of its samples (ignored
+    /// without MSAA).
+    pub fn add(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, sample: u32) {
         let u = AccU {
             width: self.width,
             height: self.height,
             count: self.count.get(),
-            _a0: 0,
+            sample,
         };
         gpu.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&u));

@@ -81,6 +81,14 @@ pub(crate) struct EnvGlobals {
     /// (their jitter covers the pixel; a footprint as well would widen the
     /// pixel's kernel to a tent).
     pub(crate) frame_share: f32,
+    /// Under MSAA, the one sample (0..4) of each pixel that a frame of a
+    /// running mean is read at, 4 for the resolved pixel (a frame alone, the
+    /// window's first, or no MSAA): the frames' jitter then places that
+    /// sample on the pixel's lattice point (crate::renderer::targets), so the
+    /// mean is the pixel's box, where the resolved samples' pattern would
+    /// widen it (docs/PLAY.md "Environment").
+    pub(crate) frame_sample: u32,
+    pub(crate) _f0: [u32; 3],
 }
 
 /// How the player integrates an environment (`sunbeam-play --env-estimator`).
@@ -255,6 +263,8 @@ impl EnvScene {
             irr_ior: ior as f32,
             hot_footprint: u32::from(footprint),
             frame_share: 1.0,
+            frame_sample: 4,
+            _f0: [0; 3],
             table_w: 1,
             table_h: 1,
             ..Default::default()
@@ -382,11 +392,13 @@ impl EnvScene {
         &self.table
     }
 
-    /// Set the frame index (the random numbers' seed) for the next frame.
-    pub(crate) fn set_frame(&self, gpu: &Gpu, frame: u32, share: f32) {
+    /// Set the frame index (the random numbers' seed), its share of the
+    /// pixel and the sample it is read at (4: resolved) for the next frame.
+    pub(crate) fn set_frame(&self, gpu: &Gpu, frame: u32, share: f32, sample: u32) {
         let mut v = self.values;
         v.frame = frame;
         v.frame_share = share;
+        v.frame_sample = sample;
         gpu.queue
             .write_buffer(&self.globals, 0, bytemuck::bytes_of(&v));
     }

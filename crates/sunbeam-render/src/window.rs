@@ -200,8 +200,8 @@ impl App {
         );
         let ms = renderer.msaa();
         let depth = depth_view_ms(&gpu, config.width, config.height, ms);
-        let msaa =
-            (ms > 1).then(|| colour_view(&gpu, config.width, config.height, config.format, ms));
+        let msaa = (ms > 1)
+            .then(|| colour_view(&gpu, config.width, config.height, config.format, ms, false));
         window.request_redraw();
         self.gfx = Some(Gfx {
             window,
@@ -391,8 +391,9 @@ impl ApplicationHandler for App {
                     g.surface.configure(&g.gpu.device, &g.config);
                     let ms = g.renderer.msaa();
                     g.depth = depth_view_ms(&g.gpu, sz.width, sz.height, ms);
-                    g.msaa = (ms > 1)
-                        .then(|| colour_view(&g.gpu, sz.width, sz.height, g.config.format, ms));
+                    g.msaa = (ms > 1).then(|| {
+                        colour_view(&g.gpu, sz.width, sz.height, g.config.format, ms, false)
+                    });
                     if let Some((off, _)) = &mut g.progressive {
                         match Offscreen::new(&g.gpu, &g.renderer, sz.width, sz.height) {
                             Ok(o) => *off = o,

@@ -306,7 +306,7 @@ mod layout_tests {
         check(
             "EnvGlobals",
             size_of::<EnvGlobals>(),
-            &f!(EnvGlobals; basis_to_rgb, sun_dir, sun_rgb, sun_t, sun_b, table_w, table_h, frame, on, has_sun, samples, estimator, chain_levels, irr_ior, table_phase, hot_footprint, frame_share),
+            &f!(EnvGlobals; basis_to_rgb, sun_dir, sun_rgb, sun_t, sun_b, table_w, table_h, frame, on, has_sun, samples, estimator, chain_levels, irr_ior, table_phase, hot_footprint, frame_share, frame_sample),
         );
         check(
             "EnvProposal",
@@ -325,7 +325,7 @@ mod layout_tests {
             ACCUMULATE_WGSL,
             "AccU",
             size_of::<AccU>(),
-            &f!(AccU; width, height, count),
+            &f!(AccU; width, height, count, sample),
         );
         check_in(
             RESOLVE_WGSL,
