@@ -293,10 +293,6 @@ pub struct Renderer {
     /// The cells' pre-passes: one walk per pixel, at a lower rate where
     /// the surface is smooth (environment scenes with the cells estimator).
     cells: Option<cells_rate::CellsRate>,
-    /// The MSAA sample the next frame is read at (4: resolved; set_frame):
-    /// a frame read at one sample walks the cells there, not in the
-    /// pre-passes, whose points are the pixel centres.
-    frame_sample: std::sync::atomic::AtomicU32,
     meshes: Vec<GpuMesh>,
     settings: Settings,
     n_lambda: u32,
@@ -744,7 +740,6 @@ impl Renderer {
             global_layout: gl0,
             global_bind,
             cells,
-            frame_sample: std::sync::atomic::AtomicU32::new(4),
             meshes,
             settings: settings.clone(),
             n_lambda: spec.len() as u32,
@@ -765,8 +760,6 @@ impl Renderer {
     /// part of the pixel along each axis the frame stands for (1 alone) and
     /// the MSAA sample it is read at (4: the resolved pixel).
     pub fn set_frame(&self, gpu: &Gpu, frame: u32, share: f32, sample: u32) {
-        self.frame_sample
-            .store(sample, std::sync::atomic::Ordering::Relaxed);
         if self.progressive() {
             self.env.set_frame(gpu, frame, share, sample);
         }
@@ -936,8 +929,7 @@ impl Renderer {
         depth: &wgpu::TextureView,
         state: &FrameState,
     ) {
-        let one_sample = self.frame_sample.load(std::sync::atomic::Ordering::Relaxed) < 4;
-        match self.cells.as_ref().filter(|_| !one_sample) {
+        match &self.cells {
             Some(c) => c.encode(
                 enc,
                 &self.global_bind,
