@@ -661,9 +661,6 @@ fn env_bilinear(tex: texture_2d<f32>, c0: vec2<i32>, f: vec2<f32>) -> vec3<f32> 
 // with scale maps under MSAA, crates/sunbeam-render/src/renderer/mod.rs
 // `reads_centre`).
 fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
-    if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS && mat.reads_cells == 1u && envg.frame_sample < 4u) {
-        return env_cells_read_at_sample(n, clip, dist);
-    }
     if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS && mat.reads_cells == 1u) {
         let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
         let p = clamp(vec2<i32>(floor(clip)), vec2<i32>(0), last);
@@ -674,38 +671,6 @@ fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> ve
         }
     }
     return vec4<f32>(0.0);
-}
-
-// env_cells_read for a frame read at one MSAA sample
-// (EnvGlobals::frame_sample), which lies msaa_position from the pixel
-// centre where the centre pass's points are: the bilinear mix of the four
-// points around the sample where each saw this surface, else 0 (the
-// fragment walks). Read at the pixel's own point, the cells stood a
-// quarter to three eighths of a pixel off the sample (the test sphere's 16
-// frames at --msaa 4: interior p99 0.57 against an 8 x 8 supersampled
-// frame, 0.47 mixed, 0.23 walking at every sample, which cost minutes a
-// frame at 512 x 512 on lavapipe; tools/sunbeam-play/tests/environment.rs
-// accumulated_cells_frames_are_the_pixels_mean). Exact would be pre-passes
-// drawn at the samples' points (their own jitter).
-fn env_cells_read_at_sample(n: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
-    let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
-    let q = clip + msaa_position(envg.frame_sample) - vec2<f32>(0.5);
-    let c0 = vec2<i32>(floor(q));
-    let f = q - floor(q);
-    var acc = vec3<f32>(0.0);
-    for (var j = 0; j < 4; j = j + 1) {
-        let o = vec2<i32>(j & 1, j >> 1u);
-        let p = clamp(c0 + o, vec2<i32>(0), last);
-        let x = textureLoad(cells_xyz, p, 0);
-        let nd = textureLoad(cells_nd, p, 0);
-        if (!(x.w > 0.5 && env_same_surface(nd.xyz, nd.w, n, dist))) {
-            return vec4<f32>(0.0);
-        }
-        let wx = select(1.0 - f.x, f.x, o.x == 1);
-        let wy = select(1.0 - f.y, f.y, o.y == 1);
-        acc = acc + (wx * wy) * x.xyz;
-    }
-    return vec4<f32>(acc, 1.0);
 }
 
 // The cells' XYZ at a fragment: the centre pass's (env_cells_read) or,

@@ -588,11 +588,16 @@ impl CellsRate {
 
     /// Record the pre-passes (`draw` draws the meshes with groups 1 and 2
     /// set) and call `main` with bind group 0 for the frame's pass. Without
-    /// targets (no [`CellsRate::prepare`] yet) `main` gets `fallback`.
+    /// targets (no [`CellsRate::prepare`] yet) `main` gets `fallback`. The
+    /// pre-passes' points are the frame's pixel centres moved by `shift`
+    /// (pixels): the MSAA sample a frame of a running mean is read at
+    /// (targets::frame_sample), so that the frame's pass reads the cells at
+    /// the point it shades.
     pub(super) fn encode(
         &self,
         enc: &mut wgpu::CommandEncoder,
         fallback: &wgpu::BindGroup,
+        shift: [f32; 2],
         draw: impl Fn(&mut wgpu::RenderPass<'_>),
         draw_full: impl Fn(&mut wgpu::RenderPass<'_>),
         main: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::BindGroup),
@@ -641,9 +646,11 @@ impl CellsRate {
                 g.full[0] as f32 / self.rate as f32,
                 g.full[1] as f32 / self.rate as f32,
             );
+            // (a shift of the frame's points is 1 / K of a grid pixel; the
+            // content moves with the viewport's origin)
             rp.set_viewport(
-                0.5 - pad * gw,
-                0.5 - pad * gh,
+                0.5 - pad * gw - shift[0] / self.rate as f32,
+                0.5 - pad * gh - shift[1] / self.rate as f32,
                 gw * (1.0 + 2.0 * pad),
                 gh * (1.0 + 2.0 * pad),
                 0.0,
@@ -696,6 +703,16 @@ impl CellsRate {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
+            if shift != [0.0; 2] {
+                rp.set_viewport(
+                    -shift[0],
+                    -shift[1],
+                    g.full[0] as f32,
+                    g.full[1] as f32,
+                    0.0,
+                    1.0,
+                );
+            }
             rp.set_pipeline(&self.centre.0);
             rp.set_bind_group(0, &g.centre_bind, &[]);
             draw(&mut rp);

@@ -293,6 +293,9 @@ pub struct Renderer {
     /// The cells' pre-passes: one walk per pixel, at a lower rate where
     /// the surface is smooth (environment scenes with the cells estimator).
     cells: Option<cells_rate::CellsRate>,
+    /// The MSAA sample the next frame is read at (4: resolved; set_frame):
+    /// the cells' pre-passes draw their points there.
+    frame_sample: std::sync::atomic::AtomicU32,
     meshes: Vec<GpuMesh>,
     settings: Settings,
     n_lambda: u32,
@@ -740,6 +743,7 @@ impl Renderer {
             global_layout: gl0,
             global_bind,
             cells,
+            frame_sample: std::sync::atomic::AtomicU32::new(4),
             meshes,
             settings: settings.clone(),
             n_lambda: spec.len() as u32,
@@ -760,6 +764,8 @@ impl Renderer {
     /// part of the pixel along each axis the frame stands for (1 alone) and
     /// the MSAA sample it is read at (4: the resolved pixel).
     pub fn set_frame(&self, gpu: &Gpu, frame: u32, share: f32, sample: u32) {
+        self.frame_sample
+            .store(sample, std::sync::atomic::Ordering::Relaxed);
         if self.progressive() {
             self.env.set_frame(gpu, frame, share, sample);
         }
@@ -929,10 +935,18 @@ impl Renderer {
         depth: &wgpu::TextureView,
         state: &FrameState,
     ) {
+        // a frame read at one MSAA sample: the pre-passes' points are that
+        // sample's, not the pixel centres, so the frame's pass reads the
+        // cells at its own point (targets::frame_sample)
+        let sample = self.frame_sample.load(std::sync::atomic::Ordering::Relaxed);
+        let shift = targets::MSAA_POSITIONS
+            .get(sample as usize)
+            .map_or([0.0; 2], |p| [p[0] as f32, p[1] as f32]);
         match &self.cells {
             Some(c) => c.encode(
                 enc,
                 &self.global_bind,
+                shift,
                 |rp| self.draw_meshes(rp),
                 |rp| self.draw_fullscreen(rp),
                 |enc, g0| self.encode_frame(enc, g0, colour, resolve, depth, state),

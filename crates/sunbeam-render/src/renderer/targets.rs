@@ -319,7 +319,10 @@ impl Offscreen {
 /// under the sky with `--msaa 4` read interior pixels by the silhouette up
 /// to 50 % too bright, where one sample of four reached the sky behind
 /// (interior p99 6.7 against 3.5 without MSAA; docs/PLAY.md "Environment").
-/// A frame alone keeps the resolve: its samples are its anti-aliasing.
+/// The cells' pre-passes draw their points at the same sample (the
+/// renderer moves their viewport by its offset), so the frame's pass reads
+/// the cells at the point it shades. A frame alone keeps the resolve: its
+/// samples are its anti-aliasing.
 pub fn frame_sample(point: [f64; 2], share: f32, msaa: bool, k: u32) -> ([f64; 2], u32) {
     if !msaa || share >= 1.0 {
         return (point, 4);
