@@ -466,6 +466,14 @@ fn shade(in: VsOut, covered_px: u32) -> vec4<f32> {
     if (one_sample) {
         sample_share = envg.frame_share;
     }
+    // the pixel centre's: the whole pixel, or in a frame of a running mean
+    // the frame's share (its jitter spreads the frames over the pixel; the
+    // whole footprint in each widened the sum's filter, as the environment's
+    // hot spots: EnvGlobals::frame_share)
+    var centre_share = 1.0;
+    if (envg.on == 1u && envg.frame_share < 1.0) {
+        centre_share = envg.frame_share;
+    }
     // On a mesh with scale maps every pixel does so (with MSAA), each sample
     // reading the maps at its own uv: the frame varies at the maps' texels
     // and jumps at the scale borders, where the screen derivatives of
@@ -501,7 +509,8 @@ fn shade(in: VsOut, covered_px: u32) -> vec4<f32> {
             }
             rgb = rgb + acc / f32(n_cov);
         } else {
-            rgb = rgb + shade_light(i, fr, wr, diffract, dw, duv_x, duv_y, dw_x, dw_y, jx, jy);
+            let k = centre_share;
+            rgb = rgb + shade_light(i, fr, wr, diffract, dw, k * duv_x, k * duv_y, k * dw_x, k * dw_y, k * jx, k * jy);
         }
     }
     // The scene's environment (shaders/environment.wgsl): one Monte Carlo
