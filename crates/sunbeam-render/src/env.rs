@@ -84,7 +84,7 @@ pub(crate) struct EnvGlobals {
     /// Under MSAA, the one sample (0..4) of each pixel that a frame of a
     /// running mean is read at, 4 for the resolved pixel (a frame alone, the
     /// window's first, or no MSAA): the frames' jitter then places that
-    /// sample on the pixel's lattice point (crate::renderer::targets), so the
+    /// sample on the pixel's lattice point (the renderer's `frame_sample`), so the
     /// mean is the pixel's box, where the resolved samples' pattern would
     /// widen it (docs/PLAY.md "Environment").
     pub(crate) frame_sample: u32,
