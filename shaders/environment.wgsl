@@ -596,7 +596,7 @@ fn env_cells_mixed(t: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>) -
         let q = clip / f32(k);
         let q0 = floor(q);
         let c0 = vec2<i32>(q0);
-        if (env_block_smooth(c0, 1, t, n)) {
+        if (env_block_smooth(c0, 1, t, n) && env_block_even(cells_xyz, c0)) {
             return vec4<f32>(env_bilinear(cells_xyz, c0, q - q0), 1.0);
         }
     }
@@ -634,6 +634,39 @@ fn env_block_smooth(c0: vec2<i32>, step: i32, t: vec3<f32>, n: vec3<f32>) -> boo
         ok = ok && dot(nn[j], nm) >= ENV_LOWRES_CONE && dot(tt[j], tm) >= ENV_LOWRES_CONE;
     }
     return ok && dot(n, nm) >= ENV_LOWRES_CONE && dot(t, tm) >= ENV_LOWRES_CONE;
+}
+
+// Whether the bilinear mix of the block of texels c0 + o, o in {0, 1}^2,
+// of `tex` stays within ENV_LOWRES_CURVE of the block's mean luminance Y:
+// a smooth patch of surface can still see a sharp edge of the environment
+// (the sky's horizon mirrored across a sphere), which the mix would spread
+// over the block. The linear interpolant's error is about an eighth of the
+// second difference, taken along both axes at each corner through its
+// neighbours outside the block (where they were shaded: w set).
+const ENV_LOWRES_CURVE: f32 = 0.01;
+fn env_block_even(tex: texture_2d<f32>, c0: vec2<i32>) -> bool {
+    let last = vec2<i32>(textureDimensions(tex)) - vec2<i32>(1);
+    var m = 0.0;
+    var worst = vec3<f32>(0.0);
+    for (var j = 0; j < 4; j = j + 1) {
+        let o = vec2<i32>(j & 1, j >> 1u);
+        let c = min(c0 + o, last);
+        let v = textureLoad(tex, c, 0).xyz;
+        m = m + v.y;
+        for (var a = 0; a < 2; a = a + 1) {
+            let e = vec2<i32>(1 - a, a);
+            let p = c - e;
+            let q = c + e;
+            if (all(p >= vec2<i32>(0)) && all(q <= last)) {
+                let vp = textureLoad(tex, p, 0);
+                let vq = textureLoad(tex, q, 0);
+                if (vp.w > 0.5 && vq.w > 0.5) {
+                    worst = max(worst, abs(vp.xyz - 2.0 * v + vq.xyz));
+                }
+            }
+        }
+    }
+    return 0.125 * max(worst.x, max(worst.y, worst.z)) <= ENV_LOWRES_CURVE * max(0.25 * m, 0.0);
 }
 
 // The bilinear mix at fraction f of the block of texels c0 + o, o in
