@@ -106,7 +106,7 @@ pub(crate) struct Cli {
     /// The first-frame cells written with --response beside the environment's
     /// maps as NAME.env-cells.ktx2, for these `sunbeam-play --env-cells` counts
     /// (comma-separated, each 1..=4096; default: the player's default for
-    /// this pack, 512 for a patch under 10 um, 768 from it; docs/PACK_FORMAT.md
+    /// this pack, 512 for a patch under 10 um, 1024 from it; docs/PACK_FORMAT.md
     /// "Cells file"): the player and the engines' export cluster any other
     /// count at start.
     #[arg(long, value_name = "N[,N...]", value_delimiter = ',', value_parser = clap::value_parser!(u64).range(1..=4096))]

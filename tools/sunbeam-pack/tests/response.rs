@@ -155,12 +155,12 @@ fn bad_response_budget_is_a_usage_error() {
 }
 
 /// Without `--response-cells` the cells file holds the player's default for
-/// the pack (docs/LIGHTING.md "How many cells"): 768 cells for a patch of
+/// the pack (docs/LIGHTING.md "How many cells"): 1024 cells for a patch of
 /// 10 um or more, 512 below.
 #[test]
 fn the_default_cells_follow_the_patchs_size() {
     let d = tmpdir("default-cells");
-    for (name, dx, want) in [("small", 25e-9, 512), ("large", 300e-9, 768)] {
+    for (name, dx, want) in [("small", 25e-9, 512), ("large", 300e-9, 1024)] {
         // 40 x 32 texels: 1 um, or 12 um at 300 nm
         let (w, h) = (40usize, 32usize);
         let z: Vec<f64> = (0..w * h)

@@ -79,7 +79,7 @@ pub(crate) struct Cli {
     pub(crate) env_estimator: EnvEstimatorArg,
     /// Environment scenes, `--env-estimator cells`: cells every view visits
     /// (1..4096; more: closer to the reference, slower; default: each pack's
-    /// own, 512 for a patch under 10 um, 768 from it; docs/LIGHTING.md "How
+    /// own, 512 for a patch under 10 um, 1024 from it; docs/LIGHTING.md "How
     /// many cells").
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub(crate) env_cells: Option<u64>,

@@ -184,7 +184,7 @@ fn the_pipelines_cells_are_read_clustered_when_missing_refused_when_damaged() {
 }
 
 /// The default count follows the pack (docs/LIGHTING.md "How many cells"):
-/// a patch of 10 um or more takes 768 cells, a smaller one 512, in the
+/// a patch of 10 um or more takes 1024 cells, a smaller one 512, in the
 /// pipeline's cells file (`sunbeam-pack --response` with no
 /// `--response-cells`) and in the player alike, so the player reads the file
 /// and clusters nothing. So does the cells' grid ("Cells at a lower rate"):
@@ -222,7 +222,7 @@ fn the_default_cells_follow_the_patchs_size() {
             .arg(&big)
             .args(["--response", "-q"]),
     );
-    for (p, want, rate) in [(&small, 512, 4), (&big, 768, 2)] {
+    for (p, want, rate) in [(&small, 512, 4), (&big, 1024, 2)] {
         let o = Command::new(BIN)
             .args(["--mesh", "builtin:sphere", "--pack"])
             .arg(p)
