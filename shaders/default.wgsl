@@ -186,7 +186,7 @@ fn cells_from_half(p: vec2<i32>) -> vec4<f32> {
     if (odd.x == 0 && odd.y == 0) {
         return vec4<f32>(textureLoad(cells_half, h, 0).xyz, 1.0);
     }
-    if (env_block_smooth(2 * h, 2, tp.xyz, textureLoad(cells_nd, p, 0).xyz) && env_block_even(cells_half, h)) {
+    if (env_block_smooth(2 * h, 2, tp.xyz, textureLoad(cells_nd, p, 0).xyz) && env_block_linear(cells_half, h)) {
         return vec4<f32>(env_bilinear(cells_half, h, 0.5 * vec2<f32>(odd)), 1.0);
     }
     return vec4<f32>(0.0);

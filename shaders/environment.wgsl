@@ -596,7 +596,7 @@ fn env_cells_mixed(t: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>) -
         let q = clip / f32(k);
         let q0 = floor(q);
         let c0 = vec2<i32>(q0);
-        if (env_block_smooth(c0, 1, t, n) && env_block_even(cells_xyz, c0)) {
+        if (env_block_smooth(c0, 1, t, n) && env_block_linear(cells_xyz, c0)) {
             return vec4<f32>(env_bilinear(cells_xyz, c0, q - q0), 1.0);
         }
     }
@@ -644,7 +644,7 @@ fn env_block_smooth(c0: vec2<i32>, step: i32, t: vec3<f32>, n: vec3<f32>) -> boo
 // second difference, taken along both axes at each corner through its
 // neighbours outside the block (where they were shaded: w set).
 const ENV_LOWRES_CURVE: f32 = 0.01;
-fn env_block_even(tex: texture_2d<f32>, c0: vec2<i32>) -> bool {
+fn env_block_linear(tex: texture_2d<f32>, c0: vec2<i32>) -> bool {
     let last = vec2<i32>(textureDimensions(tex)) - vec2<i32>(1);
     var m = 0.0;
     var worst = vec3<f32>(0.0);

@@ -671,7 +671,7 @@ fn grid_against_every_pixel(dir: &Path, scene: &Path, p99: f64) {
 /// supersampled: the row above the horizon 3.6 % too dark, the row below
 /// 6.2 % too bright, against a converged reference); blocks whose values
 /// curve more than the mix can follow now walk every pixel
-/// (shaders/environment.wgsl `env_block_even`). The grid of 4 against
+/// (shaders/environment.wgsl `env_block_linear`). The grid of 4 against
 /// every pixel, 128 x 128 over 13 degrees of view, single-sampled, 128
 /// cells: each row's luminance, and the grid in use elsewhere.
 #[test]
@@ -717,7 +717,7 @@ fn a_sharp_edge_of_the_environment_is_not_spread_by_the_grid() {
 /// Bound of [`a_sharp_edge_of_the_environment_is_not_spread_by_the_grid`],
 /// the largest relative change of a row's luminance: measured 0.08 % (row
 /// 54; lavapipe, 2026-12-06); mixing every smooth block, as before
-/// `env_block_even`, 4.06 % (row 65, the row below the horizon).
+/// `env_block_linear`, 4.06 % (row 65, the row below the horizon).
 const EDGE_ROW_BOUND: f64 = 0.005;
 
 /// `scene`'s cells frames, single-sampled, 128 cells, on the grid of 4 and
@@ -991,7 +991,7 @@ const HALF_GRID_P99: f64 = 0.23;
 /// since the centre pass mixes the grid; at the 128 cells the test uses
 /// (2026-12-02, a third of the time) 0.199 (mean 0.050, max 0.41), at 512
 /// the same day 0.197; 0.187 (mean 0.043, max 0.35) since blocks that curve
-/// walk (`env_block_even`, 2026-12-06).
+/// walk (`env_block_linear`, 2026-12-06).
 const LOWER_RATE_P99: f64 = 0.23;
 
 /// Accumulated first-frame estimates are the pixel's mean: 16 cells frames
