@@ -1183,8 +1183,8 @@ fn snake_first_frame_matches_the_reference_inside() {
 /// interior pixels. Each frame reads the sun's orders over its share of the
 /// pixel's footprint; taken as the whole pixel's differences scaled by the
 /// share, that footprint was far off where the frame turns fast (p99 4.3 on
-/// the 256^2 x 20 nm ridge pack's snake, docs/LIGHTING.md "The sun's disc
-/// in the first frame"); the differences across
+/// the 256^2 x 20 nm ridge pack's snake, docs/LIGHTING.md "The sun over
+/// the pixel"); the differences across
 /// the share itself (shaders/diffraction.wgsl `shade`) follow the sub-pixels'.
 #[test]
 fn accumulated_frames_on_the_snake_are_its_supersampled_frame() {
