@@ -691,7 +691,7 @@ fn a_sharp_edge_of_the_environment_is_not_spread_by_the_grid() {
             .chunks(im.width as usize)
             .map(|row| {
                 row.iter()
-                    .map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64)
+                    .map(|p| sunbeam_frame::linear::luminance(*p))
                     .sum()
             })
             .collect()
