@@ -86,11 +86,13 @@ fn fs_bg(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
     }
     var lin = rgb / 16.0 * bg.exposure_scale;
     lin = select(lin, vec3<f32>(0.0), lin != lin);
+    // Offscreen (output 2) the alpha is the meshes' coverage: 0 here
+    // (sunbeam_render::Offscreen).
     if (bg.output == 2u) {
         if (bg.keep_negative == 1u) {
-            return vec4<f32>(lin, 1.0);
+            return vec4<f32>(lin, 0.0);
         }
-        return vec4<f32>(max(lin, vec3<f32>(0.0)), 1.0);
+        return vec4<f32>(max(lin, vec3<f32>(0.0)), 0.0);
     }
     var out = vec3<f32>(0.0);
     for (var k = 0; k < 3; k = k + 1) {

@@ -194,6 +194,12 @@ impl Accumulator {
 
     /// Read the mean of the accumulated frames back (headless).
     pub fn read(&self, gpu: &Gpu) -> Result<LinearImage> {
+        Ok(self.read_with_coverage(gpu)?.0)
+    }
+
+    /// [`Accumulator::read`] with each pixel's mean alpha: on an offscreen
+    /// target the part of the pixel the meshes cover ([`crate::Offscreen`]).
+    pub fn read_with_coverage(&self, gpu: &Gpu) -> Result<(LinearImage, Vec<f32>)> {
         let rb = self
             .readback
             .as_ref()
@@ -212,17 +218,19 @@ impl Accumulator {
         gpu.take_errors()?;
         let inv = 1.0 / self.count.get().max(1) as f32;
         let mut img = LinearImage::new(self.width, self.height);
+        let mut coverage = vec![0.0; img.rgb.len()];
         {
             let data = rb
                 .get_mapped_range(..)
                 .map_err(|e| Error::internal(format!("readback: {e}")))?;
             let px: &[f32] = bytemuck::cast_slice(&data);
-            for (i, o) in img.rgb.iter_mut().enumerate() {
+            for (i, (o, c)) in img.rgb.iter_mut().zip(&mut coverage).enumerate() {
                 *o = [px[4 * i] * inv, px[4 * i + 1] * inv, px[4 * i + 2] * inv];
+                *c = px[4 * i + 3] * inv;
             }
         }
         rb.unmap();
-        Ok(img)
+        Ok((img, coverage))
     }
 }
 

@@ -18,6 +18,7 @@ pub mod env;
 pub mod env_export;
 pub mod export;
 pub mod gpu;
+pub mod refine;
 pub mod renderer;
 pub mod response;
 #[cfg(feature = "baselines")]

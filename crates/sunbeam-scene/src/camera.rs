@@ -147,6 +147,38 @@ impl Camera {
         normalize(std::array::from_fn(|k| o[k] + nx * rx[k] + ny * ry[k]))
     }
 
+    /// The camera whose image is the rectangle `[x0, x0 + w) x [y0, y0 + h)`
+    /// (pixels, y down) of this camera's `width x height` image: the field of
+    /// view narrowed to the rectangle's height and the lens shift moved to its
+    /// centre. An image of aspect `w / h` from it, `m` times the rectangle's
+    /// size, has each of the rectangle's pixels as `m x m` sub-pixels at
+    /// exactly their places in the full image (what a tile of a supersampled
+    /// frame is: the player's edge refinement renders tiles through it).
+    pub fn window(&self, width: u32, height: u32, rect: [f64; 4]) -> Camera {
+        let [x0, y0, w, h] = rect;
+        let (fw, fh) = (width.max(1) as f64, height.max(1) as f64);
+        let [dx, dy] = self.shift_ndc(fw / fh);
+        // the rectangle's centre (shifted NDC) and half extent (NDC units)
+        let (cx, cy) = (
+            2.0 * (x0 + 0.5 * w) / fw - 1.0,
+            1.0 - 2.0 * (y0 + 0.5 * h) / fh,
+        );
+        let (sx, sy) = (w / fw, h / fh);
+        let half = (self.fov_y_deg.to_radians() / 2.0).tan() * sy;
+        // the window's NDC is the full one's, centred on the rectangle and
+        // scaled by 1 / (sx, sy): its shift in NDC is (dx + cx) / sx, ...
+        let aspect = w / h;
+        let (ndx, ndy) = ((dx + cx) / sx, (dy + cy) / sy);
+        Camera {
+            fov_y_deg: 2.0 * half.atan().to_degrees(),
+            shift: [
+                ndx / (2.0 * (1.0 / aspect).max(1.0)),
+                ndy / (2.0 * aspect.max(1.0)),
+            ],
+            ..self.clone()
+        }
+    }
+
     /// World -> clip for an image of `width x height` pixels.
     pub fn view_proj(&self, width: u32, height: u32) -> Mat4 {
         let aspect = width.max(1) as f64 / height.max(1) as f64;
@@ -183,6 +215,53 @@ mod tests {
         let v = cam.view();
         let e = transform(&v, [1.0, 2.0, 5.0, 1.0]);
         assert!(e[0].abs() < 1e-12 && e[1].abs() < 1e-12 && e[2].abs() < 1e-12);
+    }
+
+    /// A window's image is its rectangle of the full image, `m` sub-pixels
+    /// per pixel: every point lands at `(p - (x0, y0)) m`, and the
+    /// background's rays agree.
+    #[test]
+    fn a_window_is_its_rectangle_of_the_full_image() {
+        for (w, h, shift) in [(200u32, 100u32, [0.0, 0.0]), (90, 160, [0.07, -0.11])] {
+            let cam = Camera {
+                eye: [0.3, 0.2, 4.0],
+                target: [0.0, 0.0, 0.0],
+                up: [0.1, 1.0, 0.0],
+                fov_y_deg: 35.0,
+                shift,
+            };
+            let px = |cam: &Camera, w: u32, h: u32, p: [f64; 4]| {
+                let c = transform(&cam.view_proj(w, h), p);
+                [
+                    (c[0] / c[3] * 0.5 + 0.5) * w as f64,
+                    (0.5 - c[1] / c[3] * 0.5) * h as f64,
+                ]
+            };
+            for (rect, m) in [([10.0, 20.0, 8.0, 8.0], 16u32), ([33.0, 5.0, 12.0, 4.0], 5)] {
+                let win = cam.window(w, h, rect);
+                let (ww, wh) = ((rect[2] * m as f64) as u32, (rect[3] * m as f64) as u32);
+                for p in [
+                    [0.4, -0.25, 0.3, 1.0],
+                    [-0.2, 0.5, -0.1, 1.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ] {
+                    let a = px(&cam, w, h, p);
+                    let b = px(&win, ww, wh, p);
+                    for k in 0..2 {
+                        let want = (a[k] - rect[k]) * m as f64;
+                        assert!(
+                            (b[k] - want).abs() < 1e-6 * m as f64,
+                            "{a:?} {b:?} {rect:?}"
+                        );
+                    }
+                }
+                // the ray through a window pixel is the full image's ray there
+                let (x, y) = (3.5, 1.5);
+                let d = win.ray(ww, wh, x, y);
+                let e = cam.ray(w, h, rect[0] + x / m as f64, rect[1] + y / m as f64);
+                assert!(dot(d, e) > 1.0 - 1e-12, "{d:?} {e:?}");
+            }
+        }
     }
 
     /// The lens shift moves the image by `shift x max(w, h)` pixels (right,

@@ -37,6 +37,17 @@ pub(crate) struct Cli {
     /// Headless: render K x K times the size and box-filter in linear light.
     #[arg(long, default_value_t = 1)]
     pub(crate) supersample: u32,
+    /// Headless: render again, at M x M positions each, the pixels whose sub-pixels
+    /// (with their neighbours') disagree: silhouettes, the limb's sheen, scale
+    /// borders (0..=64; 0: off; tiles of 8 x 8 pixels; after --supersample and
+    /// --frames; docs/LIGHTING.md "Edge refinement").
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=sunbeam_render::refine::MAX_POSITIONS as i64))]
+    pub(crate) edge_supersample: u32,
+    /// Headless, --edge-supersample: a pixel is refined where its sub-pixels'
+    /// luminance spans more than this times their mean (0.001..=10), and so are its
+    /// neighbours.
+    #[arg(long, default_value_t = sunbeam_render::refine::DEFAULT_THRESHOLD, value_parser = sunbeam_common::cli::ranged(0.001, 10.0))]
+    pub(crate) edge_threshold: f64,
     /// Read the response maps at the pixel centre only (no footprint filter): the point
     /// lights' map, and the environment's hot spots and the sun's disc points under the
     /// cells estimator.

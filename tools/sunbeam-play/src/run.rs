@@ -118,6 +118,11 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
     if !(1..=8).contains(&cli.supersample) {
         return Err(Error::usage("--supersample must be 1..8"));
     }
+    if cli.edge_supersample > 0 && (!cli.headless || cli.cpu || cli.bench) {
+        return Err(Error::usage(
+            "--edge-supersample refines a headless GPU frame: it needs --headless, not --cpu or --bench",
+        ));
+    }
     if cli.env_samples == 0 || cli.env_samples > 64 {
         return Err(Error::usage("--env-samples must be 1..64"));
     }
@@ -341,9 +346,29 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             let mut target = sunbeam_render::Offscreen::new(&gpu, &r, size[0] * k, size[1] * k)?;
             let state = sunbeam_render::FrameState::from_scene(&prepared);
             let t = std::time::Instant::now();
-            let img = target
-                .render_frames_linear(&gpu, &r, &state, cli.frames.unwrap_or(1))?
-                .downsample(k);
+            let (sub, coverage) =
+                target.render_frames_with_coverage(&gpu, &r, &state, cli.frames.unwrap_or(1))?;
+            let mut img = sub.downsample(k);
+            if cli.edge_supersample > 0 {
+                let te = std::time::Instant::now();
+                let flags =
+                    sunbeam_render::refine::flag_pixels(&sub, &coverage, k, cli.edge_threshold);
+                let done = sunbeam_render::refine::refine(
+                    &gpu,
+                    &r,
+                    &state,
+                    &mut img,
+                    &flags,
+                    cli.edge_supersample,
+                )?;
+                report["edge_refine"] = serde_json::json!({
+                    "positions": cli.edge_supersample,
+                    "threshold": cli.edge_threshold,
+                    "pixels": done.pixels,
+                    "tiles": done.tiles,
+                    "ms": te.elapsed().as_secs_f64() * 1e3,
+                });
+            }
             report["render_ms"] = (t.elapsed().as_secs_f64() * 1e3).into();
             if r.progressive() {
                 // The environment's Monte Carlo frames, averaged (the settled frame).

@@ -896,7 +896,12 @@ impl Renderer {
             r: e[0],
             g: e[1],
             b: e[2],
-            a: 1.0,
+            // offscreen: the meshes' coverage (crate::Offscreen)
+            a: if self.format == OFFSCREEN_FORMAT {
+                0.0
+            } else {
+                1.0
+            },
         }
     }
 

@@ -67,7 +67,10 @@ pub fn colour_view(
 /// An offscreen float target with readback: frames come back in linear light
 /// (exposure applied) and go through the display transform on the CPU
 /// (`sunbeam_frame::LinearImage::display`), so that MSAA resolves average
-/// linear values, as a camera does.
+/// linear values, as a camera does. Its alpha is the meshes' coverage: 1
+/// where a mesh is drawn, 0 where the clear colour or the background pass
+/// is, so a resolved (or accumulated) pixel's alpha is the part of it the
+/// meshes cover ([`Offscreen::render_frames_with_coverage`]).
 pub struct Offscreen {
     pub width: u32,
     pub height: u32,
@@ -163,12 +166,24 @@ impl Offscreen {
         state: &FrameState,
         n: u32,
     ) -> Result<LinearImage> {
+        Ok(self.render_frames_with_coverage(gpu, r, state, n)?.0)
+    }
+
+    /// [`Offscreen::render_frames_linear`] with each pixel's coverage by the
+    /// meshes (0..1, the mean over its MSAA samples and frames).
+    pub fn render_frames_with_coverage(
+        &mut self,
+        gpu: &Gpu,
+        r: &Renderer,
+        state: &FrameState,
+        n: u32,
+    ) -> Result<(LinearImage, Vec<f32>)> {
         let n = n.max(1);
         self.planned = Some(n);
         for _ in 1..n {
             self.draw(gpu, r, state)?;
         }
-        self.render_linear(gpu, r, state)
+        self.render_linear_with_coverage(gpu, r, state)
     }
 
     /// Frames in the progressive sum (0 for a renderer that does not accumulate).
@@ -251,9 +266,18 @@ impl Offscreen {
         r: &Renderer,
         state: &FrameState,
     ) -> Result<LinearImage> {
+        Ok(self.render_linear_with_coverage(gpu, r, state)?.0)
+    }
+
+    fn render_linear_with_coverage(
+        &self,
+        gpu: &Gpu,
+        r: &Renderer,
+        state: &FrameState,
+    ) -> Result<(LinearImage, Vec<f32>)> {
         if let Some(a) = &self.acc {
             self.draw(gpu, r, state)?;
-            return a.read(gpu);
+            return a.read_with_coverage(gpu);
         }
         r.update(gpu, state, self.width, self.height);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -286,6 +310,7 @@ impl Offscreen {
             .map_err(|e| Error::internal(format!("readback: {e}")))?;
         gpu.take_errors()?;
         let mut img = LinearImage::new(self.width, self.height);
+        let mut coverage = vec![0.0; img.rgb.len()];
         {
             let data = self
                 .readback
@@ -298,11 +323,12 @@ impl Offscreen {
                 for x in 0..self.width as usize {
                     let i = y * stride + x * 4;
                     img.rgb[y * self.width as usize + x] = [f(px[i]), f(px[i + 1]), f(px[i + 2])];
+                    coverage[y * self.width as usize + x] = f(px[i + 3]);
                 }
             }
         }
         self.readback.unmap();
-        Ok(img)
+        Ok((img, coverage))
     }
 }
 

@@ -1,0 +1,265 @@
+//! Edge refinement of a headless frame: the pixels whose sub-pixels disagree
+//! (a silhouette's coverage, the limb's sheen, a scale's border) rendered
+//! again at `m x m` positions each.
+//!
+//! A supersampled frame is a midpoint rule over each pixel; where the
+//! pixel's content is smooth at the sub-pixels' scale it is already close,
+//! and where a sharp feature crosses it (the object's outline against what
+//! is behind, a lamp's sheen at the limb thinner than a sub-pixel) it needs
+//! many more positions than the rest of the frame (docs/LIGHTING.md "Edge
+//! refinement"). So the frame flags those pixels from its own sub-pixels
+//! ([`flag_pixels`]) and renders the tiles of the image that hold them
+//! through a camera narrowed to the tile ([`sunbeam_scene::Camera::window`]):
+//! the same renderer, each tile a frame of its own (the cells' pre-passes,
+//! the footprints and MSAA at the tile's sub-pixels), whose `m x m` box
+//! replaces the flagged pixels. The cost follows the flagged pixels, not the
+//! frame's area.
+
+use crate::{FrameState, Gpu, Offscreen, Renderer};
+use sunbeam_common::{Error, Result};
+use sunbeam_frame::linear::{luminance, LinearImage, LIT_Y};
+
+/// Tiles' side in pixels (the image's side where smaller): small enough that
+/// a silhouette's tiles hold few unflagged pixels, large enough that a
+/// frame's fixed cost (pre-passes, submission, readback) is shared.
+pub const TILE: u32 = 16;
+
+/// Positions per pixel side the refinement may take (a tile is `TILE m`
+/// texels wide).
+pub const MAX_POSITIONS: u32 = 64;
+
+/// The default spread that flags a pixel (see [`flag_pixels`]).
+pub const DEFAULT_THRESHOLD: f64 = 0.1;
+
+/// What [`refine`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Refined {
+    /// Pixels replaced.
+    pub pixels: usize,
+    /// Tiles rendered.
+    pub tiles: usize,
+}
+
+/// The pixels of a `k`-times supersampled frame `sub` (`k` sub-pixels per
+/// pixel side; `coverage` its sub-pixels' coverage by the meshes, 0..1) to
+/// refine. A pixel is looked at with the ring of sub-pixels around it (the
+/// neighbours' nearest: so `k = 1` compares a pixel with its eight
+/// neighbours) and flagged where that block
+/// - holds a mesh's outline: some of it covered, some not (a silhouette's
+///   coverage is sampled as coarsely as the frame's positions), or
+/// - its covered sub-pixels' luminance spans more than `threshold` times
+///   their mean (plus [`LIT_Y`], so that near-black noise does not count):
+///   light sharp at the sub-pixels' scale on the surface;
+///
+/// and so are the eight neighbours of a flagged pixel that the meshes touch
+/// (a sheen next to a silhouette can fall between every sub-pixel of its
+/// own pixel). What is behind the meshes alone is never flagged: the
+/// background's pass already averages each pixel.
+pub fn flag_pixels(sub: &LinearImage, coverage: &[f32], k: u32, threshold: f64) -> Vec<bool> {
+    // a sub-pixel counts as covered, or as not, within this of 1 or 0 (the
+    // coverage is the mean of 4 MSAA samples in half floats)
+    const FULL: f32 = 0.99;
+    const NONE: f32 = 0.01;
+    let k = k.max(1);
+    let (w, h) = (sub.width / k, sub.height / k);
+    let (sw, sh) = (sub.width as i64, sub.height as i64);
+    let y: Vec<f64> = sub.rgb.iter().map(|&p| luminance(p)).collect();
+    let mut own = vec![false; (w * h) as usize];
+    let mut touched = vec![false; (w * h) as usize];
+    for py in 0..h as i64 {
+        for px in 0..w as i64 {
+            let (mut lo, mut hi, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0.0);
+            let (mut some, mut all) = (false, true);
+            for sy in (py * k as i64 - 1)..=((py + 1) * k as i64) {
+                for sx in (px * k as i64 - 1)..=((px + 1) * k as i64) {
+                    if sx < 0 || sy < 0 || sx >= sw || sy >= sh {
+                        continue;
+                    }
+                    let i = (sy * sw + sx) as usize;
+                    let c = coverage[i];
+                    some |= c > NONE;
+                    all &= c >= FULL;
+                    if c >= FULL {
+                        lo = lo.min(y[i]);
+                        hi = hi.max(y[i]);
+                        sum += y[i];
+                        n += 1.0;
+                    }
+                }
+            }
+            let p = (py * w as i64 + px) as usize;
+            touched[p] = some;
+            own[p] = some && (!all || (n > 0.0 && hi - lo > threshold * (sum / n + LIT_Y)));
+        }
+    }
+    let mut out = vec![false; own.len()];
+    for py in 0..h as i64 {
+        for px in 0..w as i64 {
+            let p = (py * w as i64 + px) as usize;
+            out[p] = touched[p]
+                && (-1..=1).any(|dy| {
+                    (-1..=1).any(|dx| {
+                        let (x, y) = (px + dx, py + dy);
+                        x >= 0
+                            && y >= 0
+                            && x < w as i64
+                            && y < h as i64
+                            && own[(y * w as i64 + x) as usize]
+                    })
+                });
+        }
+    }
+    out
+}
+
+/// Render the tiles of `image` that hold a flagged pixel at `m x m`
+/// positions per pixel and replace the flagged pixels with their box.
+/// `state` is the frame's state (its camera the full image's); each tile is
+/// one frame of `r`, alone (the progressive sum started again).
+pub fn refine(
+    gpu: &Gpu,
+    r: &Renderer,
+    state: &FrameState,
+    image: &mut LinearImage,
+    flags: &[bool],
+    m: u32,
+) -> Result<Refined> {
+    let (w, h) = (image.width, image.height);
+    if flags.len() != (w * h) as usize {
+        return Err(Error::internal(format!(
+            "edge refinement: {} flags for a {w} x {h} frame",
+            flags.len()
+        )));
+    }
+    if !(1..=MAX_POSITIONS).contains(&m) {
+        return Err(Error::usage(format!(
+            "the edge refinement's positions per pixel side must be 1..{MAX_POSITIONS}, not {m}"
+        )));
+    }
+    let (tw, th) = (TILE.min(w), TILE.min(h));
+    let mut done = Refined {
+        pixels: 0,
+        tiles: 0,
+    };
+    let mut target: Option<Offscreen> = None;
+    for ty in (0..h).step_by(th as usize) {
+        for tx in (0..w).step_by(tw as usize) {
+            // the last row and column of tiles end at the image's edge
+            let (x0, y0) = (tx.min(w - tw), ty.min(h - th));
+            let flagged = |x: u32, y: u32| flags[(y * w + x) as usize];
+            let any = (y0..y0 + th).any(|y| (x0..x0 + tw).any(|x| flagged(x, y)));
+            if !any {
+                continue;
+            }
+            if target.is_none() {
+                target = Some(Offscreen::new(gpu, r, tw * m, th * m)?);
+            }
+            let t = target.as_mut().expect("made above");
+            let st = FrameState {
+                camera: state
+                    .camera
+                    .window(w, h, [x0 as f64, y0 as f64, tw as f64, th as f64]),
+                ..state.clone()
+            };
+            t.reset();
+            let tile = t.render_frames_linear(gpu, r, &st, 1)?.downsample(m);
+            for y in y0..y0 + th {
+                for x in x0..x0 + tw {
+                    if flagged(x, y) {
+                        image.rgb[(y * w + x) as usize] =
+                            tile.rgb[((y - y0) * tw + (x - x0)) as usize];
+                        done.pixels += 1;
+                    }
+                }
+            }
+            done.tiles += 1;
+        }
+    }
+    Ok(done)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(w: u32, h: u32, f: impl Fn(u32, u32) -> f32) -> LinearImage {
+        let mut im = LinearImage::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let v = f(x, y);
+                im.rgb[(y * w + x) as usize] = [v, v, v];
+            }
+        }
+        im
+    }
+
+    /// A smooth gradient flags nothing; a step on the surface flags the
+    /// pixels it crosses and their neighbours, whatever `k`; so does an
+    /// outline, but not the background beyond its neighbours; a sub-pixel
+    /// sheen flags its pixel and its neighbours.
+    #[test]
+    fn flags_follow_the_outline_and_the_sub_pixels_spread() {
+        let all = |im: &LinearImage| vec![1.0f32; im.rgb.len()];
+        for k in [1u32, 4] {
+            let ramp = frame(16 * k, 8 * k, |x, _| 0.2 + 0.001 * x as f32);
+            assert!(
+                flag_pixels(&ramp, &all(&ramp), k, 0.1).iter().all(|&f| !f),
+                "k {k}"
+            );
+            // a step inside pixel column 5 (k > 1) or between 5 and 6 (k = 1)
+            let edge = if k == 1 { 6 } else { 5 * k + k / 2 };
+            let step = frame(16 * k, 8 * k, |x, _| if x < edge { 0.02 } else { 0.5 });
+            // k = 1: pixels 5 and 6 see the step, then their neighbours;
+            // k = 4: pixel 5 holds it
+            let want = |x: u32| {
+                if k == 1 {
+                    (4..=7).contains(&x)
+                } else {
+                    (4..=6).contains(&x)
+                }
+            };
+            let f = flag_pixels(&step, &all(&step), k, 0.1);
+            for y in 0..8 {
+                for x in 0..16u32 {
+                    assert_eq!(f[(y * 16 + x) as usize], want(x), "k {k} x {x} y {y}");
+                }
+            }
+            // the same step as an outline: the mesh left of it, a textured
+            // background right of it (flagged at the outline only)
+            let bg = frame(16 * k, 8 * k, |x, y| {
+                if x < edge {
+                    0.2
+                } else {
+                    0.1 + 0.5 * ((x + y) % 2) as f32
+                }
+            });
+            let cov: Vec<f32> = (0..bg.rgb.len())
+                .map(|i| {
+                    if (i as u32 % (16 * k)) < edge {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let f = flag_pixels(&bg, &cov, k, 0.1);
+            for y in 0..8 {
+                for x in 0..16u32 {
+                    // pixels whose block touches the mesh: up to 6 (k = 1), 5 (k = 4)
+                    let touched = if k == 1 { x <= 6 } else { x <= 5 };
+                    assert_eq!(
+                        f[(y * 16 + x) as usize],
+                        want(x) && touched,
+                        "outline k {k} x {x} y {y}"
+                    );
+                }
+            }
+        }
+        let sheen = frame(32, 32, |x, y| if x == 17 && y == 9 { 4.0 } else { 0.1 });
+        let f = flag_pixels(&sheen, &all(&sheen), 4, 0.1);
+        let n = f.iter().filter(|&&b| b).count();
+        // pixel (4, 2) holds the sheen (no other pixel's ring reaches it):
+        // it and its eight neighbours
+        assert!(f[2 * 8 + 4] && f[2 * 8 + 5] && n == 9, "{n}");
+    }
+}
