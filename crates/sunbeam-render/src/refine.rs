@@ -19,13 +19,20 @@ use crate::{FrameState, Gpu, Offscreen, Renderer};
 use sunbeam_common::{Error, Result};
 use sunbeam_frame::linear::{luminance, LinearImage, LIT_Y};
 
-/// Tiles' side in pixels (the image's side where smaller): small enough that
-/// a silhouette's tiles hold few unflagged pixels, large enough that a
-/// frame's fixed cost (pre-passes, submission, readback) is shared.
-pub const TILE: u32 = 16;
+/// Tiles' side in texels that [`tile_pixels`] aims at: on lavapipe a frame
+/// under 128 texels a side costs more per position (its fixed work, and a
+/// rasteriser that shares its work out in 64-pixel tiles: at 16 positions
+/// a side, tiles of 4 / 8 / 16 pixels took 115 / 65 / 59 s on the same
+/// 416 pixels), and larger ones shade more unflagged pixels.
+pub const TILE_TEXELS: u32 = 256;
 
-/// Positions per pixel side the refinement may take (a tile is `TILE m`
-/// texels wide).
+/// Tiles' side in pixels at `m` positions per pixel side: about
+/// [`TILE_TEXELS`] texels, 4 to 16 pixels (the image's side where smaller).
+pub fn tile_pixels(m: u32) -> u32 {
+    (TILE_TEXELS / m.max(1)).clamp(4, 16)
+}
+
+/// Positions per pixel side the refinement may take.
 pub const MAX_POSITIONS: u32 = 64;
 
 /// The default spread that flags a pixel (see [`flag_pixels`]).
@@ -136,7 +143,8 @@ pub fn refine(
             "the edge refinement's positions per pixel side must be 1..{MAX_POSITIONS}, not {m}"
         )));
     }
-    let (tw, th) = (TILE.min(w), TILE.min(h));
+    let tile = tile_pixels(m);
+    let (tw, th) = (tile.min(w), tile.min(h));
     let mut done = Refined {
         pixels: 0,
         tiles: 0,

@@ -39,7 +39,7 @@ pub(crate) struct Cli {
     pub(crate) supersample: u32,
     /// Headless: render again, at M x M positions each, the pixels whose sub-pixels
     /// (with their neighbours') disagree: silhouettes, the limb's sheen, scale
-    /// borders (0..=64; 0: off; tiles of 8 x 8 pixels; after --supersample and
+    /// borders (0..=64; 0: off; tiles of about 256 x 256 positions; after --supersample and
     /// --frames; docs/LIGHTING.md "Edge refinement").
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=sunbeam_render::refine::MAX_POSITIONS as i64))]
     pub(crate) edge_supersample: u32,
