@@ -36,7 +36,7 @@ pub fn tile_pixels(m: u32) -> u32 {
 pub const MAX_POSITIONS: u32 = 64;
 
 /// The default spread that flags a pixel (see [`flag_pixels`]).
-pub const DEFAULT_THRESHOLD: f64 = 0.1;
+pub const DEFAULT_THRESHOLD: f64 = 0.05;
 
 /// What [`refine`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -49,69 +49,100 @@ pub struct Refined {
 
 /// The pixels of a `k`-times supersampled frame `sub` (`k` sub-pixels per
 /// pixel side; `coverage` its sub-pixels' coverage by the meshes, 0..1) to
-/// refine. A pixel is looked at with the ring of sub-pixels around it (the
-/// neighbours' nearest: so `k = 1` compares a pixel with its eight
-/// neighbours) and flagged where that block
-/// - holds a mesh's outline: some of it covered, some not (a silhouette's
-///   coverage is sampled as coarsely as the frame's positions), or
-/// - its covered sub-pixels' luminance spans more than `threshold` times
-///   their mean (plus [`LIT_Y`], so that near-black noise does not count):
-///   light sharp at the sub-pixels' scale on the surface;
+/// refine: those where
+/// - a mesh's outline crosses the pixel's sub-pixels or the ring of
+///   sub-pixels around them (the neighbours' nearest: so `k = 1` compares a
+///   pixel with its eight neighbours): some covered, some not, a coverage
+///   sampled as coarsely as the frame's positions; or
+/// - the light on the surface bends at the sub-pixels' scale: a covered
+///   sub-pixel of the pixel (its four neighbours covered too) differs from
+///   their mean by more than `threshold` times the pixel's mean luminance
+///   (plus [`LIT_Y`], so that near-black noise does not count). That is
+///   the midpoint rule's error term: a gradient, however steep, is
+///   integrated exactly and is not flagged; a step of `4 threshold` times
+///   the mean, a sheen, an order's edge are;
 ///
-/// and so are the eight neighbours of a flagged pixel that the meshes touch
-/// (a sheen next to a silhouette can fall between every sub-pixel of its
-/// own pixel). What is behind the meshes alone is never flagged: the
+/// and the eight neighbours of a flagged pixel that the meshes touch (a
+/// sheen beside an outline can fall between every sub-pixel of its own
+/// pixel). What is behind the meshes alone is never flagged: the
 /// background's pass already averages each pixel.
 pub fn flag_pixels(sub: &LinearImage, coverage: &[f32], k: u32, threshold: f64) -> Vec<bool> {
     // a sub-pixel counts as covered, or as not, within this of 1 or 0 (the
     // coverage is the mean of 4 MSAA samples in half floats)
     const FULL: f32 = 0.99;
     const NONE: f32 = 0.01;
-    let k = k.max(1);
-    let (w, h) = (sub.width / k, sub.height / k);
+    let k = k.max(1) as i64;
+    let (w, h) = (sub.width as i64 / k, sub.height as i64 / k);
     let (sw, sh) = (sub.width as i64, sub.height as i64);
     let y: Vec<f64> = sub.rgb.iter().map(|&p| luminance(p)).collect();
+    let at = |x: i64, y: i64| (x >= 0 && y >= 0 && x < sw && y < sh).then(|| (y * sw + x) as usize);
+    // how far sub-pixel i bends from its covered neighbours' mean along
+    // each axis where it has both (0 where one of them is not covered: the
+    // outline's test takes those)
+    let bend = |x: i64, yy: i64| -> f64 {
+        let i = at(x, yy).expect("inside");
+        if coverage[i] < FULL {
+            return 0.0;
+        }
+        let (mut sum, mut n) = (0.0, 0.0);
+        for (dx, dy) in [(1, 0), (0, 1)] {
+            let (Some(a), Some(b)) = (at(x - dx, yy - dy), at(x + dx, yy + dy)) else {
+                continue;
+            };
+            if coverage[a] < FULL || coverage[b] < FULL {
+                return 0.0;
+            }
+            sum += 0.5 * (y[a] + y[b]);
+            n += 1.0;
+        }
+        if n > 0.0 {
+            (y[i] - sum / n).abs()
+        } else {
+            0.0
+        }
+    };
     let mut own = vec![false; (w * h) as usize];
     let mut touched = vec![false; (w * h) as usize];
-    for py in 0..h as i64 {
-        for px in 0..w as i64 {
-            let (mut lo, mut hi, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0.0);
+    for py in 0..h {
+        for px in 0..w {
             let (mut some, mut all) = (false, true);
-            for sy in (py * k as i64 - 1)..=((py + 1) * k as i64) {
-                for sx in (px * k as i64 - 1)..=((px + 1) * k as i64) {
-                    if sx < 0 || sy < 0 || sx >= sw || sy >= sh {
-                        continue;
-                    }
-                    let i = (sy * sw + sx) as usize;
-                    let c = coverage[i];
-                    some |= c > NONE;
-                    all &= c >= FULL;
-                    if c >= FULL {
-                        lo = lo.min(y[i]);
-                        hi = hi.max(y[i]);
-                        sum += y[i];
-                        n += 1.0;
+            for sy in (py * k - 1)..=((py + 1) * k) {
+                for sx in (px * k - 1)..=((px + 1) * k) {
+                    if let Some(i) = at(sx, sy) {
+                        some |= coverage[i] > NONE;
+                        all &= coverage[i] >= FULL;
                     }
                 }
             }
-            let p = (py * w as i64 + px) as usize;
+            let p = (py * w + px) as usize;
             touched[p] = some;
-            own[p] = some && (!all || (n > 0.0 && hi - lo > threshold * (sum / n + LIT_Y)));
+            if !some {
+                continue;
+            }
+            if !all {
+                own[p] = true;
+                continue;
+            }
+            let cells = || {
+                (py * k..(py + 1) * k)
+                    .flat_map(move |sy| (px * k..(px + 1) * k).map(move |sx| (sx, sy)))
+            };
+            let mean = cells()
+                .map(|(sx, sy)| y[(sy * sw + sx) as usize])
+                .sum::<f64>()
+                / (k * k) as f64;
+            own[p] = cells().any(|(sx, sy)| bend(sx, sy) > threshold * (mean + LIT_Y));
         }
     }
     let mut out = vec![false; own.len()];
-    for py in 0..h as i64 {
-        for px in 0..w as i64 {
-            let p = (py * w as i64 + px) as usize;
+    for py in 0..h {
+        for px in 0..w {
+            let p = (py * w + px) as usize;
             out[p] = touched[p]
                 && (-1..=1).any(|dy| {
                     (-1..=1).any(|dx| {
                         let (x, y) = (px + dx, py + dy);
-                        x >= 0
-                            && y >= 0
-                            && x < w as i64
-                            && y < h as i64
-                            && own[(y * w as i64 + x) as usize]
+                        x >= 0 && y >= 0 && x < w && y < h && own[(y * w + x) as usize]
                     })
                 });
         }
@@ -201,7 +232,7 @@ mod tests {
         im
     }
 
-    /// A smooth gradient flags nothing; a step on the surface flags the
+    /// A gradient flags nothing, however steep; a step on the surface flags the
     /// pixels it crosses and their neighbours, whatever `k`; so does an
     /// outline, but not the background beyond its neighbours; a sub-pixel
     /// sheen flags its pixel and its neighbours.
@@ -209,9 +240,12 @@ mod tests {
     fn flags_follow_the_outline_and_the_sub_pixels_spread() {
         let all = |im: &LinearImage| vec![1.0f32; im.rgb.len()];
         for k in [1u32, 4] {
-            let ramp = frame(16 * k, 8 * k, |x, _| 0.2 + 0.001 * x as f32);
+            // 25 % of the mean a pixel along x
+            let ramp = frame(16 * k, 8 * k, |x, y| {
+                0.2 + (0.05 * x as f32 + 0.02 * y as f32) / k as f32
+            });
             assert!(
-                flag_pixels(&ramp, &all(&ramp), k, 0.1).iter().all(|&f| !f),
+                flag_pixels(&ramp, &all(&ramp), k, 0.05).iter().all(|&f| !f),
                 "k {k}"
             );
             // a step inside pixel column 5 (k > 1) or between 5 and 6 (k = 1)

@@ -43,9 +43,10 @@ pub(crate) struct Cli {
     /// --frames; docs/LIGHTING.md "Edge refinement").
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=sunbeam_render::refine::MAX_POSITIONS as i64))]
     pub(crate) edge_supersample: u32,
-    /// Headless, --edge-supersample: a pixel is refined where its sub-pixels'
-    /// luminance spans more than this times their mean (0.001..=10), and so are its
-    /// neighbours.
+    /// Headless, --edge-supersample: besides the outlines, a pixel is refined where a
+    /// sub-pixel's luminance differs from its neighbours' mean by more than this times
+    /// the pixel's mean (0.001..=10: a gradient is not flagged, a step of 4x this is),
+    /// and so are its neighbours.
     #[arg(long, default_value_t = sunbeam_render::refine::DEFAULT_THRESHOLD, value_parser = sunbeam_common::cli::ranged(0.001, 10.0))]
     pub(crate) edge_threshold: f64,
     /// Read the response maps at the pixel centre only (no footprint filter): the point

@@ -1367,7 +1367,7 @@ fn edge_refinement_is_the_supersampled_frame_at_its_pixels() {
 }
 
 /// Bound of [`edge_refinement_is_the_supersampled_frame_at_its_pixels`]:
-/// measured p99 0.042 over the 340 refined pixels (half floats and the
+/// measured p99 0.042 over the 302 refined pixels (half floats and the
 /// cells' walks on two ways to the same positions; lavapipe, 2026-12-06),
 /// the 2 x 2 frame 7.64 there; tiles a twentieth of a pixel off (the
 /// window's centre moved by 0.05 pixels) fail the test.
