@@ -675,3 +675,83 @@ const SNAKE_SKY_P99: f64 = 2.0;
 /// before the sun's disc points were read over the footprint, one point per
 /// sub-pixel), plus 25 %.
 const SNAKE_SKY_INTERIOR_P99: f64 = 0.7;
+
+/// Edge refinement in three.js (`render.mjs --edge-supersample M`: the
+/// player's criterion, docs/LIGHTING.md "Edge refinement", the tiles drawn
+/// through `camera.setViewOffset`): the pixels it replaces are what the
+/// whole frame supersampled at M x M gives there (the same positions in
+/// one pass, no tiles), the others are the plain frame's, and every pixel
+/// of the silhouette is replaced. The sky-lit ridge sphere 32 x 32 on
+/// black (a steep outline), 2 x 2 then 8 x 8 at the flagged pixels, against
+/// `--supersample 8`.
+#[test]
+fn threejs_edge_refinement_is_the_supersampled_frame_at_its_pixels() {
+    let d = scratch("threejs-edge");
+    let Some(render) = example(&d) else { return };
+    ridges(&d);
+    let scene = d.join("sphere.json");
+    std::fs::write(
+        &scene,
+        r#"{ "camera": { "eye": [0, 0, 2.6], "target": [0, 0, 0], "fov_y_deg": 35 },
+  "meshes": [ { "mesh": "builtin:sphere", "pack": "ridges.ktx2", "base_color": [0.03, 0.03, 0.03], "diffuse_weight": 0.1 } ],
+  "environment": { "sky": { "sun_elevation_deg": 35, "sun_azimuth_deg": 60 } },
+  "exposure": 4.64, "size": [32, 32] }"#,
+    )
+    .unwrap();
+    let refined = threejs_frame_with(
+        &render,
+        &d,
+        &scene,
+        "refined",
+        2,
+        &["--edge-supersample", "8"],
+    );
+    let plain = threejs_frame_at(&render, &d, &scene, "plain", 2);
+    let truth = threejs_frame_at(&render, &d, &scene, "truth", 8);
+    let (w, h) = (truth.width as usize, truth.height as usize);
+    let changed: Vec<usize> = (0..w * h)
+        .filter(|&i| refined.rgb[i] != plain.rgb[i])
+        .collect();
+    // every silhouette pixel (lit at 8 x 8, with an unlit neighbour) is replaced
+    let lit =
+        |i: usize| sunbeam_frame::linear::luminance(truth.rgb[i]) > sunbeam_frame::linear::LIT_Y;
+    let mut outline = 0;
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let i = y * w + x;
+            if lit(i) && [i - 1, i + 1, i - w, i + w].iter().any(|&j| !lit(j)) {
+                outline += 1;
+                assert!(
+                    refined.rgb[i] != plain.rgb[i],
+                    "outline pixel ({x}, {y}) not refined"
+                );
+            }
+        }
+    }
+    assert!(outline > 40, "{outline}");
+    // the flags take the outline and its neighbours, not the whole sphere
+    assert!(
+        changed.len() > outline && changed.len() < w * h / 2,
+        "{} pixels changed, {outline} on the outline",
+        changed.len()
+    );
+    let de = |a: &LinearImage| {
+        let d = sunbeam_frame::linear::per_pixel_de(a, &truth).unwrap();
+        let mut v: Vec<f64> = changed.iter().filter_map(|&i| d[i]).collect();
+        sunbeam_frame::diff::stats(&mut v)
+    };
+    let (after, before) = (de(&refined), de(&plain));
+    eprintln!(
+        "three.js: {} refined pixels against --supersample 8: {after}; unrefined {before}",
+        changed.len()
+    );
+    assert!(after.p99 < EDGE_REFINED_P99, "{after}");
+    assert!(
+        before.p99 > 4.0 * EDGE_REFINED_P99,
+        "the refinement changed little: {before}"
+    );
+}
+
+/// Bound of [`threejs_edge_refinement_is_the_supersampled_frame_at_its_pixels`]
+/// (the player's bound for its own refinement, tools/sunbeam-play/tests/environment.rs).
+const EDGE_REFINED_P99: f64 = 0.1;

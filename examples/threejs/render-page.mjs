@@ -12,9 +12,88 @@ import {
 // Colours are linear values as given (no sRGB conversion of inputs or outputs).
 THREE.ColorManagement.enabled = false;
 
+// Luminance Y of linear sRGB (sunbeam_frame::linear::luminance) and the
+// luminance under which a pixel counts as unlit (sunbeam_frame::linear::LIT_Y).
+const luminance = (r, g, b) => 0.2126729 * r + 0.7151522 * g + 0.072175 * b;
+const LIT_Y = 0.0011;
+
+/**
+ * The pixels of a K-times supersampled frame to render again at more
+ * positions: the player's criterion (crates/sunbeam-render/src/refine.rs
+ * `flag_pixels`, docs/LIGHTING.md "Edge refinement"), here because the page
+ * holds the sub-pixels. `sy`: the sub-pixels' luminance, `cover`: their
+ * coverage by the meshes (0..1), `W x H` sub-pixels, `k` per pixel side. A
+ * pixel is flagged where its sub-pixels with the ring around them are partly
+ * covered, or where a covered sub-pixel (its axis neighbours covered too)
+ * differs from the mean of its neighbours along each axis by more than
+ * `threshold` times the pixel's mean luminance (plus LIT_Y): the midpoint
+ * rule's error term, so a gradient is not flagged and a sheen or a step is;
+ * then the neighbours of a flagged pixel that a mesh touches.
+ */
+function flagPixels(sy, cover, W, H, k, threshold) {
+  const FULL = 0.99, NONE = 0.01;
+  const w = W / k, h = H / k;
+  const inside = (x, y) => x >= 0 && y >= 0 && x < W && y < H;
+  const bend = (x, y) => {
+    const i = y * W + x;
+    if (cover[i] < FULL) return 0;
+    let sum = 0, n = 0;
+    for (const [dx, dy] of [[1, 0], [0, 1]]) {
+      if (!inside(x - dx, y - dy) || !inside(x + dx, y + dy)) continue;
+      const a = (y - dy) * W + x - dx, b = (y + dy) * W + x + dx;
+      if (cover[a] < FULL || cover[b] < FULL) return 0;
+      sum += 0.5 * (sy[a] + sy[b]);
+      n += 1;
+    }
+    return n > 0 ? Math.abs(sy[i] - sum / n) : 0;
+  };
+  const own = new Uint8Array(w * h), touched = new Uint8Array(w * h);
+  for (let py = 0; py < h; py++) {
+    for (let px = 0; px < w; px++) {
+      let some = false, all = true;
+      for (let y = py * k - 1; y <= (py + 1) * k; y++) {
+        for (let x = px * k - 1; x <= (px + 1) * k; x++) {
+          if (!inside(x, y)) continue;
+          const c = cover[y * W + x];
+          some ||= c > NONE;
+          all &&= c >= FULL;
+        }
+      }
+      const p = py * w + px;
+      touched[p] = some;
+      if (!some) continue;
+      if (!all) { own[p] = 1; continue; }
+      let mean = 0;
+      for (let y = py * k; y < (py + 1) * k; y++) for (let x = px * k; x < (px + 1) * k; x++) mean += sy[y * W + x];
+      mean /= k * k;
+      const limit = threshold * (mean + LIT_Y);
+      let bent = false;
+      for (let y = py * k; y < (py + 1) * k && !bent; y++) for (let x = px * k; x < (px + 1) * k && !bent; x++) bent = bend(x, y) > limit;
+      own[p] = bent;
+    }
+  }
+  const out = new Uint8Array(w * h);
+  for (let py = 0; py < h; py++) {
+    for (let px = 0; px < w; px++) {
+      if (!touched[py * w + px]) continue;
+      for (let dy = -1; dy <= 1 && !out[py * w + px]; dy++) {
+        for (let dx = -1; dx <= 1; dx++) {
+          const x = px + dx, y = py + dy;
+          if (x >= 0 && y >= 0 && x < w && y < h && own[y * w + x]) { out[py * w + px] = 1; break; }
+        }
+      }
+    }
+  }
+  return out;
+}
+
+// Tiles of the refinement: about 256 positions a side, 4 to 16 pixels (the
+// player's refine.rs tile_pixels).
+const edgeTilePixels = (m) => Math.min(16, Math.max(4, Math.floor(256 / m)));
+
 window.sunbeamRender = async (job) => {
   try {
-    const { scene: desc, meshes, size, supersample: k, msaa = 1, glsl, env: envJob, tile: tileAsked = 0 } = job;
+    const { scene: desc, meshes, size, supersample: k, msaa = 1, glsl, env: envJob, tile: tileAsked = 0, edge = 0, edgeThreshold = 0.05 } = job;
     const [w, h] = size;
     const W = w * k, H = h * k;
     const canvas = document.createElement('canvas');
@@ -100,7 +179,8 @@ window.sunbeamRender = async (job) => {
       root.add(gltf.scene);
     }
     const camera = sceneCamera(desc, w / h);
-    if (desc.background === 'environment') root.add(environmentBackground(exported, environment, camera, desc.exposure));
+    const background = desc.background === 'environment' ? environmentBackground(exported, environment, camera, desc.exposure) : null;
+    if (background) root.add(background);
     root.updateMatrixWorld(true);
     updateSunbeamUniforms(root, camera);
     // msaa > 1: a multisampled target, resolved (averaged) before the read.
@@ -113,6 +193,27 @@ window.sunbeamRender = async (job) => {
     // Box filter K x K in linear light: each texel of each tile adds to its pixel.
     const rgb = new Float64Array(w * h * 3);
     const buf = new Float32Array(Math.min(tile, W) * Math.min(tile, H) * 4);
+    // With --edge-supersample: the sub-pixels' luminance and the meshes'
+    // coverage (a second pass, the meshes white on a clear of 0 and no
+    // background, through the same target and its MSAA).
+    const subY = edge ? new Float32Array(W * H) : null;
+    const cover = edge ? new Float32Array(W * H) : null;
+    const white = edge ? new THREE.MeshBasicMaterial({ color: 0xffffff }) : null;
+    const coverage = (target, tw, th, into, x0, y0, stride) => {
+      root.overrideMaterial = white;
+      if (background) background.visible = false;
+      renderer.setClearColor(new THREE.Color(0, 0, 0), 0);
+      renderer.setRenderTarget(target);
+      renderer.render(root, camera);
+      renderer.readRenderTargetPixels(target, 0, 0, tw, th, into.buf);
+      root.overrideMaterial = null;
+      if (background) background.visible = true;
+      renderer.setClearColor(new THREE.Color(bg[0] * scale, bg[1] * scale, bg[2] * scale), 1);
+      for (let j = 0; j < th; j++) {
+        const row = th - 1 - j;
+        for (let i = 0; i < tw; i++) into.out[(y0 + j) * stride + x0 + i] = into.buf[4 * (row * tw + i)];
+      }
+    };
     // The tile's window within the camera's own (a lens shift is a view offset already).
     const shifted = camera.view?.enabled === true;
     const view = shifted ? { ...camera.view } : { fullWidth: W, fullHeight: H, offsetX: 0, offsetY: 0, width: W, height: H };
@@ -133,19 +234,101 @@ window.sunbeamRender = async (job) => {
             const p = 4 * (row * tw + i);
             const o = 3 * (y * w + Math.floor((x0 + i) / k));
             rgb[o] += buf[p]; rgb[o + 1] += buf[p + 1]; rgb[o + 2] += buf[p + 2];
+            if (subY) subY[(y0 + j) * W + x0 + i] = luminance(buf[p], buf[p + 1], buf[p + 2]);
+          }
+        }
+        if (cover) coverage(rt, tw, th, { buf, out: cover }, x0, y0, W);
+      }
+    }
+    for (let i = 0; i < rgb.length; i++) rgb[i] /= k * k;
+    // Edge refinement: the flagged pixels' tiles at edge x edge positions per
+    // pixel, each a frame of its own through the camera narrowed to the tile.
+    let refined = null;
+    if (edge) {
+      const flags = flagPixels(subY, cover, W, H, k, edgeThreshold);
+      const tp = edgeTilePixels(edge);
+      const tw = Math.min(tp, w), th = Math.min(tp, h);
+      const ew = tw * edge, eh = th * edge;
+      const et = new THREE.WebGLRenderTarget(ew, eh, {
+        type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true, samples: msaa > 1 ? msaa : 0,
+      });
+      const ebuf = new Float32Array(ew * eh * 4);
+      const done = new Uint8Array(w * h);
+      refined = { pixels: 0, tiles: 0 };
+      for (let ty = 0; ty < h; ty += th) {
+        for (let tx = 0; tx < w; tx += tw) {
+          // the last row and column of tiles end at the image's edge
+          const x0 = Math.min(tx, w - tw), y0 = Math.min(ty, h - th);
+          let any = false;
+          for (let y = y0; y < y0 + th && !any; y++) for (let x = x0; x < x0 + tw && !any; x++) any = flags[y * w + x] && !done[y * w + x];
+          if (!any) continue;
+          // Only the pixels to refine are shaded: each run of them along a
+          // row (merged with the same run in the rows below) is one draw
+          // under a scissor rectangle (SwiftShader tests depth after the
+          // fragment shader, so a depth mask would not save the shading).
+          const rects = [];
+          const open = new Map();
+          for (let y = y0; y < y0 + th; y++) {
+            const seen = new Set();
+            for (let x = x0; x < x0 + tw; x++) {
+              if (!flags[y * w + x] || done[y * w + x]) continue;
+              let e = x;
+              while (e + 1 < x0 + tw && flags[y * w + e + 1] && !done[y * w + e + 1]) e++;
+              const key = `${x},${e}`;
+              const r = open.get(key);
+              if (r && r.y1 === y) r.y1 = y + 1;
+              else { const n = { x, e, y, y1: y + 1 }; rects.push(n); open.set(key, n); }
+              seen.add(key);
+              x = e;
+            }
+            for (const key of [...open.keys()]) if (!seen.has(key)) open.delete(key);
+          }
+          camera.setViewOffset(view.fullWidth, view.fullHeight, view.offsetX + x0 * k * sx, view.offsetY + y0 * k * sy, tw * k * sx, th * k * sy);
+          et.scissorTest = false;
+          renderer.setRenderTarget(et);
+          renderer.clear();
+          renderer.autoClear = false;
+          et.scissorTest = true;
+          for (const r of rects) {
+            // scissor in the target's texels, rows bottom-up
+            et.scissor.set((r.x - x0) * edge, (y0 + th - r.y1) * edge, (r.e + 1 - r.x) * edge, (r.y1 - r.y) * edge);
+            renderer.setRenderTarget(et);
+            renderer.render(root, camera);
+          }
+          renderer.autoClear = true;
+          et.scissorTest = false;
+          renderer.setRenderTarget(et);
+          renderer.readRenderTargetPixels(et, 0, 0, ew, eh, ebuf);
+          refined.tiles += 1;
+          for (let y = y0; y < y0 + th; y++) {
+            for (let x = x0; x < x0 + tw; x++) {
+              const p = y * w + x;
+              if (!flags[p] || done[p]) continue;
+              const c = [0, 0, 0];
+              for (let j = (y - y0) * edge; j < (y - y0 + 1) * edge; j++) {
+                const row = eh - 1 - j;
+                for (let i = (x - x0) * edge; i < (x - x0 + 1) * edge; i++) {
+                  const q = 4 * (row * ew + i);
+                  c[0] += ebuf[q]; c[1] += ebuf[q + 1]; c[2] += ebuf[q + 2];
+                }
+              }
+              for (let ch = 0; ch < 3; ch++) rgb[3 * p + ch] = c[ch] / (edge * edge);
+              done[p] = 1;
+              refined.pixels += 1;
+            }
           }
         }
       }
+      et.dispose();
     }
     if (shifted) camera.setViewOffset(view.fullWidth, view.fullHeight, view.offsetX, view.offsetY, view.width, view.height);
     else camera.clearViewOffset();
-    for (let i = 0; i < rgb.length; i++) rgb[i] /= k * k;
     const dbg = gl.getExtension('WEBGL_debug_renderer_info');
     const name = dbg ? gl.getParameter(dbg.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);
     const glError = gl.getError();
     if (glError !== gl.NO_ERROR) return { error: `WebGL error 0x${glError.toString(16)}` };
     renderer.dispose();
-    return { rgb: Array.from(rgb), renderer: name, tiles: Math.ceil(W / tile) * Math.ceil(H / tile) };
+    return { rgb: Array.from(rgb), renderer: name, tiles: Math.ceil(W / tile) * Math.ceil(H / tile), edge: refined };
   } catch (e) {
     return { error: `three.js: ${e.message}` };
   }

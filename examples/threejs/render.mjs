@@ -2,6 +2,7 @@
 // Chromium, as a browser would draw it:
 //
 //   node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--tile T]
+//                   [--edge-supersample M [--edge-threshold T]]
 //
 // - the material is sunbeam-three.mjs: the GLSL ES that
 //   `sunbeam-play --export-shader glsl-es` writes from the player's WGSL
@@ -23,7 +24,12 @@
 // - --msaa N (1 or 4, default 1) renders that target with N samples per
 //   texel, as a page with `antialias: true` draws its canvas: coverage at N
 //   samples, the material shaded once per texel at the centroid of the
-//   covered samples (docs/ENGINES.md "The baked snake under the sky").
+//   covered samples (docs/ENGINES.md "The baked snake under the sky");
+// - --edge-supersample M (1..64) renders the pixels whose K x K sub-pixels
+//   disagree (a mesh's outline, the limb's sheen: the player's criterion,
+//   --edge-threshold T, default 0.05) again at M x M positions each, in
+//   tiles through camera.setViewOffset, and replaces them with that box
+//   (sunbeam-play's --edge-supersample; docs/LIGHTING.md "Edge refinement").
 //
 // Needs three and playwright-core next to it (node_modules) and Debian's
 // chromium (CHROMIUM or /usr/bin/chromium; playwright gives it a fresh
@@ -40,7 +46,7 @@ const here = dirname(fileURLToPath(import.meta.url));
 
 function usage(msg) {
   if (msg) console.error(`render.mjs: error: ${msg}`);
-  console.error('usage: node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--tile T] [--glsl FILE]');
+  console.error('usage: node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--tile T] [--edge-supersample M [--edge-threshold T]] [--glsl FILE]');
   process.exit(1);
 }
 
@@ -70,6 +76,12 @@ for (let i = 0; i < args.length; i++) {
   } else if (a === '--msaa') {
     opt.msaa = Number(next());
     if (opt.msaa !== 1 && opt.msaa !== 4) usage('--msaa: 1 or 4');
+  } else if (a === '--edge-supersample') {
+    opt.edge = Number(next());
+    if (!Number.isInteger(opt.edge) || opt.edge < 1 || opt.edge > 64) usage('--edge-supersample: 1..64 positions per pixel side');
+  } else if (a === '--edge-threshold') {
+    opt.edgeThreshold = Number(next());
+    if (!(opt.edgeThreshold > 0 && Number.isFinite(opt.edgeThreshold))) usage('--edge-threshold: a positive number (of the pixel\'s mean luminance)');
   } else if (a === '--glsl') opt.glsl = next();
   else if (a === '-h' || a === '--help') usage();
   else if (a.startsWith('-')) usage(`unknown option ${a}`);
@@ -77,6 +89,7 @@ for (let i = 0; i < args.length; i++) {
   else usage(`unexpected argument ${a}`);
 }
 if (!opt.scene || !opt.output) usage('SCENE.json and -o FRAME.png are required');
+if (opt.edgeThreshold !== undefined && !opt.edge) usage('--edge-threshold needs --edge-supersample');
 
 // ---- the scene (the same defaults as crates/sunbeam-scene) -------------------------
 let scene;
@@ -268,7 +281,8 @@ try {
   p.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
   await p.goto(`${base}/render.html`);
   await p.waitForFunction(() => window.sunbeamRender !== undefined, null, { timeout: 60000 });
-  const job = { scene, meshes, size, supersample: opt.supersample, msaa: opt.msaa, glsl, env, tile: opt.tile ?? 0 };
+  const job = { scene, meshes, size, supersample: opt.supersample, msaa: opt.msaa, glsl, env, tile: opt.tile ?? 0,
+    edge: opt.edge ?? 0, edgeThreshold: opt.edgeThreshold ?? 0.05 };
   pixels = await p.evaluate((j) => window.sunbeamRender(j), job);
 } catch (e) {
   fail(4, `rendering in Chromium failed: ${e.message}${problems.length ? `\n${problems.join('\n')}` : ''}`);
@@ -362,4 +376,4 @@ function exrBytes() {
   return Buffer.concat([header, table, lines]);
 }
 if (opt.exr) atomicWrite(opt.exr, exrBytes());
-console.error(`render.mjs: wrote ${opt.output}${opt.exr ? ` and ${opt.exr}` : ''} (${w}x${h}, ${opt.supersample}x${opt.supersample} samples per pixel${opt.msaa > 1 ? `, ${opt.msaa}x MSAA` : ''}${pixels.tiles > 1 ? `, ${pixels.tiles} tiles` : ''}, ${pixels.renderer})`);
+console.error(`render.mjs: wrote ${opt.output}${opt.exr ? ` and ${opt.exr}` : ''} (${w}x${h}, ${opt.supersample}x${opt.supersample} samples per pixel${opt.msaa > 1 ? `, ${opt.msaa}x MSAA` : ''}${pixels.tiles > 1 ? `, ${pixels.tiles} tiles` : ''}${pixels.edge ? `, ${pixels.edge.pixels} edge pixels at ${opt.edge}x${opt.edge} in ${pixels.edge.tiles} tiles` : ''}, ${pixels.renderer})`);

@@ -494,6 +494,8 @@ export function updateSunbeamUniforms(root, camera) {
   root.traverse((o) => {
     if (o.isMesh && o.material && o.material.uniforms && o.material.uniforms.sbNormalMatrix) {
       o.onBeforeRender = (r, s, cam, geom, mat) => {
+        // another material drawn in its place (scene.overrideMaterial) has none of these
+        if (!mat.uniforms?.sbNormalMatrix) return;
         mat.uniforms.sbNormalMatrix.value.getNormalMatrix(o.matrixWorld);
         mat.uniforms.sbEye.value.copy(eye);
         mat.uniformsNeedUpdate = true;

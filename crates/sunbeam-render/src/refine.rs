@@ -42,12 +42,44 @@ pub const MAX_POSITIONS: u32 = 64;
 pub const DEFAULT_THRESHOLD: f64 = 0.05;
 
 /// What [`refine`] did.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Refined {
     /// Pixels replaced.
     pub pixels: usize,
     /// Tiles rendered.
     pub tiles: usize,
+    /// Per pixel of the image: replaced, and its `m x m` positions still
+    /// unsettled ([`unsettled`]): the pixels a next level at `2 m` takes.
+    /// None where `m` is odd.
+    pub unsettled: Vec<bool>,
+}
+
+/// Whether the `m x m` positions of the pixel whose block starts at
+/// (`x0`, `y0`) in `sub` are unsettled: `m` even, and one of its four
+/// interleaved quarter-lattices (every other position along each axis,
+/// `(m / 2)^2` each: the same pixel at half the positions per side, four
+/// ways) has a mean luminance off the block's by more than `threshold`
+/// times the block's mean (plus [`LIT_Y`]). At a sharp feature the
+/// midpoint rule's error falls as `1 / m`, so the block's own error is
+/// about half that spread: what is left after `m` is measured by the
+/// positions already taken, and a next level is spent only where it shows.
+pub fn unsettled(sub: &LinearImage, m: u32, x0: u32, y0: u32, threshold: f64) -> bool {
+    if m < 2 || m % 2 == 1 {
+        return false;
+    }
+    let mut lattice = [0.0f64; 4];
+    for j in 0..m {
+        for i in 0..m {
+            let p = sub.rgb[((y0 + j) * sub.width + x0 + i) as usize];
+            lattice[((j % 2) * 2 + i % 2) as usize] += luminance(p);
+        }
+    }
+    let quarter = f64::from(m * m / 4);
+    let lattice = lattice.map(|v| v / quarter);
+    let mean = lattice.iter().sum::<f64>() / 4.0;
+    lattice
+        .iter()
+        .any(|&l| (l - mean).abs() > threshold * (mean + LIT_Y))
 }
 
 /// The pixels of a `k`-times supersampled frame `sub` (`k` sub-pixels per
@@ -156,7 +188,9 @@ pub fn flag_pixels(sub: &LinearImage, coverage: &[f32], k: u32, threshold: f64) 
 /// Render the tiles of `image` that hold a flagged pixel at `m x m`
 /// positions per pixel and replace the flagged pixels with their box.
 /// `state` is the frame's state (its camera the full image's); each tile is
-/// one frame of `r`, alone (the progressive sum started again).
+/// one frame of `r`, alone (the progressive sum started again). The
+/// replaced pixels whose positions are still [`unsettled`] at `threshold`
+/// come back in [`Refined::unsettled`].
 pub fn refine(
     gpu: &Gpu,
     r: &Renderer,
@@ -164,6 +198,7 @@ pub fn refine(
     image: &mut LinearImage,
     flags: &[bool],
     m: u32,
+    threshold: f64,
 ) -> Result<Refined> {
     let (w, h) = (image.width, image.height);
     if flags.len() != (w * h) as usize {
@@ -182,6 +217,7 @@ pub fn refine(
     let mut done = Refined {
         pixels: 0,
         tiles: 0,
+        unsettled: vec![false; flags.len()],
     };
     let mut target: Option<Offscreen> = None;
     for ty in (0..h).step_by(th as usize) {
@@ -204,12 +240,15 @@ pub fn refine(
                 ..state.clone()
             };
             t.reset();
-            let tile = t.render_frames_linear(gpu, r, &st, 1)?.downsample(m);
+            let sub = t.render_frames_linear(gpu, r, &st, 1)?;
+            let tile = sub.downsample(m);
             for y in y0..y0 + th {
                 for x in x0..x0 + tw {
                     if flagged(x, y) {
-                        image.rgb[(y * w + x) as usize] =
-                            tile.rgb[((y - y0) * tw + (x - x0)) as usize];
+                        let p = (y * w + x) as usize;
+                        image.rgb[p] = tile.rgb[((y - y0) * tw + (x - x0)) as usize];
+                        done.unsettled[p] =
+                            unsettled(&sub, m, (x - x0) * m, (y - y0) * m, threshold);
                         done.pixels += 1;
                     }
                 }
@@ -306,5 +345,29 @@ mod tests {
         // pixel (4, 2) holds the sheen (no other pixel's ring reaches it):
         // it and its eight neighbours
         assert!(f[2 * 8 + 4] && f[2 * 8 + 5] && n == 9, "{n}");
+    }
+
+    /// A block whose light is smooth at its positions is settled, however
+    /// steep; a sheen on one row of positions (half the quarter-lattices
+    /// see it) or a step between positions is not; odd `m` never is (no
+    /// quarter-lattices); the block is found at its offset in a larger image.
+    #[test]
+    fn unsettled_where_the_quarter_lattices_disagree() {
+        let m = 8;
+        let at = |f: &dyn Fn(u32, u32) -> f32| frame(3 * m, 2 * m, f);
+        // the block of pixel (1, 1): x 8..16, y 8..16
+        let ramp = at(&|x, y| 0.2 + 0.01 * x as f32 + 0.02 * y as f32);
+        assert!(!unsettled(&ramp, m, m, m, 0.05));
+        let sheen = at(&|_, y| if y == m + 3 { 2.0 } else { 0.2 });
+        assert!(unsettled(&sheen, m, m, m, 0.05));
+        // the same sheen in another pixel's block leaves this one settled
+        assert!(!unsettled(&sheen, m, m, 0, 0.05));
+        // a step between two columns of positions: the lattices see it alike
+        let step = at(&|x, _| if x < m + 4 { 0.1 } else { 0.5 });
+        assert!(!unsettled(&step, m, m, m, 0.05));
+        // a step that falls on every other column: they do not
+        let comb = at(&|x, _| if x % 2 == 0 { 0.1 } else { 0.5 });
+        assert!(unsettled(&comb, m, m, m, 0.05));
+        assert!(!unsettled(&comb, 7, m, m, 0.05));
     }
 }

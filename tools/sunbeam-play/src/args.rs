@@ -49,6 +49,13 @@ pub(crate) struct Cli {
     /// and so are its neighbours.
     #[arg(long, default_value_t = sunbeam_render::refine::DEFAULT_THRESHOLD, value_parser = sunbeam_common::cli::ranged(0.001, 10.0))]
     pub(crate) edge_threshold: f64,
+    /// Headless, --edge-supersample M: levels of refinement (1..=4). Each further level
+    /// renders again, at twice the positions per side, the refined pixels whose
+    /// positions are still unsettled: one of their four interleaved quarter-lattices
+    /// off the pixel's mean by more than --edge-threshold (M even; M doubled at the
+    /// last level at most 64).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4))]
+    pub(crate) edge_levels: u32,
     /// Read the response maps at the pixel centre only (no footprint filter): the point
     /// lights' map, and the environment's hot spots and the sun's disc points under the
     /// cells estimator.

@@ -123,6 +123,22 @@ fn settings(cli: &Cli, scene: &Scene) -> Result<Settings> {
             "--edge-supersample refines a headless GPU frame: it needs --headless, not --cpu or --bench",
         ));
     }
+    if cli.edge_levels > 1 {
+        let last = cli.edge_supersample << (cli.edge_levels - 1);
+        if cli.edge_supersample == 0 || cli.edge_supersample % 2 == 1 {
+            return Err(Error::usage(
+                "--edge-levels above 1 needs an even --edge-supersample (its quarter-lattices decide the next level)",
+            ));
+        }
+        if last > sunbeam_render::refine::MAX_POSITIONS {
+            return Err(Error::usage(format!(
+                "--edge-supersample {} with --edge-levels {} reaches {last} positions per pixel side; at most {}",
+                cli.edge_supersample,
+                cli.edge_levels,
+                sunbeam_render::refine::MAX_POSITIONS
+            )));
+        }
+    }
     if cli.env_samples == 0 || cli.env_samples > 64 {
         return Err(Error::usage("--env-samples must be 1..64"));
     }
@@ -351,21 +367,42 @@ pub(crate) fn run(cli: Cli) -> Result<()> {
             let mut img = sub.downsample(k);
             if cli.edge_supersample > 0 {
                 let te = std::time::Instant::now();
-                let flags =
+                let mut flags =
                     sunbeam_render::refine::flag_pixels(&sub, &coverage, k, cli.edge_threshold);
-                let done = sunbeam_render::refine::refine(
-                    &gpu,
-                    &r,
-                    &state,
-                    &mut img,
-                    &flags,
-                    cli.edge_supersample,
-                )?;
+                // each level refines the last one's unsettled pixels at twice the positions
+                let (mut m, mut levels, mut pixels, mut tiles) =
+                    (cli.edge_supersample, vec![], 0, 0);
+                for level in 0..cli.edge_levels {
+                    let tl = std::time::Instant::now();
+                    let done = sunbeam_render::refine::refine(
+                        &gpu,
+                        &r,
+                        &state,
+                        &mut img,
+                        &flags,
+                        m,
+                        cli.edge_threshold,
+                    )?;
+                    if level == 0 {
+                        pixels = done.pixels;
+                    }
+                    tiles += done.tiles;
+                    levels.push(serde_json::json!({
+                        "positions": m,
+                        "pixels": done.pixels,
+                        "tiles": done.tiles,
+                        "unsettled": done.unsettled.iter().filter(|&&u| u).count(),
+                        "ms": tl.elapsed().as_secs_f64() * 1e3,
+                    }));
+                    flags = done.unsettled;
+                    m *= 2;
+                }
                 report["edge_refine"] = serde_json::json!({
                     "positions": cli.edge_supersample,
                     "threshold": cli.edge_threshold,
-                    "pixels": done.pixels,
-                    "tiles": done.tiles,
+                    "pixels": pixels,
+                    "tiles": tiles,
+                    "levels": levels,
                     "ms": te.elapsed().as_secs_f64() * 1e3,
                 });
             }

@@ -1375,3 +1375,74 @@ fn edge_refinement_is_the_supersampled_frame_at_its_pixels() {
 /// the 2 x 2 frame 7.64 there; tiles a twentieth of a pixel off (the
 /// window's centre moved by 0.05 pixels) fail the test.
 const EDGE_REFINED_P99: f64 = 0.1;
+
+/// Levels of edge refinement (`--edge-levels`): the second level takes the
+/// refined pixels whose quarter-lattices still disagree to twice the
+/// positions. The sky-lit ridge sphere of
+/// [`edge_refinement_is_the_supersampled_frame_at_its_pixels`], 2 x 2, then
+/// 4 x 4 at the flagged pixels and 8 x 8 at the unsettled ones: each
+/// replaced pixel is the whole frame's at `--supersample 4` or `8` there,
+/// some (no more than the second level reports) only at 8, and fewer than
+/// the first level's.
+#[test]
+fn edge_refinement_levels_take_the_unsettled_pixels_further() {
+    let Some((dir, scene)) = sky_lit_ridge_sphere(
+        "edge-levels",
+        r#"{ "eye": [0, 0, 2.6], "target": [0, 0, 0] }"#,
+        32,
+    ) else {
+        return;
+    };
+    let run = |args: &[&str], out: &str| {
+        let o = Command::new(BIN)
+            .arg(&scene)
+            .args(["--headless", "--json", "--env-estimator", "cells", "-o"])
+            .arg(dir.join(out))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (LinearImage::read_exr(&dir.join(out)).unwrap(), report)
+    };
+    let (refined, report) = run(
+        &[
+            "--supersample",
+            "2",
+            "--edge-supersample",
+            "4",
+            "--edge-levels",
+            "2",
+        ],
+        "refined.exr",
+    );
+    let (plain, _) = run(&["--supersample", "2"], "plain.exr");
+    let (four, _) = run(&["--supersample", "4"], "four.exr");
+    let (eight, _) = run(&["--supersample", "8"], "eight.exr");
+    let levels = report["edge_refine"]["levels"].as_array().unwrap();
+    let count = |l: usize| levels[l]["pixels"].as_u64().unwrap() as usize;
+    assert!(
+        levels.len() == 2 && count(1) > 0 && count(1) < count(0),
+        "{report}"
+    );
+    let d4 = sunbeam_frame::linear::per_pixel_de(&refined, &four).unwrap();
+    let d8 = sunbeam_frame::linear::per_pixel_de(&refined, &eight).unwrap();
+    let (mut off, mut only_eight, mut changed) = (vec![], 0, 0);
+    for i in 0..plain.rgb.len() {
+        if refined.rgb[i] == plain.rgb[i] {
+            continue;
+        }
+        changed += 1;
+        let (a, b) = (d4[i].unwrap_or(0.0), d8[i].unwrap_or(0.0));
+        off.push(a.min(b));
+        if b < EDGE_REFINED_P99 && a >= EDGE_REFINED_P99 {
+            only_eight += 1;
+        }
+    }
+    let off = sunbeam_frame::diff::stats(&mut off);
+    eprintln!(
+        "{changed} pixels changed, {only_eight} the 8 x 8 frame's only; against the nearer of 4 x 4 and 8 x 8: {off}; {report}"
+    );
+    assert!(changed <= count(0) && off.p99 < EDGE_REFINED_P99, "{off}");
+    assert!(only_eight > 0 && only_eight <= count(1), "{only_eight}");
+}
