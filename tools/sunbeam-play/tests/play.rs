@@ -129,6 +129,31 @@ fn usage_and_input_errors_have_their_exit_codes() {
         assert!(err.contains("--supersample must be 1..8"), "{err}");
         assert!(!f.exists());
     }
+    // Edge refinement's levels: an odd first level, or a last level past 64
+    // positions a side, is a usage error naming the flags, no frame.
+    for (args, says) in [
+        (
+            ["--edge-supersample", "5", "--edge-levels", "2"],
+            "even --edge-supersample",
+        ),
+        (
+            ["--edge-supersample", "32", "--edge-levels", "3"],
+            "reaches 128",
+        ),
+    ] {
+        let f =
+            std::env::temp_dir().join(format!("sunbeam-play-levels-{}.png", std::process::id()));
+        let o = Command::new(BIN)
+            .args(["--mesh", "builtin:quad", "--headless", "-o"])
+            .arg(&f)
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("--edge-levels") && err.contains(says), "{err}");
+        assert!(!f.exists());
+    }
 }
 
 #[test]
