@@ -718,21 +718,16 @@ fn threejs_edge_refinement_is_the_supersampled_frame_at_its_pixels() {
         .filter(|&i| refined.rgb[i] != plain.rgb[i])
         .collect();
     // every silhouette pixel (lit at 8 x 8, with an unlit neighbour) is replaced
-    let lit =
-        |i: usize| sunbeam_frame::linear::luminance(truth.rgb[i]) > sunbeam_frame::linear::LIT_Y;
-    let mut outline = 0;
-    for y in 1..h - 1 {
-        for x in 1..w - 1 {
-            let i = y * w + x;
-            if lit(i) && [i - 1, i + 1, i - w, i + w].iter().any(|&j| !lit(j)) {
-                outline += 1;
-                assert!(
-                    refined.rgb[i] != plain.rgb[i],
-                    "outline pixel ({x}, {y}) not refined"
-                );
-            }
-        }
+    let outline = sunbeam_frame::linear::outline_pixels(&truth);
+    for &i in &outline {
+        assert!(
+            refined.rgb[i] != plain.rgb[i],
+            "outline pixel ({}, {}) not refined",
+            i % w,
+            i / w
+        );
     }
+    let outline = outline.len();
     assert!(outline > 40, "{outline}");
     // the flags take the outline and its neighbours, not the whole sphere
     assert!(

@@ -176,17 +176,30 @@ pub fn interior_pixels(frames: &[&LinearImage]) -> Vec<usize> {
     let Some(f0) = frames.first() else {
         return Vec::new();
     };
-    let (w, h) = (f0.width as usize, f0.height as usize);
+    let w = f0.width as usize;
     let lit = |i: usize| frames.iter().all(|f| luminance(f.rgb[i]) >= LIT_Y);
-    (0..w * h)
-        .filter(|&i| {
-            let (x, y) = (i % w, i / w);
-            x > 0
-                && y > 0
-                && x + 1 < w
-                && y + 1 < h
-                && (0..9).all(|k| lit((y + k / 3 - 1) * w + x + k % 3 - 1))
-        })
+    off_border(f0)
+        .filter(|&i| (0..9).all(|k| lit(i + (k / 3) * w + k % 3 - w - 1)))
+        .collect()
+}
+
+/// Indices of the pixels of `frame` with all eight neighbours in the image.
+fn off_border(frame: &LinearImage) -> impl Iterator<Item = usize> {
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    (0..w * h).filter(move |&i| {
+        let (x, y) = (i % w, i / w);
+        x > 0 && y > 0 && x + 1 < w && y + 1 < h
+    })
+}
+
+/// Indices of the lit pixels (`Y > LIT_Y`) of `frame`, away from the
+/// image's border, with an unlit pixel above, below, left or right: the
+/// outline of the lit area, the pixels a silhouette crosses.
+pub fn outline_pixels(frame: &LinearImage) -> Vec<usize> {
+    let w = frame.width as usize;
+    let lit = |i: usize| luminance(frame.rgb[i]) > LIT_Y;
+    off_border(frame)
+        .filter(|&i| lit(i) && [i - 1, i + 1, i - w, i + w].iter().any(|&j| !lit(j)))
         .collect()
 }
 
@@ -315,6 +328,24 @@ mod tests {
         assert_eq!(d.rgb[0][0], 2.5);
         assert_eq!(d.rgb[1][0], 4.5);
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A lit square's outline is its ring of border pixels, not its inside
+    /// or the dark around it.
+    #[test]
+    fn the_outline_is_the_lit_ring() {
+        let mut f = LinearImage::new(8, 8);
+        for y in 2..6 {
+            for x in 2..6 {
+                f.rgb[y * 8 + x] = [0.5; 3];
+            }
+        }
+        let o = outline_pixels(&f);
+        assert_eq!(o.len(), 12, "{o:?}");
+        assert!(o.iter().all(|&i| {
+            let (x, y) = (i % 8, i / 8);
+            (2..6).contains(&x) && (2..6).contains(&y) && (x % 3 == 2 || y % 3 == 2)
+        }));
     }
 
     #[test]

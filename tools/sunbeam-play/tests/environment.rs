@@ -1291,6 +1291,27 @@ fn an_adapter_without_float_targets_says_what_to_do() {
     }
 }
 
+/// The edge refinement's scene: [`sky_lit_ridge_sphere`] 32 x 32 on black,
+/// filling half the frame (a long, steep outline).
+fn edge_sphere(name: &str) -> Option<(PathBuf, PathBuf)> {
+    sky_lit_ridge_sphere(name, r#"{ "eye": [0, 0, 2.6], "target": [0, 0, 0] }"#, 32)
+}
+
+/// The player's cells frame of `scene` with `args` (the edge refinement's),
+/// written to `out`, and its `--json` report.
+fn edge_frame(scene: &Path, out: &Path, args: &[&str]) -> (LinearImage, serde_json::Value) {
+    let o = Command::new(BIN)
+        .arg(scene)
+        .args(["--headless", "--json", "--env-estimator", "cells", "-o"])
+        .arg(out)
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    (LinearImage::read_exr(out).unwrap(), report)
+}
+
 /// Edge refinement (`--edge-supersample M`, docs/LIGHTING.md "Edge
 /// refinement"): the pixels it replaces are what the whole frame
 /// supersampled at M x M gives there (the same positions through the full
@@ -1300,25 +1321,10 @@ fn an_adapter_without_float_targets_says_what_to_do() {
 /// `--supersample 8`.
 #[test]
 fn edge_refinement_is_the_supersampled_frame_at_its_pixels() {
-    let Some((dir, scene)) = sky_lit_ridge_sphere(
-        "edge-refine",
-        r#"{ "eye": [0, 0, 2.6], "target": [0, 0, 0] }"#,
-        32,
-    ) else {
+    let Some((dir, scene)) = edge_sphere("edge-refine") else {
         return;
     };
-    let run = |args: &[&str], out: &str| {
-        let o = Command::new(BIN)
-            .arg(&scene)
-            .args(["--headless", "--json", "--env-estimator", "cells", "-o"])
-            .arg(dir.join(out))
-            .args(args)
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        (LinearImage::read_exr(&dir.join(out)).unwrap(), report)
-    };
+    let run = |args: &[&str], out: &str| edge_frame(&scene, &dir.join(out), args);
     let (refined, report) = run(
         &["--supersample", "2", "--edge-supersample", "8"],
         "refined.exr",
@@ -1338,22 +1344,17 @@ fn edge_refinement_is_the_supersampled_frame_at_its_pixels() {
     // every silhouette pixel (partly covered at 8 x 8: neither black nor
     // like all its lit neighbours) is among them: each lit pixel with an
     // unlit neighbour
-    let (w, h) = (truth.width as usize, truth.height as usize);
-    let lit =
-        |i: usize| sunbeam_frame::linear::luminance(truth.rgb[i]) > sunbeam_frame::linear::LIT_Y;
-    let mut outline = 0;
-    for y in 1..h - 1 {
-        for x in 1..w - 1 {
-            let i = y * w + x;
-            if lit(i) && [i - 1, i + 1, i - w, i + w].iter().any(|&j| !lit(j)) {
-                outline += 1;
-                assert!(
-                    refined.rgb[i] != plain.rgb[i],
-                    "outline pixel ({x}, {y}) not refined"
-                );
-            }
-        }
+    let w = truth.width as usize;
+    let outline = sunbeam_frame::linear::outline_pixels(&truth);
+    for &i in &outline {
+        assert!(
+            refined.rgb[i] != plain.rgb[i],
+            "outline pixel ({}, {}) not refined",
+            i % w,
+            i / w
+        );
     }
+    let outline = outline.len();
     assert!(outline > 40, "{outline}");
     let de = |a: &LinearImage| {
         let d = sunbeam_frame::linear::per_pixel_de(a, &truth).unwrap();
@@ -1386,25 +1387,10 @@ const EDGE_REFINED_P99: f64 = 0.1;
 /// the first level's.
 #[test]
 fn edge_refinement_levels_take_the_unsettled_pixels_further() {
-    let Some((dir, scene)) = sky_lit_ridge_sphere(
-        "edge-levels",
-        r#"{ "eye": [0, 0, 2.6], "target": [0, 0, 0] }"#,
-        32,
-    ) else {
+    let Some((dir, scene)) = edge_sphere("edge-levels") else {
         return;
     };
-    let run = |args: &[&str], out: &str| {
-        let o = Command::new(BIN)
-            .arg(&scene)
-            .args(["--headless", "--json", "--env-estimator", "cells", "-o"])
-            .arg(dir.join(out))
-            .args(args)
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        (LinearImage::read_exr(&dir.join(out)).unwrap(), report)
-    };
+    let run = |args: &[&str], out: &str| edge_frame(&scene, &dir.join(out), args);
     let (refined, report) = run(
         &[
             "--supersample",
