@@ -35,8 +35,9 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
 
 // The cells' coarse pre-pass (g.cells_rate > 1), its raster part: at each
 // grid point the view (world; w: 1 where this mesh diffracts under the
-// environment and the view is above ENV_GRAZING_COS, else 0: the full-rate
-// pass walks those itself), the frame's normal and the distance to the eye,
+// environment and the pre-passes serve the view (env_cells_serves), else
+// 0: the full-rate pass walks those itself), the frame's normal and the
+// distance to the eye,
 // and its tangent with the mesh (mat.cells_id). fs_cells_walk then walks
 // the cells at the marked points; the centre pass mixes their XYZ
 // (shaders/environment.wgsl env_cells_mixed).
@@ -48,10 +49,10 @@ struct CellsOut {
 
 // Whether the pre-passes shade the cells at a point seen from local view
 // wr_l: a mesh diffracting under the environment whose fragments read them
-// (`mat.reads_cells`), the view above ENV_GRAZING_COS (the frame's pass
-// walks grazing views itself).
+// (`mat.reads_cells`), a view the pre-passes serve (env_cells_serves; the
+// frame's pass walks the others itself).
 fn cells_shaded_here(wr_l: vec3<f32>) -> bool {
-    return envg.on == 1u && envp.on == 1u && mat.reads_cells == 1u && mat.base.w < 1.0 && wr_l.z > ENV_GRAZING_COS;
+    return envg.on == 1u && envp.on == 1u && mat.reads_cells == 1u && mat.base.w < 1.0 && env_cells_serves(wr_l.z);
 }
 
 // The centre pass (g.cells_rate >= 1): single-sampled at the frame's size,

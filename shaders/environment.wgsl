@@ -410,6 +410,18 @@ const ENV_DEFENSIVE: f32 = 0.25;
 const ENV_GRAZING_COS: f32 = 0.2;
 const ENV_GRAZING_SAMPLES: u32 = 4u;
 
+// The views the cells' pre-passes serve (their grid and centre pass): above
+// ENV_GRAZING_COS in a frame, where the term changes fastest across a pixel
+// at the limb and the frame's pass walks each grazing fragment itself; every
+// view above the horizon in a tile of edge refinement (g.cells_grazing: its
+// texels are 1 / m of the image's pixels, so the grid's blocks pass their
+// cone and curvature tests at the limb too, and a grazing pixel's m x m
+// positions no longer each walk the cells: docs/LIGHTING.md "Edge
+// refinement").
+fn env_cells_serves(wr_z: f32) -> bool {
+    return wr_z > select(ENV_GRAZING_COS, 0.0, g.cells_grazing == 1u);
+}
+
 // Density per unit (u, v) of a direction uniform over the hemisphere.
 fn env_hemi_pdf(wr: vec3<f32>, uv: vec2<f32>) -> f32 {
     let wxy = -uv - wr.xy;
@@ -556,7 +568,7 @@ fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
 // pixel corner (K = g.cells_rate: grid point (i, j) at the frame's pixel
 // coordinates (i K, j K)); a pixel in the block [i K, (i + 1) K) takes the
 // bilinear mix of the block's four corners when they saw one smooth patch
-// of surface: all shaded (a diffracting mesh, views above ENV_GRAZING_COS),
+// of surface: all shaded (a diffracting mesh, views env_cells_serves takes),
 // their normals and tangents within ENV_LOWRES_CONE (2 degrees) of their
 // mean, and the pixel's own normal and tangent within the cone of that mean.
 // Not their distances: the term depends on the frame and the view alone
@@ -592,7 +604,7 @@ fn env_same_surface(n_seen: vec3<f32>, d_seen: f32, n: vec3<f32>, dist: f32) -> 
 // centre's full-screen walk, fs_cells_walk).
 fn env_cells_mixed(t: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>) -> vec4<f32> {
     let k = g.cells_rate;
-    if (k > 1u && wr.z > ENV_GRAZING_COS) {
+    if (k > 1u && env_cells_serves(wr.z)) {
         let q = clip / f32(k);
         let q0 = floor(q);
         let c0 = vec2<i32>(q0);
@@ -694,7 +706,7 @@ fn env_bilinear(tex: texture_2d<f32>, c0: vec2<i32>, f: vec2<f32>) -> vec3<f32> 
 // with scale maps under MSAA, crates/sunbeam-render/src/renderer/mod.rs
 // `reads_centre`).
 fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
-    if (g.cells_rate > 0u && wr.z > ENV_GRAZING_COS && mat.reads_cells == 1u) {
+    if (g.cells_rate > 0u && env_cells_serves(wr.z) && mat.reads_cells == 1u) {
         let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
         let p = clamp(vec2<i32>(floor(clip)), vec2<i32>(0), last);
         let x = textureLoad(cells_xyz, p, 0);

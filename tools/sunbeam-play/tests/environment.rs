@@ -1371,11 +1371,15 @@ fn edge_refinement_is_the_supersampled_frame_at_its_pixels() {
 }
 
 /// Bound of [`edge_refinement_is_the_supersampled_frame_at_its_pixels`]:
-/// measured p99 0.042 over the 302 refined pixels (half floats and the
-/// cells' walks on two ways to the same positions; lavapipe, 2026-12-06),
-/// the 2 x 2 frame 7.64 there; tiles a twentieth of a pixel off (the
-/// window's centre moved by 0.05 pixels) fail the test.
-const EDGE_REFINED_P99: f64 = 0.1;
+/// measured p99 0.19 over the 302 refined pixels (0.16 in the levels'
+/// test), the 2 x 2 frame 7.64 there; lavapipe, 2026-12-07. The two are
+/// the same positions by two ways: a tile's cells' pre-passes serve its
+/// grazing views (a tile's texel is an eighth of the pixel), where the
+/// whole frame walks the cells at each grazing fragment (0.042 when both
+/// walked), besides half floats. Tiles a twentieth of a pixel off (the
+/// window's centre moved by 0.05 pixels) read p99 5.5 and an outline pixel
+/// unchanged.
+const EDGE_REFINED_P99: f64 = 0.3;
 
 /// Levels of edge refinement (`--edge-levels`): the second level takes the
 /// refined pixels whose quarter-lattices still disagree to twice the

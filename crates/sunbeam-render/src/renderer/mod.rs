@@ -269,6 +269,15 @@ pub struct FrameState {
     pub lights: Vec<Light>,
     pub exposure: f64,
     pub background: Background,
+    /// Pixels of this frame per side of one pixel of the image it stands
+    /// for: 1, or `m` in a tile of edge refinement ([`crate::refine`]).
+    /// Above 1 the cells' pre-passes serve grazing views too: a texel is
+    /// `1 / m` of the pixel, so the grid's blocks pass their tests at the
+    /// limb, where each of the pixel's `m x m` positions walked the cells
+    /// (docs/LIGHTING.md "Edge refinement"). A supersampled frame keeps 1:
+    /// at a few sub-pixels the grazing band is a texel or two wide, its
+    /// blocks fail, and its grid points' walks were extra work (measured).
+    pub sub_pixel: u32,
 }
 
 impl FrameState {
@@ -278,6 +287,7 @@ impl FrameState {
             lights: p.scene.lights.clone(),
             exposure: p.scene.exposure,
             background: p.scene.background,
+            sub_pixel: 1,
         }
     }
 }
@@ -846,6 +856,8 @@ impl Renderer {
             n_lambda: self.n_lambda,
             msaa: self.msaa(),
             cells_rate: self.env_cells_rate(),
+            cells_grazing: u32::from(state.sub_pixel > 1),
+            _pad: [0; 3],
         };
         if let Some(c) = &self.cells {
             c.prepare(

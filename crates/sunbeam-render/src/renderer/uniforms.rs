@@ -46,6 +46,10 @@ pub(super) struct Globals {
     /// pixels for K > 1; [`super::cells_rate`]); 0: every fragment walks
     /// them.
     pub(super) cells_rate: u32,
+    /// 1: the cells' pre-passes serve grazing views too (a tile of edge
+    /// refinement, [`super::FrameState::sub_pixel`] > 1), else 0.
+    pub(super) cells_grazing: u32,
+    pub(super) _pad: [u32; 3],
 }
 
 #[repr(C)]
@@ -219,7 +223,8 @@ mod layout_tests {
                 exposure_scale,
                 n_lambda,
                 msaa,
-                cells_rate
+                cells_rate,
+                cells_grazing
             ),
         );
     }
