@@ -182,20 +182,27 @@ fn bad_scenes_exit_non_zero_with_the_field_named() {
         .unwrap();
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--msaa"));
-    for (flag, value) in [
-        ("--tile", "0"),
-        ("--supersample", "17"),
-        ("--edge-supersample", "65"),
-        ("--edge-threshold", "-1"),
+    // (the arguments, the flag the error names)
+    let levels = "--edge-levels";
+    for (bad, flag) in [
+        (&["--tile", "0"][..], "--tile"),
+        (&["--supersample", "17"], "--supersample"),
+        (&["--edge-supersample", "65"], "--edge-supersample"),
+        (&["--edge-threshold", "-1"], "--edge-threshold"),
+        (&["--edge-supersample", "8", levels, "5"], levels),
+        (&["--edge-supersample", "3", levels, "2"], levels),
+        (&["--edge-supersample", "32", levels, "3"], levels),
+        (&[levels, "2"], levels),
     ] {
         let o = Command::new("node")
             .arg(&render)
             .arg(&s)
-            .args(["-o", "x.png", flag, value])
+            .args(["-o", "x.png"])
+            .args(bad)
             .output()
             .unwrap();
-        assert_eq!(o.status.code(), Some(1), "{flag} {value}");
-        assert!(String::from_utf8_lossy(&o.stderr).contains(flag));
+        assert_eq!(o.status.code(), Some(1), "{bad:?}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains(flag), "{bad:?}");
     }
     // A light's colour and the lens shift are checked, naming the field.
     for (bad, field) in [
@@ -688,7 +695,8 @@ const SNAKE_SKY_INTERIOR_P99: f64 = 0.7;
 /// one pass, no tiles), the others are the plain frame's, and every pixel
 /// of the silhouette is replaced. The sky-lit ridge sphere 32 x 32 on
 /// black (a steep outline), 2 x 2 then 8 x 8 at the flagged pixels, against
-/// `--supersample 8`.
+/// `--supersample 8`; and with `--edge-levels 2` from 4 x 4, against
+/// `--supersample 4` and `8`.
 #[test]
 fn threejs_edge_refinement_is_the_supersampled_frame_at_its_pixels() {
     let d = scratch("threejs-edge");
@@ -749,6 +757,37 @@ fn threejs_edge_refinement_is_the_supersampled_frame_at_its_pixels() {
     assert!(
         before.p99 > 4.0 * EDGE_REFINED_P99,
         "the refinement changed little: {before}"
+    );
+    // Levels (`--edge-levels 2`): 4 x 4 at the flagged pixels, then 8 x 8
+    // at those whose quarter-lattices still disagree: each replaced pixel
+    // is the whole frame's at 4 x 4 or at 8 x 8, some only at 8 x 8, not
+    // all of them.
+    let levels = threejs_frame_with(
+        &render,
+        &d,
+        &scene,
+        "levels",
+        2,
+        &["--edge-supersample", "4", "--edge-levels", "2"],
+    );
+    let four = threejs_frame_at(&render, &d, &scene, "four", 4);
+    let d4 = sunbeam_frame::linear::per_pixel_de(&levels, &four).unwrap();
+    let d8 = sunbeam_frame::linear::per_pixel_de(&levels, &truth).unwrap();
+    let (mut off, mut only_eight, mut replaced) = (vec![], 0, 0);
+    for i in (0..w * h).filter(|&i| levels.rgb[i] != plain.rgb[i]) {
+        replaced += 1;
+        let (a, b) = (d4[i].unwrap_or(0.0), d8[i].unwrap_or(0.0));
+        off.push(a.min(b));
+        if b < EDGE_REFINED_P99 && a >= EDGE_REFINED_P99 {
+            only_eight += 1;
+        }
+    }
+    let off = sunbeam_frame::diff::stats(&mut off);
+    eprintln!("three.js levels: {replaced} pixels replaced, {only_eight} the 8 x 8 frame's only; against the nearer of 4 x 4 and 8 x 8: {off}");
+    assert!(off.p99 < EDGE_REFINED_P99, "{off}");
+    assert!(
+        only_eight > 0 && only_eight < replaced,
+        "{only_eight} of {replaced}"
     );
 }
 

@@ -91,9 +91,34 @@ function flagPixels(sy, cover, W, H, k, threshold) {
 // player's refine.rs tile_pixels).
 const edgeTilePixels = (m) => Math.min(16, Math.max(4, Math.floor(256 / m)));
 
+/**
+ * Whether a refined pixel's m x m positions are still unsettled: the
+ * player's criterion (crates/sunbeam-render/src/refine.rs `unsettled`). `m`
+ * even, and one of the four interleaved quarter-lattices of positions
+ * (every other one along each axis) has a mean luminance off the block's
+ * by more than `threshold` times the block's mean (plus LIT_Y). `buf`: the
+ * tile's RGBA texels, `ew x eh`, rows bottom-up; the block's top-left texel
+ * at (i0, j0) counted from the top.
+ */
+function unsettled(buf, ew, eh, m, i0, j0, threshold) {
+  if (m < 2 || m % 2 === 1) return false;
+  const lattice = [0, 0, 0, 0];
+  for (let j = 0; j < m; j++) {
+    const row = eh - 1 - (j0 + j);
+    for (let i = 0; i < m; i++) {
+      const q = 4 * (row * ew + i0 + i);
+      lattice[(j % 2) * 2 + (i % 2)] += luminance(buf[q], buf[q + 1], buf[q + 2]);
+    }
+  }
+  const quarter = (m * m) / 4;
+  const means = lattice.map((v) => v / quarter);
+  const mean = (means[0] + means[1] + means[2] + means[3]) / 4;
+  return means.some((l) => Math.abs(l - mean) > threshold * (mean + LIT_Y));
+}
+
 window.sunbeamRender = async (job) => {
   try {
-    const { scene: desc, meshes, size, supersample: k, msaa = 1, glsl, env: envJob, tile: tileAsked = 0, edge = 0, edgeThreshold = 0.05 } = job;
+    const { scene: desc, meshes, size, supersample: k, msaa = 1, glsl, env: envJob, tile: tileAsked = 0, edge = 0, edgeThreshold = 0.05, edgeLevels = 1 } = job;
     const [w, h] = size;
     const W = w * k, H = h * k;
     const canvas = document.createElement('canvas');
@@ -242,10 +267,11 @@ window.sunbeamRender = async (job) => {
     }
     for (let i = 0; i < rgb.length; i++) rgb[i] /= k * k;
     // Edge refinement: the flagged pixels' tiles at edge x edge positions per
-    // pixel, each a frame of its own through the camera narrowed to the tile.
+    // pixel, each a frame of its own through the camera narrowed to the tile;
+    // each further level (edgeLevels) takes the refined pixels whose
+    // positions are still unsettled to twice the positions per side.
     let refined = null;
-    if (edge) {
-      const flags = flagPixels(subY, cover, W, H, k, edgeThreshold);
+    const refineLevel = (flags, edge) => {
       const tp = edgeTilePixels(edge);
       const tw = Math.min(tp, w), th = Math.min(tp, h);
       const ew = tw * edge, eh = th * edge;
@@ -254,7 +280,7 @@ window.sunbeamRender = async (job) => {
       });
       const ebuf = new Float32Array(ew * eh * 4);
       const done = new Uint8Array(w * h);
-      refined = { pixels: 0, tiles: 0 };
+      const level = { positions: edge, pixels: 0, tiles: 0, unsettled: new Uint8Array(w * h) };
       for (let ty = 0; ty < h; ty += th) {
         for (let tx = 0; tx < w; tx += tw) {
           // the last row and column of tiles end at the image's edge
@@ -299,7 +325,7 @@ window.sunbeamRender = async (job) => {
           et.scissorTest = false;
           renderer.setRenderTarget(et);
           renderer.readRenderTargetPixels(et, 0, 0, ew, eh, ebuf);
-          refined.tiles += 1;
+          level.tiles += 1;
           for (let y = y0; y < y0 + th; y++) {
             for (let x = x0; x < x0 + tw; x++) {
               const p = y * w + x;
@@ -314,12 +340,24 @@ window.sunbeamRender = async (job) => {
               }
               for (let ch = 0; ch < 3; ch++) rgb[3 * p + ch] = c[ch] / (edge * edge);
               done[p] = 1;
-              refined.pixels += 1;
+              level.unsettled[p] = unsettled(ebuf, ew, eh, edge, (x - x0) * edge, (y - y0) * edge, edgeThreshold);
+              level.pixels += 1;
             }
           }
         }
       }
       et.dispose();
+      return level;
+    };
+    if (edge) {
+      let flags = flagPixels(subY, cover, W, H, k, edgeThreshold);
+      const levels = [];
+      for (let l = 0, m = edge; l < edgeLevels; l++, m *= 2) {
+        const level = refineLevel(flags, m);
+        flags = level.unsettled;
+        levels.push({ positions: m, pixels: level.pixels, tiles: level.tiles, unsettled: flags.reduce((a, b) => a + b, 0) });
+      }
+      refined = { pixels: levels[0].pixels, tiles: levels.reduce((a, l) => a + l.tiles, 0), levels };
     }
     if (shifted) camera.setViewOffset(view.fullWidth, view.fullHeight, view.offsetX, view.offsetY, view.width, view.height);
     else camera.clearViewOffset();

@@ -2,7 +2,7 @@
 // Chromium, as a browser would draw it:
 //
 //   node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--tile T]
-//                   [--edge-supersample M [--edge-threshold T]]
+//                   [--edge-supersample M [--edge-threshold T] [--edge-levels N]]
 //
 // - the material is sunbeam-three.mjs: the GLSL ES that
 //   `sunbeam-play --export-shader glsl-es` writes from the player's WGSL
@@ -30,6 +30,10 @@
 //   --edge-threshold T, default 0.05) again at M x M positions each, in
 //   tiles through camera.setViewOffset, and replaces them with that box
 //   (sunbeam-play's --edge-supersample; docs/LIGHTING.md "Edge refinement").
+//   --edge-levels N (1..4, default 1; an even M, M 2^(N-1) <= 64): each
+//   further level takes the refined pixels whose positions still disagree
+//   (their four interleaved quarter-lattices, the player's criterion) to
+//   twice the positions per side (sunbeam-play's --edge-levels).
 //
 // Needs three and playwright-core next to it (node_modules) and Debian's
 // chromium (CHROMIUM or /usr/bin/chromium; playwright gives it a fresh
@@ -46,7 +50,7 @@ const here = dirname(fileURLToPath(import.meta.url));
 
 function usage(msg) {
   if (msg) console.error(`render.mjs: error: ${msg}`);
-  console.error('usage: node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--tile T] [--edge-supersample M [--edge-threshold T]] [--glsl FILE]');
+  console.error('usage: node render.mjs SCENE.json -o FRAME.png [--exr FRAME.exr] [--size WxH] [--supersample K] [--msaa N] [--tile T] [--edge-supersample M [--edge-threshold T] [--edge-levels N]] [--glsl FILE]');
   process.exit(1);
 }
 
@@ -82,6 +86,9 @@ for (let i = 0; i < args.length; i++) {
   } else if (a === '--edge-threshold') {
     opt.edgeThreshold = Number(next());
     if (!(opt.edgeThreshold > 0 && Number.isFinite(opt.edgeThreshold))) usage('--edge-threshold: a positive number (of the pixel\'s mean luminance)');
+  } else if (a === '--edge-levels') {
+    opt.edgeLevels = Number(next());
+    if (!Number.isInteger(opt.edgeLevels) || opt.edgeLevels < 1 || opt.edgeLevels > 4) usage('--edge-levels: 1..4');
   } else if (a === '--glsl') opt.glsl = next();
   else if (a === '-h' || a === '--help') usage();
   else if (a.startsWith('-')) usage(`unknown option ${a}`);
@@ -90,6 +97,12 @@ for (let i = 0; i < args.length; i++) {
 }
 if (!opt.scene || !opt.output) usage('SCENE.json and -o FRAME.png are required');
 if (opt.edgeThreshold !== undefined && !opt.edge) usage('--edge-threshold needs --edge-supersample');
+if (opt.edgeLevels !== undefined && !opt.edge) usage('--edge-levels needs --edge-supersample');
+if ((opt.edgeLevels ?? 1) > 1) {
+  if (opt.edge % 2 === 1) usage('--edge-levels above 1 needs an even --edge-supersample (its quarter-lattices decide the next level)');
+  const last = opt.edge * 2 ** (opt.edgeLevels - 1);
+  if (last > 64) usage(`--edge-supersample ${opt.edge} with --edge-levels ${opt.edgeLevels} reaches ${last} positions per pixel side; at most 64`);
+}
 
 // ---- the scene (the same defaults as crates/sunbeam-scene) -------------------------
 let scene;
@@ -282,7 +295,7 @@ try {
   await p.goto(`${base}/render.html`);
   await p.waitForFunction(() => window.sunbeamRender !== undefined, null, { timeout: 60000 });
   const job = { scene, meshes, size, supersample: opt.supersample, msaa: opt.msaa, glsl, env, tile: opt.tile ?? 0,
-    edge: opt.edge ?? 0, edgeThreshold: opt.edgeThreshold ?? 0.05 };
+    edge: opt.edge ?? 0, edgeThreshold: opt.edgeThreshold ?? 0.05, edgeLevels: opt.edgeLevels ?? 1 };
   pixels = await p.evaluate((j) => window.sunbeamRender(j), job);
 } catch (e) {
   fail(4, `rendering in Chromium failed: ${e.message}${problems.length ? `\n${problems.join('\n')}` : ''}`);
@@ -376,4 +389,4 @@ function exrBytes() {
   return Buffer.concat([header, table, lines]);
 }
 if (opt.exr) atomicWrite(opt.exr, exrBytes());
-console.error(`render.mjs: wrote ${opt.output}${opt.exr ? ` and ${opt.exr}` : ''} (${w}x${h}, ${opt.supersample}x${opt.supersample} samples per pixel${opt.msaa > 1 ? `, ${opt.msaa}x MSAA` : ''}${pixels.tiles > 1 ? `, ${pixels.tiles} tiles` : ''}${pixels.edge ? `, ${pixels.edge.pixels} edge pixels at ${opt.edge}x${opt.edge} in ${pixels.edge.tiles} tiles` : ''}, ${pixels.renderer})`);
+console.error(`render.mjs: wrote ${opt.output}${opt.exr ? ` and ${opt.exr}` : ''} (${w}x${h}, ${opt.supersample}x${opt.supersample} samples per pixel${opt.msaa > 1 ? `, ${opt.msaa}x MSAA` : ''}${pixels.tiles > 1 ? `, ${pixels.tiles} tiles` : ''}${pixels.edge ? `, edge pixels ${pixels.edge.levels.map((l) => `${l.pixels} at ${l.positions}x${l.positions}`).join(', ')} in ${pixels.edge.tiles} tiles` : ''}, ${pixels.renderer})`);
