@@ -280,7 +280,7 @@ window.sunbeamRender = async (job) => {
       });
       const ebuf = new Float32Array(ew * eh * 4);
       const done = new Uint8Array(w * h);
-      const level = { positions: edge, pixels: 0, tiles: 0, unsettled: new Uint8Array(w * h) };
+      const level = { pixels: 0, tiles: 0, unsettled: new Uint8Array(w * h) };
       for (let ty = 0; ty < h; ty += th) {
         for (let tx = 0; tx < w; tx += tw) {
           // the last row and column of tiles end at the image's edge
