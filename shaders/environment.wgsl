@@ -416,7 +416,7 @@ const ENV_GRAZING_SAMPLES: u32 = 4u;
 // view above the horizon in a tile of edge refinement (g.cells_grazing: its
 // texels are 1 / m of the image's pixels, so the grid's blocks pass their
 // cone and curvature tests at the limb too, and a grazing pixel's m x m
-// positions no longer each walk the cells: docs/LIGHTING.md "Edge
+// positions do not each walk the cells: docs/LIGHTING.md "Edge
 // refinement").
 fn env_cells_serves(wr_z: f32) -> bool {
     return wr_z > select(ENV_GRAZING_COS, 0.0, g.cells_grazing == 1u);

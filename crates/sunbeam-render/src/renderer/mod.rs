@@ -273,8 +273,8 @@ pub struct FrameState {
     /// for: 1, or `m` in a tile of edge refinement ([`crate::refine`]).
     /// Above 1 the cells' pre-passes serve grazing views too: a texel is
     /// `1 / m` of the pixel, so the grid's blocks pass their tests at the
-    /// limb, where each of the pixel's `m x m` positions walked the cells
-    /// (docs/LIGHTING.md "Edge refinement"). A supersampled frame keeps 1:
+    /// limb, and the pixel's `m x m` positions there do not each walk the
+    /// cells (docs/LIGHTING.md "Edge refinement"). A supersampled frame keeps 1:
     /// at a few sub-pixels the grazing band is a texel or two wide, its
     /// blocks fail, and its grid points' walks were extra work (measured).
     pub sub_pixel: u32,
