@@ -37,10 +37,9 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
 // grid point the view (world; w: 1 where this mesh diffracts under the
 // environment and the pre-passes serve the view (env_cells_serves), else
 // 0: the full-rate pass walks those itself), the frame's normal and the
-// distance to the eye,
-// and its tangent with the mesh (mat.cells_id). fs_cells_walk then walks
-// the cells at the marked points; the centre pass mixes their XYZ
-// (shaders/environment.wgsl env_cells_mixed).
+// distance to the eye, and its tangent with the mesh (mat.cells_id).
+// fs_cells_walk then walks the cells at the marked points; the centre
+// pass mixes their XYZ (shaders/environment.wgsl env_cells_mixed).
 struct CellsOut {
     @location(0) xyz: vec4<f32>,
     @location(1) nd: vec4<f32>,
