@@ -35,9 +35,9 @@ fn fs_main(in: VsOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f
 
 // The cells' coarse pre-pass (g.cells_rate > 1), its raster part: at each
 // grid point the view (world; w: 1 where this mesh diffracts under the
-// environment and the pre-passes serve the view (env_cells_serves), else
-// 0: the full-rate pass walks those itself), the frame's normal and the
-// distance to the eye, and its tangent with the mesh (mat.cells_id).
+// environment and the grid serves the view (env_grid_serves), else 0: the
+// centre pass walks those pixels), the frame's normal and the distance to
+// the eye, and its tangent with the mesh (mat.cells_id).
 // fs_cells_walk then walks the cells at the marked points; the centre
 // pass mixes their XYZ (shaders/environment.wgsl env_cells_mixed).
 struct CellsOut {
@@ -48,10 +48,11 @@ struct CellsOut {
 
 // Whether the pre-passes shade the cells at a point seen from local view
 // wr_l: a mesh diffracting under the environment whose fragments read them
-// (`mat.reads_cells`), a view the pre-passes serve (env_cells_serves; the
-// frame's pass walks the others itself).
+// (`mat.reads_cells`), a view above the horizon. The centre pass shades
+// every such point; the grid those whose view it serves too
+// (env_grid_serves).
 fn cells_shaded_here(wr_l: vec3<f32>) -> bool {
-    return envg.on == 1u && envp.on == 1u && mat.reads_cells == 1u && mat.base.w < 1.0 && env_cells_serves(wr_l.z);
+    return envg.on == 1u && envp.on == 1u && mat.reads_cells == 1u && mat.base.w < 1.0 && wr_l.z > 0.0;
 }
 
 // The centre pass (g.cells_rate >= 1): single-sampled at the frame's size,
@@ -97,7 +98,7 @@ fn fs_cells(in: VsOut) -> CellsOut {
     // the walk follows in fs_cells_walk: here the view (world) and whether
     // the cells are shaded here
     o.xyz = vec4<f32>(wr, 0.0);
-    if (cells_shaded_here(wr_l)) {
+    if (cells_shaded_here(wr_l) && env_grid_serves(wr_l.z)) {
         o.xyz.w = 1.0;
     }
     o.nd = vec4<f32>(fr[2], length(g.eye.xyz - in.world));
@@ -113,7 +114,7 @@ fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> 
 }
 
 // The cells' XYZ at point p of the pass's targets (bindings 2-4) where the
-// raster pass marked it with this mesh: (XYZ, 1), else 0. The walk is
+// raster pass marked it with this mesh: (XYZ, 1 or 2), else 0. The walk is
 // inside the branch: after a discard WGSL demotes the invocation to a
 // helper, which goes on running the walk's loop beside the live lanes, so
 // every point (the background, the other meshes') would walk.
@@ -127,7 +128,10 @@ fn cells_walk_at(p: vec2<i32>) -> vec4<f32> {
         let fr = sb_frame(textureLoad(cells_nd, p, 0).xyz, tc.xyz);
         let wr = a.xyz;
         let wr_l = vec3<f32>(dot(wr, fr[0]), dot(wr, fr[1]), dot(wr, fr[2]));
-        o = vec4<f32>(env_cells(fr[0], fr[1], fr[2], wr_l), 1.0);
+        // w: 2 at a view the grid does not serve (env_grid_serves), which
+        // the frame's pass reads at the pixel's centre and inside the
+        // surface's outline only (env_cells_read)
+        o = vec4<f32>(env_cells(fr[0], fr[1], fr[2], wr_l), select(1.0, 2.0, !env_grid_serves(wr_l.z)));
     }
     return o;
 }

@@ -46,8 +46,8 @@ struct Globals {
     // env_cells_pixel): K >= 1 when the centre pass ran (after a coarse grid
     // of K x K pixels for K > 1), else 0
     cells_rate: u32,
-    // 1: the cells' pre-passes serve grazing views too (a tile of edge
-    // refinement; shaders/environment.wgsl env_cells_serves), else 0
+    // 1: the cells' grid serves grazing views too (a tile of edge
+    // refinement; shaders/environment.wgsl env_grid_serves), else 0
     cells_grazing: u32,
 };
 

@@ -410,15 +410,14 @@ const ENV_DEFENSIVE: f32 = 0.25;
 const ENV_GRAZING_COS: f32 = 0.2;
 const ENV_GRAZING_SAMPLES: u32 = 4u;
 
-// The views the cells' pre-passes serve (their grid and centre pass): above
-// ENV_GRAZING_COS in a frame, where the term changes fastest across a pixel
-// at the limb and the frame's pass walks each grazing fragment itself; every
-// view above the horizon in a tile of edge refinement (g.cells_grazing: its
-// texels are 1 / m of the image's pixels, so the grid's blocks pass their
-// cone and curvature tests at the limb too, and a grazing pixel's m x m
-// positions do not each walk the cells: docs/LIGHTING.md "Edge
-// refinement").
-fn env_cells_serves(wr_z: f32) -> bool {
+// The views the cells' coarse grid serves: above ENV_GRAZING_COS in a frame,
+// where the term changes fastest across a pixel at the limb, the grid's
+// blocks fail their cone there and its points would walk for nothing (the
+// centre pass walks those pixels, once each); every view above the horizon
+// in a tile of edge refinement (g.cells_grazing: its texels are 1 / m of
+// the image's pixels, so the grid's blocks pass their cone and curvature
+// tests at the limb too: docs/LIGHTING.md "Edge refinement").
+fn env_grid_serves(wr_z: f32) -> bool {
     return wr_z > select(ENV_GRAZING_COS, 0.0, g.cells_grazing == 1u);
 }
 
@@ -568,7 +567,7 @@ fn env_irradiance_read(skin: bool, uv: vec2<f32>) -> vec3<f32> {
 // pixel corner (K = g.cells_rate: grid point (i, j) at the frame's pixel
 // coordinates (i K, j K)); a pixel in the block [i K, (i + 1) K) takes the
 // bilinear mix of the block's four corners when they saw one smooth patch
-// of surface: all shaded (a diffracting mesh, views env_cells_serves takes),
+// of surface: all shaded (a diffracting mesh, views env_grid_serves takes),
 // their normals and tangents within ENV_LOWRES_CONE (2 degrees) of their
 // mean, and the pixel's own normal and tangent within the cone of that mean.
 // Not their distances: the term depends on the frame and the view alone
@@ -604,7 +603,7 @@ fn env_same_surface(n_seen: vec3<f32>, d_seen: f32, n: vec3<f32>, dist: f32) -> 
 // centre's full-screen walk, fs_cells_walk).
 fn env_cells_mixed(t: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>) -> vec4<f32> {
     let k = g.cells_rate;
-    if (k > 1u && env_cells_serves(wr.z)) {
+    if (k > 1u && env_grid_serves(wr.z)) {
         let q = clip / f32(k);
         let q0 = floor(q);
         let c0 = vec2<i32>(q0);
@@ -700,41 +699,69 @@ fn env_bilinear(tex: texture_2d<f32>, c0: vec2<i32>, f: vec2<f32>) -> vec3<f32> 
 // (its normal within ENV_LOWRES_OWN, its distance within ENV_LOWRES_DEPTH;
 // the fragment of the triangle under the pixel centre matches exactly), so
 // that a pixel walks the cells once whatever the triangles touching it:
-// (its XYZ, 1); else (another surface behind a silhouette, grazing views, no
-// centre pass) 0: the fragment walks them itself. Only on meshes that read
-// the pre-passes (`mat.reads_cells`, decided by the renderer: not a mesh
-// with scale maps under MSAA, crates/sunbeam-render/src/renderer/mod.rs
-// `reads_centre`).
-fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32) -> vec4<f32> {
-    if (g.cells_rate > 0u && env_cells_serves(wr.z) && mat.reads_cells == 1u) {
+// (its XYZ, 1); else (another surface behind a silhouette, no centre pass)
+// 0: the fragment walks them itself. At a grazing view, the point's or the
+// centre's (one the grid does not serve, env_grid_serves: w = 2), the
+// value is read at the pixel's centre (`at_centre`: a fragment that covers
+// the pixel) and at the samples of a pixel inside the surface's outline
+// (env_inside_outline: an edge between its triangles); on the silhouette a
+// partly covered pixel's samples walk once at their mean, the covered
+// part's centre, as the reference averages that part: at the limb the term
+// turns fastest (read there, the 64 x 64 sphere's silhouette ring was
+// CIEDE2000 up to 5 off every fragment walking: docs/LIGHTING.md "One walk
+// per pixel"). Only on
+// meshes that read the pre-passes (`mat.reads_cells`, decided by the
+// renderer: not a mesh with scale maps under MSAA,
+// crates/sunbeam-render/src/renderer/mod.rs `reads_centre`).
+fn env_cells_read(n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32, at_centre: bool) -> vec4<f32> {
+    if (g.cells_rate > 0u && wr.z > 0.0 && mat.reads_cells == 1u) {
         let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
         let p = clamp(vec2<i32>(floor(clip)), vec2<i32>(0), last);
         let x = textureLoad(cells_xyz, p, 0);
         let nd = textureLoad(cells_nd, p, 0);
-        if (x.w > 0.5 && env_same_surface(nd.xyz, nd.w, n, dist)) {
+        let plain = x.w < 1.5 && env_grid_serves(wr.z);
+        if (x.w > 0.5 && env_same_surface(nd.xyz, nd.w, n, dist) && (at_centre || plain || env_inside_outline(p, n, dist))) {
             return vec4<f32>(x.xyz, 1.0);
         }
     }
     return vec4<f32>(0.0);
 }
 
+// Whether the centres of the four pixels next to pixel p saw the surface
+// with normal n at distance dist too: p lies inside that surface's outline
+// (at an edge between its triangles), not on its silhouette.
+fn env_inside_outline(p: vec2<i32>, n: vec3<f32>, dist: f32) -> bool {
+    let last = vec2<i32>(textureDimensions(cells_xyz)) - vec2<i32>(1);
+    var ok = true;
+    for (var j = 0; j < 4; j = j + 1) {
+        let e = select(vec2<i32>(1, 0), vec2<i32>(0, 1), (j & 1) == 1) * select(1, -1, j >= 2);
+        let q = clamp(p + e, vec2<i32>(0), last);
+        let nq = textureLoad(cells_nd, q, 0);
+        ok = ok && textureLoad(cells_xyz, q, 0).w > 0.5 && env_same_surface(nq.xyz, nq.w, n, dist);
+    }
+    return ok;
+}
+
 // The cells' XYZ at a fragment: the centre pass's (env_cells_read) or,
 // with `walk`, a walk of its own; without, 0 (the caller walks once for
-// several points: shaders/diffraction.wgsl env_cells_carried).
+// several points: shaders/diffraction.wgsl env_cells_carried). With `walk`
+// the point is the pixel's centre; without, one of a partly covered
+// pixel's samples.
 fn env_cells_pixel(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip: vec2<f32>, dist: f32, walk: bool) -> vec3<f32> {
-    let r = env_cells_read(n, wr, clip, dist);
+    let r = env_cells_read(n, wr, clip, dist, walk);
     if (r.w > 0.5 || !walk) {
         return r.xyz;
     }
     return env_cells(t, b, n, wr);
 }
 
-// Whether env_shade with `walk` would walk the cells at this fragment: the
+// Whether env_shade would walk the cells at this sample of a partly covered
+// pixel (were `walk` set; the caller walks once at the samples' mean): the
 // first-frame estimator's diffraction part where the centre pass has no
 // value for it.
 fn env_cells_walks(n: vec3<f32>, wr: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32) -> bool {
     return envg.on == 1u && envg.estimator == 0u && wr.z > 0.0 && diffract && envp.on == 1u && dw < 1.0
-        && env_cells_read(n, wr, clip, dist).w < 0.5;
+        && env_cells_read(n, wr, clip, dist, false).w < 0.5;
 }
 
 // ---------------------------------------------------------------- the estimator

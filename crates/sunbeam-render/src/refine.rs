@@ -16,9 +16,10 @@
 //! flagged pixel, not the frame's area; each tile shades its unflagged
 //! pixels too (4.7 times the flagged ones on a 512 x 512 sphere: a stencil
 //! of the flagged pixels would save that, not built). A tile's frame has
-//! `sub_pixel` = `m` ([`FrameState`]): its cells' pre-passes serve its
-//! grazing views too, so a limb pixel's `m x m` positions do not each walk
-//! the cells (the sphere's M = 8 refinement: 83 s, 488 s with each walking).
+//! `sub_pixel` = `m` ([`FrameState`]): its cells' grid serves its grazing
+//! views too, so a limb pixel's `m x m` positions mix from the grid instead
+//! of each walking the cells (the sphere's M = 8 refinement: 83 s, 488 s
+//! with each walking).
 
 use crate::{FrameState, Gpu, Offscreen, Renderer};
 use sunbeam_common::{Error, Result};

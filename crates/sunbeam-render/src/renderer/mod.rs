@@ -271,12 +271,13 @@ pub struct FrameState {
     pub background: Background,
     /// Pixels of this frame per side of one pixel of the image it stands
     /// for: 1, or `m` in a tile of edge refinement ([`crate::refine`]).
-    /// Above 1 the cells' pre-passes serve grazing views too: a texel is
-    /// `1 / m` of the pixel, so the grid's blocks pass their tests at the
-    /// limb, and the pixel's `m x m` positions there do not each walk the
-    /// cells (docs/LIGHTING.md "Edge refinement"). A supersampled frame keeps 1:
-    /// at a few sub-pixels the grazing band is a texel or two wide, its
-    /// blocks fail, and its grid points' walks were extra work (measured).
+    /// Above 1 the cells' grid serves grazing views too: a texel is `1 / m`
+    /// of the pixel, so the grid's blocks pass their tests at the limb, and
+    /// the pixel's `m x m` positions there mix instead of each walking the
+    /// cells in the centre pass (docs/LIGHTING.md "Edge refinement"). A
+    /// supersampled frame keeps 1: at a few sub-pixels the grazing band is a
+    /// texel or two wide, its blocks fail, and its grid points' walks were
+    /// extra work (measured).
     pub sub_pixel: u32,
 }
 

@@ -46,7 +46,7 @@ pub(super) struct Globals {
     /// pixels for K > 1; [`super::cells_rate`]); 0: every fragment walks
     /// them.
     pub(super) cells_rate: u32,
-    /// 1: the cells' pre-passes serve grazing views too (a tile of edge
+    /// 1: the cells' grid serves grazing views too (a tile of edge
     /// refinement, [`super::FrameState::sub_pixel`] > 1), else 0.
     pub(super) cells_grazing: u32,
     pub(super) _pad: [u32; 3],
