@@ -1371,12 +1371,12 @@ fn edge_refinement_is_the_supersampled_frame_at_its_pixels() {
 }
 
 /// Bound of [`edge_refinement_is_the_supersampled_frame_at_its_pixels`]:
-/// measured p99 0.19 over the 302 refined pixels (0.16 in the levels'
-/// test), the 2 x 2 frame 7.64 there; lavapipe, 2026-12-07. The two are
-/// the same positions by two ways: a tile's cells' pre-passes serve its
-/// grazing views (a tile's texel is an eighth of the pixel), where the
-/// whole frame walks the cells at each grazing fragment (0.042 when both
-/// walked), besides half floats. Tiles a twentieth of a pixel off (the
+/// measured p99 0.22 over the 302 refined pixels (0.17 in the levels'
+/// test), the 2 x 2 frame 7.67 there; lavapipe, 2026-12-07. The two are
+/// the same positions by two ways: a tile's cells' grid serves its grazing
+/// views (a tile's texel is an eighth of the pixel), where the whole frame
+/// walks the cells at each grazing pixel (0.042 when both walked at each
+/// fragment), besides half floats. Tiles a twentieth of a pixel off (the
 /// window's centre moved by 0.05 pixels) read p99 5.5 and an outline pixel
 /// unchanged.
 const EDGE_REFINED_P99: f64 = 0.3;
