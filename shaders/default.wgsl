@@ -136,13 +136,14 @@ fn cells_walk_at(p: vec2<i32>) -> vec4<f32> {
     return o;
 }
 
-// Whether the grid's walk first mixes its points from the half grid
+// Whether the walk first mixes its points from its even points
 // (fs_cells_walk_half): set for the grid's walk when the packs are small
-// enough (crates/sunbeam-render/src/renderer/cells_rate.rs HALF_GRID_PATCH_M).
+// enough (crates/sunbeam-render/src/renderer/cells_rate.rs HALF_GRID_PATCH_M)
+// and for the centre's walk wherever there is a grid (rate > 1).
 override SB_WALK_FROM_HALF: bool = false;
 
 // Whether the walk's target is laid out in bands (band_point): set for the
-// grid's walk; the centre's walk writes the frame's layout.
+// grid's walks; the centre's walks write the frame's layout.
 override SB_WALK_BANDED: bool = false;
 
 // The point of a grid `w` points wide at pixel s of a target laid out in
@@ -156,12 +157,16 @@ fn band_point(s: vec2<i32>, w: i32) -> vec2<i32> {
     return vec2<i32>(s.x - band * w, band * i32(g.cells_band) + s.y);
 }
 
-// The half grid: the grid's even points (2i, 2j), walked into a target
-// laid out in bands (band_point) of the half grid's rows.
+// The even points (2i, 2j) of the grid or of the centre's pixels, walked
+// into a target half the size: for the grid laid out in bands (band_point)
+// of the half grid's rows.
 @fragment
 fn fs_cells_walk_half(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f32> {
     let half = (vec2<i32>(textureDimensions(cells_xyz)) + vec2<i32>(1)) / 2;
-    let h = band_point(vec2<i32>(floor(clip.xy)), half.x);
+    var h = vec2<i32>(floor(clip.xy));
+    if (SB_WALK_BANDED) {
+        h = band_point(h, half.x);
+    }
     // no discard before the walk (cells_walk_at): the band's rows past the
     // grid skip it in a branch
     var o = vec4<f32>(0.0);
@@ -174,11 +179,12 @@ fn fs_cells_walk_half(@builtin(position) clip: vec4<f32>) -> @location(0) vec4<f
     return o;
 }
 
-// Grid point p of this mesh from the half grid (binding 5): its own walk at
-// an even point; elsewhere the bilinear mix of the four even points around
-// it where they saw one smooth patch with p on it (shaders/environment.wgsl
-// env_block_smooth, as a pixel's block). (XYZ, 1), else 0: p walks for
-// itself.
+// Point p of this mesh (a grid point, or a pixel the centre pass marked)
+// from its even points (binding 5, fs_cells_walk_half): its own walk at an
+// even point; elsewhere the bilinear mix of the four even points around it
+// where they saw one smooth patch with p on it (shaders/environment.wgsl
+// env_block_smooth and env_block_linear, as a pixel's block). (XYZ, 1 or 2
+// as cells_walk_at marks it), else 0: p walks for itself.
 fn cells_from_half(p: vec2<i32>) -> vec4<f32> {
     let a = textureLoad(cells_xyz, p, 0);
     let tp = textureLoad(cells_t, p, 0);
@@ -188,18 +194,21 @@ fn cells_from_half(p: vec2<i32>) -> vec4<f32> {
     let h = p / 2;
     let odd = p - 2 * h;
     if (odd.x == 0 && odd.y == 0) {
-        return vec4<f32>(textureLoad(cells_half, h, 0).xyz, 1.0);
+        return textureLoad(cells_half, h, 0);
     }
-    if (env_block_smooth(2 * h, 2, tp.xyz, textureLoad(cells_nd, p, 0).xyz) && env_block_linear(cells_half, h)) {
-        return vec4<f32>(env_bilinear(cells_half, h, 0.5 * vec2<f32>(odd)), 1.0);
+    let n = textureLoad(cells_nd, p, 0).xyz;
+    if (env_block_smooth(2 * h, 2, tp.xyz, n) && env_block_linear(cells_half, h)) {
+        // w: 2 at a view the grid does not serve, as cells_walk_at marks it
+        return vec4<f32>(env_bilinear(cells_half, h, 0.5 * vec2<f32>(odd)), select(1.0, 2.0, !env_grid_serves(dot(a.xyz, n))));
     }
     return vec4<f32>(0.0);
 }
 
 // The cells' walk, one full-screen pass per mesh after fs_cells (the grid,
-// into a target laid out in bands: its points mixed from the half grid
-// where SB_WALK_FROM_HALF and its blocks allow) and after fs_cells_centre
-// (the pixels the grid does not serve): at each point the raster pass marked, the cells' XYZ from the
+// into a target laid out in bands) and after fs_cells_centre (the pixels
+// the grid does not serve), the points mixed from their even points where
+// SB_WALK_FROM_HALF and their blocks allow (cells_from_half): at each point
+// the raster pass marked, the cells' XYZ from the
 // frame and view it wrote (bindings 2-4: its targets), so that every SIMD
 // block of the walk is full whatever the triangles' size.
 @fragment

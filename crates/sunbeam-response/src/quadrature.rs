@@ -74,6 +74,9 @@ pub const SKIP_SHARE: f64 = 1e-4;
 #[derive(Debug, Clone)]
 struct Row {
     r: f64,
+    /// `1 / sqrt(4 - r^2)`: the layer's scale at this radius ([`View::add`]),
+    /// once per row rather than per texel and view.
+    inv_chord: f64,
     /// Radii of the texel's inner and outer edges.
     r_lo: f64,
     r_hi: f64,
@@ -175,8 +178,10 @@ impl EnvQuadrature {
         let mut rows: Vec<Row> = (0..grid.n_rho)
             .map(|j| {
                 let (r_lo, r_hi, area) = grid.texel_extent(j);
+                let r = grid.r_at(j);
                 Row {
-                    r: grid.r_at(j),
+                    r,
+                    inv_chord: 1.0 / (4.0 - r * r).max(1e-12).sqrt(),
                     r_lo,
                     r_hi,
                     area,
@@ -768,7 +773,7 @@ impl<'a> View<'a> {
             min_cos: (2.0 * row.extent).sqrt(),
         };
         if (1.0 - d).abs() > BAND * row.extent {
-            self.plain(quad, -x, -y, row.r, area, foot, e, xyz);
+            self.plain(quad, -x, -y, row.inv_chord, area, foot, e, xyz);
             return;
         }
         // Near the horizon: the texel's radial and angular half extents
@@ -780,7 +785,7 @@ impl<'a> View<'a> {
             quad,
             -x,
             -y,
-            row.r,
+            row.inv_chord,
             hr.max(1e-9),
             ha.max(1e-9),
             area,
@@ -791,20 +796,21 @@ impl<'a> View<'a> {
     }
 
     /// Adds `weight * sum_k c_k E_k(s)` of texel layers `e` for an incoming
-    /// direction with `cos(theta_i) = ci` at `(u, v)` radius `r`.
+    /// direction with `cos(theta_i) = ci` at a `(u, v)` radius `r` whose row
+    /// has `inv_chord = 1 / sqrt(4 - r^2)`.
     #[allow(clippy::too_many_arguments)]
     fn add(
         &self,
         quad: &EnvQuadrature,
         ci: f64,
-        r: f64,
+        inv_chord: f64,
         weight: f64,
         c: [f64; 3],
         e: &[f32],
         xyz: &mut [f64; 3],
     ) {
         let ns = quad.grid.n_s;
-        let s = (ci + self.wr[2]) / (4.0 - r * r).max(1e-12).sqrt();
+        let s = (ci + self.wr[2]) * inv_chord;
         let ks = s.clamp(0.0, 1.0) * (ns - 1) as f64;
         let k0 = (ks.floor() as usize).min(ns.saturating_sub(2));
         let k1 = (k0 + 1).min(ns - 1);
@@ -828,7 +834,7 @@ impl<'a> View<'a> {
         quad: &EnvQuadrature,
         x: f64,
         y: f64,
-        r: f64,
+        inv_chord: f64,
         area: f64,
         foot: Footprint,
         e: &[f32],
@@ -843,7 +849,7 @@ impl<'a> View<'a> {
         let gain = self.masking.gain(wi, self.wr, self.skin) / ci;
         if gain > 0.0 && gain.is_finite() {
             let c = self.coefficients([x, y, ci], foot.solid_angle(ci));
-            self.add(quad, ci, r, area * gain, c, e, xyz);
+            self.add(quad, ci, inv_chord, area * gain, c, e, xyz);
         }
     }
 
@@ -861,7 +867,7 @@ impl<'a> View<'a> {
         quad: &EnvQuadrature,
         x: f64,
         y: f64,
-        r: f64,
+        inv_chord: f64,
         hr: f64,
         ha: f64,
         area: f64,
@@ -907,7 +913,7 @@ impl<'a> View<'a> {
                 let gs = self.masking.gain(wi, self.wr, self.skin) * (ci + cr) * (ci + cr);
                 let f = wgt * half.abs() * density(dm) / dm * gs;
                 if f > 0.0 && f.is_finite() {
-                    self.add(quad, ci, r, area * f, c, e, xyz);
+                    self.add(quad, ci, inv_chord, area * f, c, e, xyz);
                 }
             }
         }

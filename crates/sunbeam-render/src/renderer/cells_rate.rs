@@ -230,8 +230,12 @@ struct Grid {
     centre_t: wgpu::TextureView,
     /// Bind group 0 of the centre pass: the coarse grid (stand-ins at K = 1).
     centre_bind: wgpu::BindGroup,
-    /// Bind group 0 of the centre's walk: the centre pass's targets.
+    /// Bind group 0 of the centre's walk: the centre pass's targets and
+    /// its even pixels' XYZ (a stand-in without them).
     centre_walk_bind: wgpu::BindGroup,
+    /// The centre's even pixels' XYZ and the bind group of their walk (the
+    /// centre pass's targets), with [`CellsGrid::centre_half`].
+    centre_half: Option<(wgpu::TextureView, wgpu::BindGroup)>,
     /// Bind group 0 of the frame's pass: globals, spectrum and the centres.
     bind: wgpu::BindGroup,
 }
@@ -247,6 +251,8 @@ pub(super) struct CellsRate {
     coarse: Option<CoarsePipelines>,
     /// The centre pass and its full-screen walk.
     centre: (wgpu::RenderPipeline, wgpu::RenderPipeline),
+    /// The centre's even pixels' walk before it ([`CellsGrid::centre_half`]).
+    centre_half: Option<wgpu::RenderPipeline>,
     pre_bind: wgpu::BindGroup,
     stand_in: wgpu::TextureView,
     grid: Mutex<Option<Grid>>,
@@ -259,6 +265,11 @@ pub(super) struct CellsRate {
 pub(super) struct CellsGrid {
     pub(super) rate: u32,
     pub(super) half: bool,
+    /// The centre's walk mixes its odd pixels from its even ones where
+    /// they pass the block test, as the grid from its half grid: with a
+    /// grid (rate > 1), where the frame's values are smooth enough to
+    /// interpolate at all; at rate 1 every pixel walks.
+    pub(super) centre_half: bool,
 }
 
 /// The grid's raster pass, its full-screen walk, and the half grid's walk
@@ -388,7 +399,11 @@ impl CellsRate {
             entry,
             constants: Vec::new(),
         };
-        let CellsGrid { rate, half } = grid;
+        let CellsGrid {
+            rate,
+            half,
+            centre_half,
+        } = grid;
         let coarse = if rate > 1 {
             let raster = render_pipeline(
                 device,
@@ -417,7 +432,10 @@ impl CellsRate {
                     device,
                     layouts,
                     &[XYZ_FORMAT],
-                    &pass("diffraction.wgsl cells half walk", "fs_cells_walk_half"),
+                    &Technique {
+                        constants: vec![("SB_WALK_BANDED", 1.0)],
+                        ..pass("diffraction.wgsl cells half walk", "fs_cells_walk_half")
+                    },
                 )?)
             } else {
                 None
@@ -438,9 +456,25 @@ impl CellsRate {
                 device,
                 layouts,
                 &[CENTRE_FORMAT],
-                &pass("diffraction.wgsl cells centre walk", "fs_cells_walk"),
+                &Technique {
+                    constants: vec![("SB_WALK_FROM_HALF", f64::from(u8::from(centre_half)))],
+                    ..pass("diffraction.wgsl cells centre walk", "fs_cells_walk")
+                },
             )?,
         );
+        let centre_half = if centre_half {
+            Some(fullscreen_pipeline(
+                device,
+                layouts,
+                &[CENTRE_FORMAT],
+                &pass(
+                    "diffraction.wgsl cells centre half walk",
+                    "fs_cells_walk_half",
+                ),
+            )?)
+        } else {
+            None
+        };
         let pre_bind = global_bind(
             device,
             layouts[0],
@@ -453,6 +487,7 @@ impl CellsRate {
             max_width: device.limits().max_texture_dimension_2d,
             coarse,
             centre,
+            centre_half,
             pre_bind,
             stand_in: stand_in.clone(),
             grid: Mutex::new(None),
@@ -547,12 +582,30 @@ impl CellsRate {
         let centre_depth = super::depth_view(gpu, w, h);
         let centre_view = target(gpu, w, h, FRAME_FORMAT);
         let centre_t = target(gpu, w, h, FRAME_FORMAT);
+        // the centre's even pixels (2i, 2j), and the bind group of their walk
+        let centre_half = self.centre_half.as_ref().map(|_| {
+            let [hw, hh] = half_size([w, h]);
+            let xyz = target(gpu, hw, hh, CENTRE_FORMAT);
+            let bind = global_bind(
+                &gpu.device,
+                layout,
+                globals,
+                spectrum,
+                [&centre_view, &centre_nd, &centre_t, &self.stand_in],
+            );
+            (xyz, bind)
+        });
         let centre_walk_bind = global_bind(
             &gpu.device,
             layout,
             globals,
             spectrum,
-            [&centre_view, &centre_nd, &centre_t, &self.stand_in],
+            [
+                &centre_view,
+                &centre_nd,
+                &centre_t,
+                centre_half.as_ref().map_or(&self.stand_in, |(v, _)| v),
+            ],
         );
         let si = &self.stand_in;
         let centre_bind = match &coarse {
@@ -582,6 +635,7 @@ impl CellsRate {
             centre_t,
             centre_bind,
             centre_walk_bind,
+            centre_half,
             bind,
         });
     }
@@ -607,7 +661,7 @@ impl CellsRate {
             main(enc, fallback);
             return;
         };
-        let clear = |view| {
+        fn clear(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<'_>> {
             Some(wgpu::RenderPassColorAttachment {
                 view,
                 depth_slice: None,
@@ -617,7 +671,7 @@ impl CellsRate {
                     store: wgpu::StoreOp::Store,
                 },
             })
-        };
+        }
         let depth = |view| {
             Some(wgpu::RenderPassDepthStencilAttachment {
                 view,
@@ -627,6 +681,24 @@ impl CellsRate {
                 }),
                 stencil_ops: None,
             })
+        };
+        // a full-screen walk into a cleared `view`
+        let walk = |enc: &mut wgpu::CommandEncoder,
+                    label: &str,
+                    view: &wgpu::TextureView,
+                    pipeline: &wgpu::RenderPipeline,
+                    bind: &wgpu::BindGroup| {
+            let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(label),
+                color_attachments: &[clear(view)],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            rp.set_pipeline(pipeline);
+            rp.set_bind_group(0, bind, &[]);
+            draw_full(&mut rp);
         };
         if let (Some(c), Some(p)) = (&g.coarse, &self.coarse) {
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -661,32 +733,10 @@ impl CellsRate {
             draw(&mut rp);
             drop(rp);
             if let (Some((strip, view, bind)), Some(half)) = (&c.half, &p.half) {
-                let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("cells half grid walk"),
-                    color_attachments: &[clear(strip)],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                rp.set_pipeline(half);
-                rp.set_bind_group(0, bind, &[]);
-                draw_full(&mut rp);
-                drop(rp);
+                walk(enc, "cells half grid walk", strip, half, bind);
                 c.bands.unband(enc, strip, view, half_size(c.size));
             }
-            let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("cells grid walk"),
-                color_attachments: &[clear(&c.strip)],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            rp.set_pipeline(&p.walk);
-            rp.set_bind_group(0, &c.walk_bind, &[]);
-            draw_full(&mut rp);
-            drop(rp);
+            walk(enc, "cells grid walk", &c.strip, &p.walk, &c.walk_bind);
             c.bands.unband(enc, &c.strip, &c.walked, c.size);
         }
         {
@@ -717,6 +767,9 @@ impl CellsRate {
             rp.set_bind_group(0, &g.centre_bind, &[]);
             draw(&mut rp);
             drop(rp);
+            if let (Some((xyz, bind)), Some(half)) = (&g.centre_half, &self.centre_half) {
+                walk(enc, "cells centre half walk", xyz, half, bind);
+            }
             // the pixels the grid does not serve, walked into the XYZ the
             // centre pass wrote (loaded: its mixed pixels stay)
             let mut rp = enc.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -522,7 +522,11 @@ impl Renderer {
                                 &adapter,
                                 &device,
                                 &layouts,
-                                cells_rate::CellsGrid { rate, half },
+                                cells_rate::CellsGrid {
+                                    rate,
+                                    half,
+                                    centre_half: rate > 1,
+                                },
                                 &globals,
                                 &spectrum,
                                 &stand_in,
