@@ -117,7 +117,8 @@ pub(crate) struct Cli {
     pub(crate) env_hot_threshold: f64,
     /// Environment scenes, `--env-estimator cells`: shade the cells on a grid
     /// of one pixel in K x K and interpolate them where the surface is smooth,
-    /// once per pixel elsewhere (1..=16; 1: once per pixel; 0: once per
+    /// elsewhere at every other pixel and interpolate those where they allow,
+    /// once per pixel where not (1..=16; 1: once per pixel; 0: once per
     /// fragment, every triangle touching a pixel, the slow path kept for
     /// comparisons; default: 4 for a patch under 32 um, 2 from 32 um, the
     /// finest of the scene's packs; docs/LIGHTING.md "Cells at a lower
