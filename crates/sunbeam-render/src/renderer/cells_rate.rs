@@ -234,7 +234,7 @@ struct Grid {
     /// its even pixels' XYZ (a stand-in without them).
     centre_walk_bind: wgpu::BindGroup,
     /// The centre's even pixels' XYZ and the bind group of their walk (the
-    /// centre pass's targets), with [`CellsGrid::centre_half`].
+    /// centre pass's targets), with a grid (rate > 1).
     centre_half: Option<(wgpu::TextureView, wgpu::BindGroup)>,
     /// Bind group 0 of the frame's pass: globals, spectrum and the centres.
     bind: wgpu::BindGroup,
@@ -251,7 +251,7 @@ pub(super) struct CellsRate {
     coarse: Option<CoarsePipelines>,
     /// The centre pass and its full-screen walk.
     centre: (wgpu::RenderPipeline, wgpu::RenderPipeline),
-    /// The centre's even pixels' walk before it ([`CellsGrid::centre_half`]).
+    /// The centre's even pixels' walk before it, with a grid (rate > 1).
     centre_half: Option<wgpu::RenderPipeline>,
     pre_bind: wgpu::BindGroup,
     stand_in: wgpu::TextureView,
@@ -265,11 +265,6 @@ pub(super) struct CellsRate {
 pub(super) struct CellsGrid {
     pub(super) rate: u32,
     pub(super) half: bool,
-    /// The centre's walk mixes its odd pixels from its even ones where
-    /// they pass the block test, as the grid from its half grid: with a
-    /// grid (rate > 1), where the frame's values are smooth enough to
-    /// interpolate at all; at rate 1 every pixel walks.
-    pub(super) centre_half: bool,
 }
 
 /// The grid's raster pass, its full-screen walk, and the half grid's walk
@@ -399,11 +394,12 @@ impl CellsRate {
             entry,
             constants: Vec::new(),
         };
-        let CellsGrid {
-            rate,
-            half,
-            centre_half,
-        } = grid;
+        let CellsGrid { rate, half } = grid;
+        // The centre's walk mixes its odd pixels from its even ones where
+        // they pass the block test, as the grid from its half grid: with a
+        // grid (rate > 1), where the frame's values are smooth enough to
+        // interpolate at all; at rate 1 every pixel walks.
+        let centre_half = rate > 1;
         let coarse = if rate > 1 {
             let raster = render_pipeline(
                 device,

@@ -522,11 +522,7 @@ impl Renderer {
                                 &adapter,
                                 &device,
                                 &layouts,
-                                cells_rate::CellsGrid {
-                                    rate,
-                                    half,
-                                    centre_half: rate > 1,
-                                },
+                                cells_rate::CellsGrid { rate, half },
                                 &globals,
                                 &spectrum,
                                 &stand_in,
