@@ -13,8 +13,8 @@
 // and shaders/env_table.wgsl (sb_env_equirect) before it. The host supplies
 // the data, so that the player reads a storage buffer and the export a data
 // texture (WebGL2 has no storage buffers):
-//   env_cell_f32(i), env_cell_u32(i): float i of Cells::gpu_data, as a float
-//     or as its bits (the child pointers);
+//   env_cell_v4(i): floats 4 i to 4 i + 3 of Cells::gpu_data (the links
+//     are u32 bits: bitcast);
 //   env_cells_top(): cells of the top cut; env_cells_nodes(): every node;
 //   env_cells_layers(): the maps' s layers;
 //   env_cells_view(wr): what the mesh's gain and masking need of the view
@@ -38,9 +38,13 @@ fn env_prefiltered(d: vec3<f32>, omega: f32) -> vec3<f32> {
 // Cells refine near the horizon while their spread times this reaches it
 // (sunbeam_response::cells::REFINE).
 const ENV_REFINE: f32 = 3.0;
-// Cells::gpu_data: floats per node before its masses (u, v, spread, first,
-// next, the 9 masses' offsets, then the width uu, uv, vv), and "no node".
-const ENV_CELL_HEADER: u32 = 26u;
+// Cells::gpu_data in fours of floats (cells::GPU_HEADER, GPU_LAYER): per
+// node (u, v, spread, first), (next, the width uu, uv, vv), per basis its 3
+// masses' offsets in two fours, then per layer one four per basis (XYZ, 0).
+// A four is one load: a leaf's reads were most of a walk's time on llvmpipe
+// as single floats (docs/LIGHTING.md "Where a walk's time goes").
+const ENV_CELL_HEADER: u32 = 8u;
+const ENV_CELL_LAYER: u32 = 3u;
 // Cells within this many of their widths of the horizon integrate G / cos
 // across them (cells::RIM_WIDTHS); outside the disc by less than this they
 // still count (cells::RIM_OUTSIDE); the half-width of env_rim_moments'
@@ -60,7 +64,7 @@ const ENV_CELL_NONE: u32 = 0xffffffffu;
 fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     var xyz = vec3<f32>(0.0);
     let ns = env_cells_layers();
-    let stride = ENV_CELL_HEADER + 9u * ns;
+    let stride = ENV_CELL_HEADER + ENV_CELL_LAYER * ns;
     if (env_cells_top() == 0u) {
         return xyz;
     }
@@ -85,25 +89,27 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         var l = 0.0;
         for (var depth = 0u; depth < n_nodes; depth = depth + 1u) {
             o = id * stride;
-            uv = vec2<f32>(env_cell_f32(o), env_cell_f32(o + 1u));
-            spread = env_cell_f32(o + 2u);
+            let h0 = env_cell_v4(o);
+            uv = h0.xy;
+            spread = h0.z;
             wxy = -uv - wr.xy;
             l = length(wxy);
-            let first = env_cell_u32(o + 3u);
+            let first = bitcast<u32>(h0.w);
             if (first == ENV_CELL_NONE || 1.0 - l >= ENV_REFINE * spread) {
                 break;
             }
             id = first;
         }
         let dist = 1.0 - l;
-        id = env_cell_u32(o + 4u);
+        let h1 = env_cell_v4(o + 1u);
+        id = bitcast<u32>(h1.x);
         var inside = select(0.0, 1.0, dist > 0.0);
         if (spread > 0.0) {
             inside = env_gaussian_inside(dist, spread);
         }
         // near the horizon: the cell's width towards it (cells::Cells::estimate)
         let dir = wxy / max(l, 1e-12);
-        let wq = vec3<f32>(env_cell_f32(o + 23u), env_cell_f32(o + 24u), env_cell_f32(o + 25u));
+        let wq = h1.yzw;
         let sigma = sqrt(max(dir.x * dir.x * wq.x + 2.0 * dir.x * dir.y * wq.y + dir.y * dir.y * wq.z, 0.0));
         let rim = l > 1e-9 && sigma > 0.0 && dist < ENV_RIM_WIDTHS * sigma && dist > -ENV_RIM_OUTSIDE;
         if (!rim && (inside <= 0.0 || dist <= -0.5)) {
@@ -142,7 +148,7 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
         // at the cell's mean (env_rim_slope)
         let slope = env_rim_slope(rg, sigma, dir, wr, view, g0);
         let ly = env_cell_layer(wg.z, wr.z, r, ns);
-        let m0 = o + ENV_CELL_HEADER + ly.k0 * 9u;
+        let m0 = o + ENV_CELL_HEADER + ly.k0 * ENV_CELL_LAYER;
         var gc = gw * inside;
         if (rim) {
             gc = gw;
@@ -171,7 +177,7 @@ fn env_rim_moments(a: f32) -> vec2<f32> {
 
 // What a leaf's masses share, for env_cell_basis.
 struct EnvCellShare {
-    // the node's offset in the cells' data
+    // the node's offset in the cells' data, in fours
     o: u32,
     uv: vec2<f32>,
     spread: f32,
@@ -197,10 +203,10 @@ struct EnvCellShare {
 fn env_cell_basis(cs: EnvCellShare, bb: u32, m0: u32, f: f32, cb: f32, wr: vec3<f32>) -> vec3<f32> {
     var share = vec3<f32>(cs.gc);
     if (cs.straddles) {
-        let q = cs.o + 5u + 6u * bb;
-        let o0 = vec2<f32>(env_cell_f32(q), env_cell_f32(q + 1u));
-        let o1 = vec2<f32>(env_cell_f32(q + 2u), env_cell_f32(q + 3u));
-        let o2 = vec2<f32>(env_cell_f32(q + 4u), env_cell_f32(q + 5u));
+        let q01 = env_cell_v4(cs.o + 2u + 2u * bb);
+        let o0 = q01.xy;
+        let o1 = q01.zw;
+        let o2 = env_cell_v4(cs.o + 3u + 2u * bb).xy;
         if (cs.rim) {
             share = vec3<f32>(
                 env_cell_rim_gain(cs.dist, cs.sigma, cs.dir, o0, cs.wz0, cs.g0, cs.slope),
@@ -233,9 +239,8 @@ fn env_cell_layer(wz: f32, wrz: f32, r: f32, ns: u32) -> EnvCellLayer {
 // Basis bb's XYZ mass between the layer at m0 and the next, f the weight of
 // the latter (Cell::mass_at).
 fn env_cell_mass(m0: u32, bb: u32, f: f32) -> vec3<f32> {
-    let m1 = m0 + 9u;
-    let a0 = vec3<f32>(env_cell_f32(m0 + 3u * bb), env_cell_f32(m0 + 3u * bb + 1u), env_cell_f32(m0 + 3u * bb + 2u));
-    let a1 = vec3<f32>(env_cell_f32(m1 + 3u * bb), env_cell_f32(m1 + 3u * bb + 1u), env_cell_f32(m1 + 3u * bb + 2u));
+    let a0 = env_cell_v4(m0 + bb).xyz;
+    let a1 = env_cell_v4(m0 + ENV_CELL_LAYER + bb).xyz;
     return mix(a0, a1, f);
 }
 

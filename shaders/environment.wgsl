@@ -110,8 +110,8 @@ struct EnvProposal {
 // sRGB): transmitted through the skin (weight cos (1 - F)), and plain
 @group(2) @binding(10) var env_irr_skin: texture_2d<f32>;
 @group(2) @binding(11) var env_irr_plain: texture_2d<f32>;
-// the maps' cells (sunbeam_response::cells::Cells::gpu_data)
-@group(2) @binding(12) var<storage, read> cells: array<f32>;
+// the maps' cells (sunbeam_response::cells::Cells::gpu_data), four floats an element
+@group(2) @binding(12) var<storage, read> cells: array<vec4<f32>>;
 // the hot spots' taps (shaders/env_hotspots.wgsl), two vec4 per tap:
 // (world direction, 0) and (the light's basis power times the tap's weight, 0)
 @group(2) @binding(13) var<storage, read> env_lights: array<vec4<f32>>;
@@ -512,12 +512,8 @@ fn env_descend(wr: vec3<f32>, u: vec3<f32>, q: u32) -> EnvDraw {
 // export, shaders/export_env.wgsl); the player supplies its data access here:
 // the nodes from the storage buffer, the chain and irradiance tables from
 // group 2, the mesh's gain with its masking.
-fn env_cell_f32(i: u32) -> f32 {
+fn env_cell_v4(i: u32) -> vec4<f32> {
     return cells[i];
-}
-
-fn env_cell_u32(i: u32) -> u32 {
-    return bitcast<u32>(cells[i]);
 }
 
 fn env_cells_top() -> u32 {
@@ -525,7 +521,7 @@ fn env_cells_top() -> u32 {
 }
 
 fn env_cells_nodes() -> u32 {
-    return arrayLength(&cells) / (ENV_CELL_HEADER + 9u * envp.n_s);
+    return arrayLength(&cells) / (ENV_CELL_HEADER + ENV_CELL_LAYER * envp.n_s);
 }
 
 fn env_cells_layers() -> u32 {

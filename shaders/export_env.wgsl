@@ -89,13 +89,16 @@ fn env_hot_maps(p: vec3<f32>, uvw: vec3<f32>) -> vec3<f32> {
         + p.z * textureSampleLevel(env_basis2, resp_smp, at, 0.0).xyz;
 }
 
-fn env_cell_u32(i: u32) -> u32 {
+// Floats 4 i to 4 i + 3, in one row: the texture is 2048 texels wide or
+// as wide as the cells, a multiple of 4 (sunbeam-render's env_export.rs).
+fn env_cell_v4(i: u32) -> vec4<f32> {
     let w = u32(textureDimensions(env_cells_tex, 0).x);
-    return textureLoad(env_cells_tex, vec2<i32>(i32(i % w), i32(i / w)), 0).x;
-}
-
-fn env_cell_f32(i: u32) -> f32 {
-    return bitcast<f32>(env_cell_u32(i));
+    let at = vec2<i32>(i32((4u * i) % w), i32((4u * i) / w));
+    return bitcast<vec4<f32>>(vec4<u32>(
+        textureLoad(env_cells_tex, at, 0).x,
+        textureLoad(env_cells_tex, at + vec2<i32>(1, 0), 0).x,
+        textureLoad(env_cells_tex, at + vec2<i32>(2, 0), 0).x,
+        textureLoad(env_cells_tex, at + vec2<i32>(3, 0), 0).x));
 }
 
 fn env_cells_top() -> u32 {

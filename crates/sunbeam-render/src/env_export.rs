@@ -158,12 +158,15 @@ pub fn export(
         let cells = crate::env::pack_cells(cells, pack);
         let c = environment::first_frame_cells(&er, &env, pack, path, mi, cells, &mut notes)?;
         let mut bits: Vec<u32> = c.data.iter().map(|v| v.to_bits()).collect();
+        // 2048 or the whole set, both multiples of 4: a node's four floats
+        // lie in one row (shaders/export_env.wgsl `env_cell_v4`)
         let w = CELLS_WIDTH.min(bits.len().max(1));
         let h = bits.len().div_ceil(w).max(1);
         bits.resize(w * h, 0);
         let info = serde_json::json!({
             "n_top": c.n_top, "n_s": er.grid.n_s, "nodes": c.nodes,
-            "header": sunbeam_response::cells::GPU_HEADER, "width": w, "height": h,
+            "header": sunbeam_response::cells::GPU_HEADER, "layer": sunbeam_response::cells::GPU_LAYER,
+            "width": w, "height": h,
         });
         let file = put(
             &format!("cells-{mi}.ktx2"),

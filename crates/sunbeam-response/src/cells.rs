@@ -86,8 +86,12 @@ pub fn first_frame_top(patch_m: f64) -> usize {
 pub fn first_frame_top_for(manifest: &sunbeam_pack::Manifest) -> usize {
     first_frame_top(manifest.patch.lx_m.max(manifest.patch.ly_m))
 }
-/// Floats per node in [`Cells::gpu_data`] before its layers' masses.
-pub const GPU_HEADER: usize = 5 + 18 + 3;
+/// Floats per node in [`Cells::gpu_data`] before its layers' masses: `[u,
+/// v, spread, first]`, `[next, uu, uv, vv]`, per basis its 3 offsets in 8.
+pub const GPU_HEADER: usize = 4 + 4 + 3 * 8;
+/// Floats per layer of a node's masses in [`Cells::gpu_data`]: per basis
+/// XYZ and a 0.
+pub const GPU_LAYER: usize = 3 * 4;
 /// Leaves whose centroid lies within this many of their widths of the view's
 /// horizon take [`rim_point`]'s integral of `G / cos` across them.
 pub const RIM_WIDTHS: f64 = 5.0;
@@ -463,12 +467,14 @@ impl Cells {
         }
     }
 
-    /// The nodes for the shader (shaders/environment.wgsl `env_cells`): per
-    /// node `[u, v, spread, first child, next]` (links as u32 bits,
-    /// [`GPU_NONE`] for none), the 9 `offsets` (u, v each), `width` (uu, uv,
-    /// vv), then `n_s`
-    /// layers of 9 masses (XYZ of `E_0, E_1, E_2`); the second child follows
-    /// the first.
+    /// The nodes for the shader (shaders/env_cells.wgsl `env_cells`), in
+    /// fours of floats: per node `[u, v, spread, first child]`, `[next, uu,
+    /// uv, vv]` (links as u32 bits, [`GPU_NONE`] for none; `width`), per
+    /// basis `b` its 3 `offsets` (u, v each) and two 0s, then `n_s` layers of
+    /// `[X, Y, Z, 0]` of `E_0, E_1, E_2`; the second child follows the first.
+    /// A four is one load in the shader: read one float at a time, a leaf's
+    /// reads were about 40 % of a walk on llvmpipe (docs/LIGHTING.md "Where a
+    /// walk's time goes").
     ///
     /// `next` threads the tree: the node a depth-first walk visits after this
     /// one and its subtree (the next top cell, or the sibling, or the
@@ -491,7 +497,7 @@ impl Cells {
                 next[b as usize] = next[i];
             }
         }
-        let mut out = Vec::with_capacity(self.nodes.len() * (GPU_HEADER + 9 * ns));
+        let mut out = Vec::with_capacity(self.nodes.len() * (GPU_HEADER + GPU_LAYER * ns));
         for (c, &nx) in self.nodes.iter().zip(&next) {
             let first = c.children.map_or(GPU_NONE, |ch| ch[0]);
             out.extend([
@@ -501,10 +507,16 @@ impl Cells {
                 f32::from_bits(first),
                 f32::from_bits(nx),
             ]);
-            out.extend(c.offsets.iter().flat_map(|o| o.map(|x| x as f32)));
             out.extend(c.width.map(|x| x as f32));
+            for o in c.offsets.chunks(3) {
+                out.extend(o.iter().flat_map(|o| o.map(|x| x as f32)));
+                out.extend([0.0; 2]);
+            }
             for layer in &c.mass {
-                out.extend(layer.iter().map(|&m| m as f32));
+                for m in layer.chunks(3) {
+                    out.extend(m.iter().map(|&m| m as f32));
+                    out.push(0.0);
+                }
             }
         }
         out
@@ -836,7 +848,7 @@ mod tests {
             n_top: 3,
         };
         let data = cells.gpu_data();
-        let stride = GPU_HEADER + 9 * 2;
+        let stride = GPU_HEADER + GPU_LAYER * 2;
         assert_eq!(data.len(), 11 * stride);
         assert_eq!(walk(&data, stride, &|_| false), vec![0, 1, 2]);
         assert_eq!(walk(&data, stride, &|_| true), vec![3, 7, 8, 1, 5, 9, 10]);

@@ -17,7 +17,7 @@
 //! one after another, each from the start of a row; the [`CellsInfo`] JSON
 //! under the key `sunbeam.env-cells` says where each set lies.
 
-use crate::cells::{Cells, GpuCells, GPU_HEADER, GPU_NONE};
+use crate::cells::{Cells, GpuCells, GPU_HEADER, GPU_LAYER, GPU_NONE};
 use crate::env_file::EnvFile;
 use crate::grid::Grid;
 use crate::ktx2;
@@ -29,10 +29,11 @@ use sunbeam_pack::Manifest;
 
 /// `CellsInfo::format`.
 pub const FORMAT: &str = "sunbeam-env-cells";
-/// Format version: 2 added each node's `width` ([`GPU_HEADER`] 26). A file
-/// of an earlier version does not serve (the player clusters instead and
-/// says so), it is not damaged.
-pub const VERSION: u32 = 2;
+/// Format version: 2 added each node's `width`, 3 laid each node out in
+/// fours of floats ([`GPU_HEADER`] 32, [`GPU_LAYER`] 12). A file of an
+/// earlier version does not serve (the player clusters instead and says
+/// so), it is not damaged.
+pub const VERSION: u32 = 3;
 /// Key of the info JSON in the KTX2 key/value data.
 pub const INFO_KEY: &str = "sunbeam.env-cells";
 /// Width of the texture (texels; WebGL2 guarantees 2048).
@@ -192,7 +193,7 @@ impl CellsInfo {
 
     /// Floats per node.
     fn stride(&self) -> usize {
-        GPU_HEADER + 9 * self.grid.n_s
+        GPU_HEADER + GPU_LAYER * self.grid.n_s
     }
 
     /// Check the description against a texture of `texels`: every set
