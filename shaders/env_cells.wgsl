@@ -45,6 +45,11 @@ const ENV_REFINE: f32 = 3.0;
 // as single floats (docs/LIGHTING.md "Where a walk's time goes").
 const ENV_CELL_HEADER: u32 = 8u;
 const ENV_CELL_LAYER: u32 = 3u;
+
+// Fours per node for maps of ns layers (cells::gpu_stride / 4).
+fn env_cell_stride(ns: u32) -> u32 {
+    return ENV_CELL_HEADER + ENV_CELL_LAYER * ns;
+}
 // Cells within this many of their widths of the horizon integrate G / cos
 // across them (cells::RIM_WIDTHS); outside the disc by less than this they
 // still count (cells::RIM_OUTSIDE); the half-width of env_rim_moments'
@@ -64,7 +69,7 @@ const ENV_CELL_NONE: u32 = 0xffffffffu;
 fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
     var xyz = vec3<f32>(0.0);
     let ns = env_cells_layers();
-    let stride = ENV_CELL_HEADER + ENV_CELL_LAYER * ns;
+    let stride = env_cell_stride(ns);
     if (env_cells_top() == 0u) {
         return xyz;
     }

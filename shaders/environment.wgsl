@@ -521,7 +521,7 @@ fn env_cells_top() -> u32 {
 }
 
 fn env_cells_nodes() -> u32 {
-    return arrayLength(&cells) / (ENV_CELL_HEADER + ENV_CELL_LAYER * envp.n_s);
+    return arrayLength(&cells) / env_cell_stride(envp.n_s);
 }
 
 fn env_cells_layers() -> u32 {

@@ -92,6 +92,11 @@ pub const GPU_HEADER: usize = 4 + 4 + 3 * 8;
 /// Floats per layer of a node's masses in [`Cells::gpu_data`]: per basis
 /// XYZ and a 0.
 pub const GPU_LAYER: usize = 3 * 4;
+
+/// Floats per node in [`Cells::gpu_data`] for maps of `n_s` layers.
+pub fn gpu_stride(n_s: usize) -> usize {
+    GPU_HEADER + GPU_LAYER * n_s
+}
 /// Leaves whose centroid lies within this many of their widths of the view's
 /// horizon take [`rim_point`]'s integral of `G / cos` across them.
 pub const RIM_WIDTHS: f64 = 5.0;
@@ -497,7 +502,7 @@ impl Cells {
                 next[b as usize] = next[i];
             }
         }
-        let mut out = Vec::with_capacity(self.nodes.len() * (GPU_HEADER + GPU_LAYER * ns));
+        let mut out = Vec::with_capacity(self.nodes.len() * gpu_stride(ns));
         for (c, &nx) in self.nodes.iter().zip(&next) {
             let first = c.children.map_or(GPU_NONE, |ch| ch[0]);
             out.extend([
@@ -848,7 +853,7 @@ mod tests {
             n_top: 3,
         };
         let data = cells.gpu_data();
-        let stride = GPU_HEADER + GPU_LAYER * 2;
+        let stride = gpu_stride(2);
         assert_eq!(data.len(), 11 * stride);
         assert_eq!(walk(&data, stride, &|_| false), vec![0, 1, 2]);
         assert_eq!(walk(&data, stride, &|_| true), vec![3, 7, 8, 1, 5, 9, 10]);

@@ -17,7 +17,7 @@
 //! one after another, each from the start of a row; the [`CellsInfo`] JSON
 //! under the key `sunbeam.env-cells` says where each set lies.
 
-use crate::cells::{Cells, GpuCells, GPU_HEADER, GPU_LAYER, GPU_NONE};
+use crate::cells::{gpu_stride, Cells, GpuCells, GPU_HEADER, GPU_NONE};
 use crate::env_file::EnvFile;
 use crate::grid::Grid;
 use crate::ktx2;
@@ -30,7 +30,7 @@ use sunbeam_pack::Manifest;
 /// `CellsInfo::format`.
 pub const FORMAT: &str = "sunbeam-env-cells";
 /// Format version: 2 added each node's `width`, 3 laid each node out in
-/// fours of floats ([`GPU_HEADER`] 32, [`GPU_LAYER`] 12). A file of an
+/// fours of floats ([`GPU_HEADER`] 32, [`GPU_LAYER`](crate::cells::GPU_LAYER) 12). A file of an
 /// earlier version does not serve (the player clusters instead and says
 /// so), it is not damaged.
 pub const VERSION: u32 = 3;
@@ -193,7 +193,7 @@ impl CellsInfo {
 
     /// Floats per node.
     fn stride(&self) -> usize {
-        GPU_HEADER + GPU_LAYER * self.grid.n_s
+        gpu_stride(self.grid.n_s)
     }
 
     /// Check the description against a texture of `texels`: every set
