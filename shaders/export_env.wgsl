@@ -12,8 +12,9 @@
 //     same coordinates without the phase (u = phi / 2 pi): transmitted
 //     through the skin (irradiance-skin.ktx2) and plain (irradiance.ktx2);
 //   6 env_smp: linear, linear between mip levels, repeat in u, clamp in v;
-//   7 env_cells_tex: the cells, 2D R32UI, float i of Cells::gpu_data (its
-//     bits) at texel (i % width, i / width) (cells.ktx2);
+//   7 env_cells_tex: the cells, 2D RGBA32UI, floats 4 i to 4 i + 3 of
+//     Cells::gpu_data (their bits) at texel (i % width, i / width)
+//     (cells-I.ktx2);
 //   8 sunbeam_env: the numbers (environment.json);
 //   9 env_sun_map: the sky's sun, Omega_sun E_sun over directions: a
 //     response map of the sun's spectrum (sun-I.ktx2, read like the material's
@@ -89,16 +90,10 @@ fn env_hot_maps(p: vec3<f32>, uvw: vec3<f32>) -> vec3<f32> {
         + p.z * textureSampleLevel(env_basis2, resp_smp, at, 0.0).xyz;
 }
 
-// Floats 4 i to 4 i + 3, in one row: the texture is 2048 texels wide or
-// as wide as the cells, a multiple of 4 (sunbeam-render's env_export.rs).
+// Floats 4 i to 4 i + 3: texel i (sunbeam-render's env_export.rs).
 fn env_cell_v4(i: u32) -> vec4<f32> {
     let w = u32(textureDimensions(env_cells_tex, 0).x);
-    let at = vec2<i32>(i32((4u * i) % w), i32((4u * i) / w));
-    return bitcast<vec4<f32>>(vec4<u32>(
-        textureLoad(env_cells_tex, at, 0).x,
-        textureLoad(env_cells_tex, at + vec2<i32>(1, 0), 0).x,
-        textureLoad(env_cells_tex, at + vec2<i32>(2, 0), 0).x,
-        textureLoad(env_cells_tex, at + vec2<i32>(3, 0), 0).x));
+    return bitcast<vec4<f32>>(textureLoad(env_cells_tex, vec2<i32>(i32(i % w), i32(i / w)), 0));
 }
 
 fn env_cells_top() -> u32 {

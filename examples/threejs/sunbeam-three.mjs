@@ -138,9 +138,9 @@ export function parseEnvironment({ json, chain, irradianceSkin, irradiance, cell
     out.hotSpots = tex;
   }
   for (const [file, buf] of Object.entries(cells)) {
-    const [l] = ktxLevels(buf, file, 98);
-    const tex = new THREE.DataTexture(new Uint32Array(l.bytes), l.width, l.height, THREE.RedIntegerFormat, THREE.UnsignedIntType);
-    tex.internalFormat = 'R32UI';
+    const [l] = ktxLevels(buf, file, 107);
+    const tex = new THREE.DataTexture(new Uint32Array(l.bytes), l.width, l.height, THREE.RGBAIntegerFormat, THREE.UnsignedIntType);
+    tex.internalFormat = 'RGBA32UI';
     tex.minFilter = THREE.NearestFilter;
     tex.magFilter = THREE.NearestFilter;
     tex.generateMipmaps = false;
@@ -417,8 +417,8 @@ export function sunbeamMaterial({ exportedGlsl, map, baseColor = [0.05, 0.05, 0.
   // Stand-ins of the environment's textures (each sampler needs a texture of its type).
   const flat = new THREE.DataTexture(new Uint16Array(4), 1, 1, THREE.RGBAFormat, THREE.HalfFloatType);
   flat.needsUpdate = true;
-  const noCells = new THREE.DataTexture(new Uint32Array(1), 1, 1, THREE.RedIntegerFormat, THREE.UnsignedIntType);
-  noCells.internalFormat = 'R32UI';
+  const noCells = new THREE.DataTexture(new Uint32Array(4), 1, 1, THREE.RGBAIntegerFormat, THREE.UnsignedIntType);
+  noCells.internalFormat = 'RGBA32UI';
   noCells.needsUpdate = true;
   const noScale = new THREE.DataTexture(new Uint8Array([128, 128, 255, 255]), 1, 1, THREE.RGBAFormat, THREE.UnsignedByteType);
   noScale.needsUpdate = true;

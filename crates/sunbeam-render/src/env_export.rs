@@ -11,8 +11,9 @@
 //!   without the sun (sunbeam_light::irradiance), transmitted through the
 //!   skin of the first mesh with a pack and plain, 2D RGBA16F;
 //! - `cells-I.ktx2` for each mesh I with a pack (one per distinct pack, the
-//!   others naming the same file): Cells::gpu_data as 2D R32_UINT (the floats'
-//!   bits), [`CELLS_WIDTH`] wide; with the sky's sun up, `sun-I.ktx2`: the
+//!   others naming the same file): Cells::gpu_data as 2D R32G32B32A32_UINT
+//!   (the floats' bits, one of its fours a texel), [`CELLS_WIDTH`] texels
+//!   wide; with the sky's sun up, `sun-I.ktx2`: the
 //!   pack's `Omega_sun E_sun` map (a response map, RGBA16F 3D);
 //! - a map's hot spots as lights (sunbeam_light::hotspots, as the player's
 //!   `--env-hot-spots`): their taps in `environment.json` (`hot_spots`), the
@@ -34,7 +35,8 @@ use sunbeam_frame::Prepared;
 use sunbeam_optics::colour;
 use sunbeam_response::ktx2::{encode_2d, Texture2d};
 
-/// Width of the cells' texture (WebGL2 guarantees 2048).
+/// Width of the cells' texture in texels of four words (WebGL2 guarantees
+/// 2048).
 pub const CELLS_WIDTH: usize = 2048;
 /// The KTX2 key of each file's JSON.
 pub const KEY: &str = "sunbeam.environment";
@@ -158,11 +160,13 @@ pub fn export(
         let cells = crate::env::pack_cells(cells, pack);
         let c = environment::first_frame_cells(&er, &env, pack, path, mi, cells, &mut notes)?;
         let mut bits: Vec<u32> = c.data.iter().map(|v| v.to_bits()).collect();
-        // 2048 or the whole set, both multiples of 4: a node's four floats
-        // lie in one row (shaders/export_env.wgsl `env_cell_v4`)
-        let w = CELLS_WIDTH.min(bits.len().max(1));
-        let h = bits.len().div_ceil(w).max(1);
-        bits.resize(w * h, 0);
+        // one four a texel, one fetch in the shader (shaders/export_env.wgsl
+        // `env_cell_v4`): SwiftShader's frame took 0.77-0.83x the time of
+        // four R32_UINT fetches (docs/ENGINES.md "Environment")
+        let fours = bits.len().div_ceil(4);
+        let w = CELLS_WIDTH.min(fours.max(1));
+        let h = fours.div_ceil(w).max(1);
+        bits.resize(4 * w * h, 0);
         let info = serde_json::json!({
             "n_top": c.n_top, "n_s": er.grid.n_s, "nodes": c.nodes,
             "header": sunbeam_response::cells::GPU_HEADER, "layer": sunbeam_response::cells::GPU_LAYER,
@@ -170,7 +174,7 @@ pub fn export(
         });
         let file = put(
             &format!("cells-{mi}.ktx2"),
-            encode_2d(KEY, &info.to_string(), &Texture2d::R32u(w, h, &bits)),
+            encode_2d(KEY, &info.to_string(), &Texture2d::Rgba32u(w, h, &bits)),
         )?;
         let mut v = info;
         v["file"] = file.into();

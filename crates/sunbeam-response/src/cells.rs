@@ -106,7 +106,7 @@ pub const RIM_WIDTHS: f64 = 5.0;
 pub const RIM_OUTSIDE: f64 = 0.05;
 /// Half-width of [`rim_moments`]' box in units of the cell's rms width
 /// (`sqrt 3`: the box of the same variance).
-const RIM_BOX: f64 = 1.732_050_807_568_877_2;
+pub const RIM_BOX: f64 = 1.732_050_807_568_877_2;
 /// "No node" in [`Cells::gpu_data`]'s links.
 pub const GPU_NONE: u32 = u32::MAX;
 

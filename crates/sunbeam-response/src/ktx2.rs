@@ -82,21 +82,28 @@ pub(crate) fn encode_texture(
 
 /// VK_FORMAT_R32_UINT.
 pub const VK_R32_UINT: u32 = 98;
+/// VK_FORMAT_R32G32B32A32_UINT.
+pub const VK_R32G32B32A32_UINT: u32 = 107;
 
-/// The data format descriptor of R32_UINT: one 32-bit unsigned sample.
-fn dfd_r32_uint() -> Vec<u8> {
-    let block = 24 + 16;
+/// The data format descriptor of R32_UINT (`channels` 1) or
+/// R32G32B32A32_UINT (4): 32-bit unsigned samples R, G, B, A.
+fn dfd_uint(channels: usize) -> Vec<u8> {
+    let block = 24 + 16 * channels;
     let mut d = Vec::with_capacity(4 + block);
     d.extend_from_slice(&((4 + block) as u32).to_le_bytes());
     d.extend_from_slice(&0u32.to_le_bytes()); // Khronos, basic descriptor
     d.extend_from_slice(&(2u32 | ((block as u32) << 16)).to_le_bytes());
     d.extend_from_slice(&[1, 1, 1, 0]); // RGBSDA, BT.709 primaries, linear, flags 0
     d.extend_from_slice(&[0, 0, 0, 0]); // 1x1x1x1 block
-    d.extend_from_slice(&[4, 0, 0, 0, 0, 0, 0, 0]);
-    d.extend_from_slice(&(31u32 << 16).to_le_bytes()); // R, 32 bits, unsigned integer
-    d.extend_from_slice(&0u32.to_le_bytes());
-    d.extend_from_slice(&0u32.to_le_bytes());
-    d.extend_from_slice(&u32::MAX.to_le_bytes());
+    d.extend_from_slice(&[4 * channels as u8, 0, 0, 0, 0, 0, 0, 0]);
+    for (c, id) in [0u32, 1, 2, 15].into_iter().take(channels).enumerate() {
+        // bit offset, 32 bits, the channel, unsigned integer
+        let w0 = (c as u32 * 32) | (31 << 16) | (id << 24);
+        d.extend_from_slice(&w0.to_le_bytes());
+        d.extend_from_slice(&0u32.to_le_bytes());
+        d.extend_from_slice(&0u32.to_le_bytes());
+        d.extend_from_slice(&u32::MAX.to_le_bytes());
+    }
     d
 }
 
@@ -108,6 +115,8 @@ pub enum Texture2d<'a> {
     Rgba16f(&'a [(usize, usize, Vec<u16>)]),
     /// R32_UINT, one level.
     R32u(usize, usize, &'a [u32]),
+    /// R32G32B32A32_UINT, one level (4 words a texel).
+    Rgba32u(usize, usize, &'a [u32]),
 }
 
 /// Encode a [`Texture2d`].
@@ -129,12 +138,16 @@ pub fn encode_2d(key: &str, info_json: &str, t: &Texture2d<'_>) -> Vec<u8> {
                 &bytes,
             )
         }
-        Texture2d::R32u(w, h, data) => {
+        Texture2d::R32u(w, h, data) | Texture2d::Rgba32u(w, h, data) => {
+            let (format, channels) = match t {
+                Texture2d::R32u(..) => (VK_R32_UINT, 1),
+                _ => (VK_R32G32B32A32_UINT, 4),
+            };
             let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
             encode_levels(
-                VK_R32_UINT,
+                format,
                 4,
-                dfd_r32_uint(),
+                dfd_uint(channels),
                 key,
                 info_json,
                 [*w, *h, 0],
@@ -145,7 +158,9 @@ pub fn encode_2d(key: &str, info_json: &str, t: &Texture2d<'_>) -> Vec<u8> {
 }
 
 /// The container around `levels` (level 0 first; stored smallest first, as
-/// KTX 2.0 section 3.9 asks, each at a multiple of 8 bytes).
+/// KTX 2.0 section 3.9 asks, each at a multiple of 8 bytes, or of the texel
+/// where it is 16: the least common multiple of the texel's size and 4 that
+/// section asks for, at least 8).
 fn encode_levels(
     vk_format: u32,
     type_size: u32,
@@ -159,10 +174,12 @@ fn encode_levels(
     let dfd_off = HEADER_LEN + LEVEL_INDEX_LEN * levels.len();
     let kvd_off = dfd_off + dfd.len();
     let mut offsets = vec![0usize; levels.len()];
-    let mut at = (kvd_off + kvd.len()).div_ceil(TEXEL) * TEXEL;
+    // the texel's bytes, from the descriptor's bytesPlane0
+    let align = usize::from(dfd[20]).max(TEXEL);
+    let mut at = (kvd_off + kvd.len()).div_ceil(align) * align;
     for (m, level) in levels.iter().enumerate().rev() {
         offsets[m] = at;
-        at = (at + level.len()).div_ceil(TEXEL) * TEXEL;
+        at = (at + level.len()).div_ceil(align) * align;
     }
     let mut out = Vec::with_capacity(at);
     out.extend_from_slice(&IDENTIFIER);

@@ -113,7 +113,24 @@ fn writes_the_players_data_deterministically() {
     assert_eq!(meshes[0]["n_top"], 32);
     let cells = std::fs::read(a.join("cells-0.ktx2")).unwrap();
     let (fmt, w, h, levels) = ktx2_head(&cells);
-    assert_eq!(fmt, 98, "R32_UINT");
+    assert_eq!(fmt, 107, "R32G32B32A32_UINT");
+    // KTX 2.0 sections 3-4: typeSize 4; a basic descriptor of four 32-bit
+    // unsigned samples R, G, B, A (bytesPlane0 16); the level at a multiple
+    // of lcm(16, 4), as long as the texels
+    assert_eq!(u32_at(&cells, 16), 4, "typeSize");
+    let dfd = u32_at(&cells, 48) as usize;
+    assert_eq!(u32_at(&cells, dfd), 4 + 24 + 4 * 16, "DFD size");
+    assert_eq!(cells[dfd + 20], 16, "bytesPlane0");
+    for (c, id) in [0, 1, 2, 15].into_iter().enumerate() {
+        let w0 = u32_at(&cells, dfd + 28 + 16 * c);
+        assert_eq!(
+            (w0 & 0xffff, (w0 >> 16) & 0xff, w0 >> 24),
+            (32 * c as u32, 31, id),
+            "sample {c}"
+        );
+    }
+    assert_eq!(levels[0].0 % 16, 0, "level offset");
+    assert_eq!(levels[0].1, 16 * w as usize * h as usize, "level length");
     assert_eq!(
         (w as u64, h as u64),
         (

@@ -250,3 +250,52 @@ pub(crate) fn first_frame_cells(
     }
     Ok(g)
 }
+
+#[cfg(test)]
+mod cells_wgsl_tests {
+    //! shaders/env_cells.wgsl mirrors sunbeam_response::cells' constants by
+    //! hand (the layout of `Cells::gpu_data` in fours, the walk's
+    //! thresholds); naga's parse of the player's shader reads them back, so
+    //! the two cannot drift (a wrong layout would show only as a wrong image).
+    use super::super::SHADER;
+    use sunbeam_response::cells;
+
+    fn constant(module: &naga::Module, name: &str) -> f64 {
+        let (_, c) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("{name} is not a constant of the WGSL"));
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::F32(x)) => f64::from(x),
+            naga::Expression::Literal(naga::Literal::U32(x)) => f64::from(x),
+            ref e => panic!("{name}: not a literal: {e:?}"),
+        }
+    }
+
+    #[test]
+    fn the_cells_constants_match_the_wgsl() {
+        let module = naga::front::wgsl::parse_str(SHADER).expect("the shader parses");
+        let c = |name| constant(&module, name);
+        assert_eq!(
+            c("ENV_CELL_HEADER") * 4.0,
+            cells::GPU_HEADER as f64,
+            "header in fours"
+        );
+        assert_eq!(
+            c("ENV_CELL_LAYER") * 4.0,
+            cells::GPU_LAYER as f64,
+            "layer in fours"
+        );
+        assert_eq!(c("ENV_CELL_NONE"), f64::from(cells::GPU_NONE));
+        for (name, rust) in [
+            ("ENV_REFINE", cells::REFINE),
+            ("ENV_RIM_WIDTHS", cells::RIM_WIDTHS),
+            ("ENV_RIM_OUTSIDE", cells::RIM_OUTSIDE),
+            ("ENV_RIM_BOX", cells::RIM_BOX),
+            ("ENV_CELL_STRADDLE", cells::STRADDLE),
+        ] {
+            assert_eq!(c(name), f64::from(rust as f32), "{name}");
+        }
+    }
+}
