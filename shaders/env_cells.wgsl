@@ -82,7 +82,8 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
     var id = 0u;
     for (var visit = 0u; visit < n_nodes && id != ENV_CELL_NONE; visit = visit + 1u) {
         // down to the first node that does not refine (a node whose spread
-        // reaches the horizon is replaced by its children), in a loop of its
+        // reaches the horizon, from inside or outside, is replaced by its
+        // children: cells::Cells::estimate), in a loop of its
         // own: on llvmpipe a refined node then costs this loop's body, not
         // the leaf's ("What a branch costs on llvmpipe"); each step goes one
         // level down. A walk counts a leaf twice against llvmpipe's loop
@@ -100,7 +101,7 @@ fn env_cells(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>) -> vec3<f3
             wxy = -uv - wr.xy;
             l = length(wxy);
             let first = bitcast<u32>(h0.w);
-            if (first == ENV_CELL_NONE || 1.0 - l >= ENV_REFINE * spread) {
+            if (first == ENV_CELL_NONE || abs(1.0 - l) >= ENV_REFINE * spread) {
                 break;
             }
             id = first;
