@@ -226,3 +226,51 @@ fn a_straddling_cell_keeps_the_colour_inside_the_horizon() {
         "the test must see the offsets: {worst_old:.3}"
     );
 }
+
+/// A view refines only cells near its horizon (`|dist| < REFINE spread`,
+/// on either side): a cell outside the disc by more is one leaf, not
+/// walked down to its deepest leaves. So a view visits at most the top
+/// cut plus two children of each node near its horizon, counted here
+/// from the nodes directly. The thesis' patch under the sky, 512 cells,
+/// 64 views with `cos` 0.05-1: 1,630-2,258 visits, each within its bound
+/// (1,642-2,260); the rule `dist < REFINE spread` (every node outside
+/// refined) visited 11,206 at the first view against its 1,960
+/// (docs/LIGHTING.md "Where a walk's time goes").
+#[test]
+fn a_view_refines_only_the_cells_near_its_horizon() {
+    use sunbeam_optics::gain::Material;
+    use sunbeam_optics::masking::Masking;
+    use sunbeam_response::cells::REFINE;
+    let Some(snake) = sunbeam_common::testdata::shared_file("snake/Xeno100x100.png") else {
+        return;
+    };
+    let dir = snake.parent().unwrap();
+    let pack = fixtures::pack(&fixtures::XENO, dir, &BuildOptions::default()).unwrap();
+    let env = Environment::Sky(Box::new(Sky::new(40.0, 30.0, 3.0, 1.0)));
+    let er = build_env(&pack, &env, &Options::default());
+    let cells = Cells::build(&er.basis, 512, DEFAULT_DEPTH);
+    let frame = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+    let white = |_d: [f64; 3], _o: f64| [1.0, 0.0, 0.0];
+    let top: Vec<u32> = (0..cells.n_top as u32).collect();
+    for q in 0..64 {
+        let c = 0.05 + 0.95 * (q as f64 + 0.5) / 64.0;
+        let (s, a) = ((1.0 - c * c).sqrt(), 2.399_963 * q as f64);
+        let wr = [s * a.cos(), s * a.sin(), c];
+        let (_, visits) =
+            cells.estimate_from(&top, frame, wr, Masking::Off, Material::default(), &white);
+        let near = cells
+            .nodes
+            .iter()
+            .filter(|n| {
+                let d = 1.0 - (n.uv[0] + wr[0]).hypot(n.uv[1] + wr[1]);
+                n.children.is_some() && d.abs() < REFINE * n.spread
+            })
+            .count();
+        let bound = cells.n_top + 2 * near;
+        eprintln!("view {q}: cos {c:.3}, {visits} visits, bound {bound}");
+        assert!(
+            visits <= bound,
+            "view {q} (cos {c:.3}): {visits} visits, more than {bound}"
+        );
+    }
+}
