@@ -138,23 +138,32 @@ pub fn encode_2d(key: &str, info_json: &str, t: &Texture2d<'_>) -> Vec<u8> {
                 &bytes,
             )
         }
-        Texture2d::R32u(w, h, data) | Texture2d::Rgba32u(w, h, data) => {
-            let (format, channels) = match t {
-                Texture2d::R32u(..) => (VK_R32_UINT, 1),
-                _ => (VK_R32G32B32A32_UINT, 4),
-            };
-            let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
-            encode_levels(
-                format,
-                4,
-                dfd_uint(channels),
-                key,
-                info_json,
-                [*w, *h, 0],
-                &[bytes],
-            )
+        Texture2d::R32u(w, h, data) => encode_uint(VK_R32_UINT, 1, key, info_json, [*w, *h], data),
+        Texture2d::Rgba32u(w, h, data) => {
+            encode_uint(VK_R32G32B32A32_UINT, 4, key, info_json, [*w, *h], data)
         }
     }
+}
+
+/// One level of 32-bit unsigned words, `channels` a texel.
+fn encode_uint(
+    vk_format: u32,
+    channels: usize,
+    key: &str,
+    info_json: &str,
+    [w, h]: [usize; 2],
+    data: &[u32],
+) -> Vec<u8> {
+    let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+    encode_levels(
+        vk_format,
+        4,
+        dfd_uint(channels),
+        key,
+        info_json,
+        [w, h, 0],
+        &[bytes],
+    )
 }
 
 /// The container around `levels` (level 0 first; stored smallest first, as

@@ -10,7 +10,7 @@ use sunbeam_frame::fixtures;
 use sunbeam_light::{sky::Sky, Environment};
 use sunbeam_pack::build::BuildOptions;
 use sunbeam_response::cells::{Cells, DEFAULT_DEPTH};
-use sunbeam_response::env::build_env;
+use sunbeam_response::env::{build_env, EnvResponse};
 use sunbeam_response::Options;
 
 /// Relative difference of `a` and `b` against the scale `s`.
@@ -18,15 +18,21 @@ fn close(a: f64, b: f64, s: f64) -> bool {
     (a - b).abs() <= 1e-9 * s.max(1e-30)
 }
 
-#[test]
-fn the_cells_masses_are_the_maps_integrals() {
-    let Some(snake) = sunbeam_common::testdata::shared_file("snake/Xeno100x100.png") else {
-        return;
-    };
+/// The thesis' Xenopeltis patch's environment maps under the built-in sky
+/// (None, with a message, without the shared data).
+fn thesis_under_the_sky() -> Option<EnvResponse> {
+    let snake = sunbeam_common::testdata::shared_file("snake/Xeno100x100.png")?;
     let dir = snake.parent().unwrap();
     let pack = fixtures::pack(&fixtures::XENO, dir, &BuildOptions::default()).unwrap();
     let env = Environment::Sky(Box::new(Sky::new(40.0, 30.0, 3.0, 1.0)));
-    let er = build_env(&pack, &env, &Options::default());
+    Some(build_env(&pack, &env, &Options::default()))
+}
+
+#[test]
+fn the_cells_masses_are_the_maps_integrals() {
+    let Some(er) = thesis_under_the_sky() else {
+        return;
+    };
     let g = er.grid;
     let (nt, nr, ns) = (g.n_theta, g.n_rho, g.n_s);
     // The direct integral over the texels the cells cluster: those whose |Y|
@@ -241,13 +247,9 @@ fn a_view_refines_only_the_cells_near_its_horizon() {
     use sunbeam_optics::gain::Material;
     use sunbeam_optics::masking::Masking;
     use sunbeam_response::cells::REFINE;
-    let Some(snake) = sunbeam_common::testdata::shared_file("snake/Xeno100x100.png") else {
+    let Some(er) = thesis_under_the_sky() else {
         return;
     };
-    let dir = snake.parent().unwrap();
-    let pack = fixtures::pack(&fixtures::XENO, dir, &BuildOptions::default()).unwrap();
-    let env = Environment::Sky(Box::new(Sky::new(40.0, 30.0, 3.0, 1.0)));
-    let er = build_env(&pack, &env, &Options::default());
     let cells = Cells::build(&er.basis, 512, DEFAULT_DEPTH);
     let frame = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
     let white = |_d: [f64; 3], _o: f64| [1.0, 0.0, 0.0];
