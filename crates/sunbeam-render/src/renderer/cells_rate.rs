@@ -70,16 +70,24 @@ const GRID_PAD: f64 = 0.125;
 /// multiple of the 4 x 4 pixels a CPU rasteriser shades together.
 const BAND_ROWS: u32 = 8;
 
+/// A CPU rasteriser's tile side (lavapipe: 64 x 64 pixels), the tallest
+/// band ([`Bands`]).
+const TILE: u32 = 64;
+
 /// The grid's walks render into targets laid out in bands: the grid's rows
-/// cut into bands of `rows` rows, put side by side (shaders/default.wgsl
-/// `band_point`, `Globals::cells_band`), then copied back into the grid's
-/// layout ([`Bands::unband`]). A CPU rasteriser (lavapipe) shares a pass
-/// among its threads by tiles of 64 x 64 pixels: the half grid of a 512 x
-/// 512 frame (65 x 65 points) was one tile and three slivers, so one
-/// thread walked it all (on 2 cores it cost as much as on 1, 5.6 s of an
-/// 11.3 s frame, docs/LIGHTING.md "The walks' layout"). In bands of 8 rows
-/// the same points are 10 tiles of 64 x 8. The rows double from
-/// [`BAND_ROWS`] until the strip fits the device's widest texture.
+/// cut into bands, put side by side (shaders/default.wgsl `band_point`,
+/// `Globals::cells_band`), then copied back into the grid's layout
+/// ([`Bands::unband`]). A CPU rasteriser (lavapipe) shares a pass among its
+/// threads by tiles of 64 x 64 pixels: the half grid of a 512 x 512 frame
+/// (65 x 65 points) was one tile and three slivers, so one thread walked it
+/// all (docs/LIGHTING.md "The walks' layout"). But a walk costs more in a
+/// short tile: the 20 um grid of a 512 x 512 frame (129 x 129 points) took
+/// 5.9 s in bands of 8 rows and 3.3 s in bands of 64 (lavapipe, 2 cores;
+/// 16 rows 4.3 s, 32 rows 3.6 s, the grid's own layout 3.3 s). So a band
+/// is a tile tall (64 rows) where the smallest grid walked in bands (the
+/// half grid where there is one) still gives each thread a tile's worth of
+/// points, and halves down to [`BAND_ROWS`] until it does; the rows double
+/// from there until the strip fits the device's widest texture.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct Bands {
     /// Rows of one band.
@@ -87,10 +95,16 @@ pub(super) struct Bands {
 }
 
 impl Bands {
-    /// The bands of a grid `size` points, for a device whose textures are
-    /// at most `max` texels wide.
-    pub(super) fn new(size: [u32; 2], max: u32) -> Bands {
-        let mut rows = BAND_ROWS;
+    /// The bands of a grid `size` points (walked from its half grid when
+    /// `half`), for a device whose textures are at most `max` texels wide
+    /// and a rasteriser of `threads` threads.
+    pub(super) fn new(size: [u32; 2], half: bool, max: u32, threads: u32) -> Bands {
+        let walked = if half { half_size(size) } else { size };
+        let points = walked[0] * walked[1];
+        let mut rows = TILE;
+        while rows > BAND_ROWS && points < threads.max(1) * TILE * rows {
+            rows /= 2;
+        }
         while rows < size[1] && size[0] * size[1].div_ceil(rows) > max {
             rows *= 2;
         }
@@ -132,6 +146,22 @@ impl Bands {
             );
         }
     }
+}
+
+/// The threads lavapipe shares a pass among: `LP_NUM_THREADS`, else the
+/// machine's cores (what it defaults to). Only the bands' shape follows it
+/// ([`Bands`]): the image is the same whatever it is.
+fn rasteriser_threads() -> u32 {
+    std::env::var("LP_NUM_THREADS")
+        .ok()
+        .and_then(|v| v.trim().parse::<u32>().ok())
+        .or_else(|| {
+            std::thread::available_parallelism()
+                .ok()
+                .and_then(|n| u32::try_from(n.get()).ok())
+        })
+        .unwrap_or(1)
+        .max(1)
 }
 
 /// The grid's size in points for a `w x h` frame at rate `rate` > 1: the
@@ -247,6 +277,8 @@ pub(super) struct CellsRate {
     rate: u32,
     /// The device's widest 2D texture (texels).
     max_width: u32,
+    /// The threads a CPU rasteriser shares a pass among ([`Bands`]).
+    threads: u32,
     /// The grid's passes (rate K > 1).
     coarse: Option<CoarsePipelines>,
     /// The centre pass and its full-screen walk.
@@ -481,6 +513,7 @@ impl CellsRate {
         Ok(CellsRate {
             rate,
             max_width: device.limits().max_texture_dimension_2d,
+            threads: rasteriser_threads(),
             coarse,
             centre,
             centre_half,
@@ -499,7 +532,7 @@ impl CellsRate {
     /// (`Globals::cells_band`); 0 without a grid.
     pub(super) fn band_rows(&self, w: u32, h: u32) -> u32 {
         if self.rate > 1 {
-            Bands::new(grid_size(self.rate, w, h), self.max_width).rows
+            self.bands(grid_size(self.rate, w, h)).rows
         } else {
             0
         }
@@ -508,6 +541,11 @@ impl CellsRate {
     /// Whether the grid mixes from the half grid.
     pub(super) fn half(&self) -> bool {
         self.coarse.as_ref().is_some_and(|p| p.half.is_some())
+    }
+
+    /// The bands of a grid `size` points.
+    fn bands(&self, size: [u32; 2]) -> Bands {
+        Bands::new(size, self.half(), self.max_width, self.threads)
     }
 
     /// Make the targets for a `w x h` frame (kept while the size stays).
@@ -527,7 +565,7 @@ impl CellsRate {
         let copied = |size, usage| target_for(gpu, size, XYZ_FORMAT, usage);
         let coarse = (self.rate > 1).then(|| {
             let size = grid_size(self.rate, w, h);
-            let bands = Bands::new(size, self.max_width);
+            let bands = self.bands(size);
             let [gw, gh] = size;
             let xyz = target(gpu, gw, gh, FRAME_FORMAT);
             let nd = target(gpu, gw, gh, FRAME_FORMAT);
@@ -794,7 +832,7 @@ impl CellsRate {
 
 #[cfg(test)]
 mod tests {
-    use super::{default_cells_rate, half_grid, Bands, BAND_ROWS};
+    use super::{default_cells_rate, half_grid, Bands, BAND_ROWS, TILE};
 
     /// The sizes measured against converged references ([`super::FINE_GRID_PATCH_M`])
     /// take the grid that was measured as good as every pixel there.
@@ -814,19 +852,38 @@ mod tests {
         // and a grid of 3 x 3 (a 8 x 8 frame at K = 4)
         for size in [[129, 129], [481, 271], [961, 541], [1921, 1081], [3, 3]] {
             for max in [2048, 8192, 16384] {
-                let b = Bands::new(size, max);
-                let [w, h] = b.strip(size);
-                assert!(w <= max.max(size[0]), "{size:?} {max}: {w}");
-                assert_eq!(b.rows % BAND_ROWS, 0, "{size:?} {max}");
-                assert!(h * (w / size[0]) >= size[1], "{size:?} {max}: {w} x {h}");
-                assert_eq!(w % size[0], 0, "{size:?} {max}");
-                if size[1] <= BAND_ROWS {
-                    assert_eq!([w, h], size);
+                for (half, threads) in [(false, 1), (true, 2), (false, 16)] {
+                    let b = Bands::new(size, half, max, threads);
+                    let [w, h] = b.strip(size);
+                    let at = format!("{size:?} {max} {half} {threads}: {w} x {h}");
+                    assert!(w <= max.max(size[0]), "{at}");
+                    assert_eq!(b.rows % BAND_ROWS, 0, "{at}");
+                    assert!(h * (w / size[0]) >= size[1], "{at}");
+                    assert_eq!(w % size[0], 0, "{at}");
+                    if size[1] <= b.rows {
+                        assert_eq!([w, h], size, "{at}");
+                    }
                 }
             }
         }
-        // the half grid of a 512 x 512 frame: ten tiles of 64 x 8, not one
-        assert_eq!(Bands::new([129, 129], 8192).strip([65, 65]), [585, 8]);
+    }
+
+    /// Bands are a tile tall where each thread still gets a tile's worth of
+    /// points, and shorter where the walked grid is small: the 20 um grid of
+    /// a 512 x 512 frame (no half grid) in bands of 64 rows on 2 threads;
+    /// with its half grid (65 x 65 points, 5 um) in bands of 32, so that the
+    /// half grid's strip is more than one tile and its slivers.
+    #[test]
+    fn the_bands_are_a_tile_tall_where_the_threads_stay_busy() {
+        assert_eq!(Bands::new([129, 129], false, 8192, 2).rows, TILE);
+        let half = Bands::new([129, 129], true, 8192, 2);
+        assert_eq!(half.rows, 32);
+        assert_eq!(half.strip([65, 65]), [195, 32]);
+        // many threads: shorter bands, down to BAND_ROWS
+        assert_eq!(Bands::new([129, 129], false, 8192, 16).rows, 16);
+        assert_eq!(Bands::new([129, 129], true, 8192, 64).rows, BAND_ROWS);
+        // 1920 x 1080 at K = 4: a tile tall
+        assert_eq!(Bands::new([481, 271], false, 16384, 16).rows, TILE);
     }
 
     /// The half grid at the size measured with it (5 um), not at the sizes
