@@ -86,8 +86,9 @@ const TILE: u32 = 64;
 /// 16 rows 4.3 s, 32 rows 3.6 s, the grid's own layout 3.3 s). So a band
 /// is a tile tall (64 rows) where the smallest grid walked in bands (the
 /// half grid where there is one) still gives each thread a tile's worth of
-/// points, and halves down to [`BAND_ROWS`] until it does; the rows double
-/// from there until the strip fits the device's widest texture.
+/// points, and halves down to [`BAND_ROWS`] until it does (a grid too small
+/// to fill the threads even then stays a tile tall); the rows double from
+/// there until the strip fits the device's widest texture.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct Bands {
     /// Rows of one band.
@@ -101,9 +102,15 @@ impl Bands {
     pub(super) fn new(size: [u32; 2], half: bool, max: u32, threads: u32) -> Bands {
         let walked = if half { half_size(size) } else { size };
         let points = walked[0] * walked[1];
+        let full = |rows: u32| points >= threads.max(1) * TILE * rows;
         let mut rows = TILE;
-        while rows > BAND_ROWS && points < threads.max(1) * TILE * rows {
+        while rows > BAND_ROWS && !full(rows) {
             rows /= 2;
+        }
+        if !full(rows) {
+            // too few points to share among the threads at any height:
+            // the tallest tiles, a grid of up to 64 rows in its own layout
+            rows = TILE;
         }
         while rows < size[1] && size[0] * size[1].div_ceil(rows) > max {
             rows *= 2;
@@ -881,9 +888,14 @@ mod tests {
         assert_eq!(half.strip([65, 65]), [195, 32]);
         // many threads: shorter bands, down to BAND_ROWS
         assert_eq!(Bands::new([129, 129], false, 8192, 16).rows, 16);
-        assert_eq!(Bands::new([129, 129], true, 8192, 64).rows, BAND_ROWS);
+        assert_eq!(Bands::new([129, 129], true, 8192, 8).rows, BAND_ROWS);
         // 1920 x 1080 at K = 4: a tile tall
         assert_eq!(Bands::new([481, 271], false, 16384, 16).rows, TILE);
+        // a 40 x 40 frame at K = 4 (11 x 11 points): no height shares it
+        // among 2 threads, so it keeps its own layout, a tile tall
+        let small = Bands::new([11, 11], false, 8192, 2);
+        assert_eq!(small.rows, TILE);
+        assert_eq!(small.strip([11, 11]), [11, 11]);
     }
 
     /// The half grid at the size measured with it (5 um), not at the sizes
