@@ -102,16 +102,13 @@ impl Bands {
     pub(super) fn new(size: [u32; 2], half: bool, max: u32, threads: u32) -> Bands {
         let walked = if half { half_size(size) } else { size };
         let points = walked[0] * walked[1];
-        let full = |rows: u32| points >= threads.max(1) * TILE * rows;
-        let mut rows = TILE;
-        while rows > BAND_ROWS && !full(rows) {
-            rows /= 2;
-        }
-        if !full(rows) {
-            // too few points to share among the threads at any height:
-            // the tallest tiles, a grid of up to 64 rows in its own layout
-            rows = TILE;
-        }
+        // the tallest band that gives every thread a tile's worth; with too
+        // few points for any height, the tallest (a grid of up to 64 rows
+        // keeps its own layout)
+        let mut rows = [TILE, TILE / 2, TILE / 4, BAND_ROWS]
+            .into_iter()
+            .find(|&rows| points >= threads.max(1) * TILE * rows)
+            .unwrap_or(TILE);
         while rows < size[1] && size[0] * size[1].div_ceil(rows) > max {
             rows *= 2;
         }
