@@ -380,7 +380,7 @@ fn env_cells_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, dw: f32) -> vec3<f3
 // not carry that, and each point's own read of the maps can
 // (docs/LIGHTING.md "Scale borders").
 fn env_sun_disc_carried(in: VsOut, d: AttrDerivs, o: vec2<f32>, share: f32, dw: f32) -> vec3<f32> {
-    if (!(envg.on == 1u && envg.estimator == 0u && envg.has_sun == 1u && envp.has_sun == 1u && envp.on == 1u && mat.has_pack == 1u && dw < 1.0)) {
+    if (!(envg.on == 1u && env_by_cells() && envg.has_sun == 1u && envp.has_sun == 1u && envp.on == 1u && mat.has_pack == 1u && dw < 1.0)) {
         return vec3<f32>(0.0);
     }
     // this frame's share of the part of the pixel (env_shade's hot_fp); a
@@ -454,7 +454,7 @@ fn shade(in: VsOut, covered_px: u32) -> vec4<f32> {
     // across a pixel (the baked snake at 96 x 48: 16 frames p99 3.5 inside
     // against 0.96 for the same 16 points in one 4 x 4 supersampled frame).
     // A share of 0 (the window's open-ended sum) reads a point.
-    if (envg.on == 1u && envg.frame_share > 0.0 && envg.frame_share < 1.0) {
+    if (env_in_pipeline() && envg.on == 1u && envg.frame_share > 0.0 && envg.frame_share < 1.0) {
         let s = envg.frame_share;
         let x1 = carried_view(in, da, vec2<f32>(0.5 * s, 0.0));
         let x0 = carried_view(in, da, vec2<f32>(-0.5 * s, 0.0));
@@ -539,7 +539,7 @@ fn shade(in: VsOut, covered_px: u32) -> vec4<f32> {
     // The scene's environment (shaders/environment.wgsl): one Monte Carlo
     // estimate per frame, accumulated by the caller, or the first-frame
     // estimator's cells.
-    if (envg.on == 1u && !(one_sample && n_cov == 0u)) {
+    if (env_in_pipeline() && envg.on == 1u && !(one_sample && n_cov == 0u)) {
         // Where the environment's Monte Carlo estimate shades: the pixel centre,
         // except in a partly covered pixel whose centre sees the surface at a
         // grazing angle or from below (a silhouette): there the centre
@@ -583,7 +583,7 @@ fn shade(in: VsOut, covered_px: u32) -> vec4<f32> {
         // iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS), and three walks
         // of 2048 cells were cut short, darkening the partly covered pixels
         // of grazing views (docs/LIGHTING.md "One walk per fragment").
-        if (envg.estimator == 0u) {
+        if (env_by_cells()) {
             // On a mesh with scale maps the sun's disc reads the maps at
             // each of its points (env_sun_disc_carried).
             let scaled = mat.scales_on == 1u;

@@ -50,7 +50,8 @@ struct EnvGlobals {
     has_sun: u32,
     // proposal samples per pixel per frame
     samples: u32,
-    // 0: the cells (first-frame estimator), 1: Monte Carlo
+    // 0: the cells (first-frame estimator), 1: Monte Carlo; the shaders
+    // read SB_ENV_ESTIMATOR, which equals it
     estimator: u32,
     // levels of the prefiltered chain env_chain
     chain_levels: u32,
@@ -93,6 +94,24 @@ struct EnvProposal {
 };
 
 @group(2) @binding(0) var<uniform> envg: EnvGlobals;
+
+// The environment's estimator as a pipeline constant (0: the cells, 1:
+// Monte Carlo, as envg.estimator; 2: a pipeline that never shades an
+// environment, envg.on 0): the driver then compiles only the path a scene
+// takes. With every path behind the uniforms, llvmpipe took 20-29 s to
+// compile the default pipeline on its first use (docs/bench/play.md
+// "Shader compile time and unused paths").
+override SB_ENV_ESTIMATOR: u32 = 0u;
+
+// Whether the first-frame estimator (the cells) shades the environment.
+fn env_by_cells() -> bool {
+    return SB_ENV_ESTIMATOR == 0u;
+}
+
+// Whether this pipeline shades an environment at all (where envg.on may be 1).
+fn env_in_pipeline() -> bool {
+    return SB_ENV_ESTIMATOR < 2u;
+}
 @group(2) @binding(1) var<uniform> envp: EnvProposal;
 // level l, layer k, cell (x, y) at offsets[l] + (k * H_l + y) * W_l + x
 @group(2) @binding(2) var<storage, read> pyramid: array<f32>;
@@ -756,7 +775,7 @@ fn env_cells_pixel(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, clip
 // first-frame estimator's diffraction part where the centre pass has no
 // value for it.
 fn env_cells_walks(n: vec3<f32>, wr: vec3<f32>, dw: f32, diffract: bool, clip: vec2<f32>, dist: f32) -> bool {
-    return envg.on == 1u && envg.estimator == 0u && wr.z > 0.0 && diffract && envp.on == 1u && dw < 1.0
+    return envg.on == 1u && env_by_cells() && wr.z > 0.0 && diffract && envp.on == 1u && dw < 1.0
         && env_cells_read(n, wr, clip, dist, false).w < 0.5;
 }
 
@@ -776,7 +795,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     var rgb = vec3<f32>(0.0);
     // Diffuse: one cosine-weighted direction (pdf cos / pi) plus the sun's
     // disc, each times the share the skin transmits at its incidence.
-    let tabled = envg.estimator == 0u && (!diffract || abs(mat.ior - envg.irr_ior) < 1e-6);
+    let tabled = env_by_cells() && (!diffract || abs(mat.ior - envg.irr_ior) < 1e-6);
     if (dw > 0.0 && tabled) {
         // The first-frame estimator: the tabulated (transmitted) irradiance.
         var irr = env_irradiance(false, n);
@@ -815,7 +834,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     if (envg.hot_footprint == 1u) {
         hot_fp = env_footprint_times(fp, envg.frame_share);
     }
-    if (envg.estimator == 0u) {
+    if (env_by_cells()) {
         xyz = env_cells_pixel(t, b, n, wr, clip, dist, walk) + env_hotspots_footprint(t, b, n, wr, hot_fp);
     } else {
     // The first frame after a reset (every frame while the view moves) is the
@@ -888,7 +907,7 @@ fn env_shade(t: vec3<f32>, b: vec3<f32>, n: vec3<f32>, wr: vec3<f32>, base: vec3
     xyz = xyz / f32(ns);
     }
     if (envg.has_sun == 1u && envp.has_sun == 1u) {
-        if (envg.estimator == 0u) {
+        if (env_by_cells()) {
             if (sun) {
                 xyz = xyz + env_sun_disc(t, b, n, wr, gr, hot_fp);
             }

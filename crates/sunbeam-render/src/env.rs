@@ -103,6 +103,18 @@ pub enum EnvEstimator {
     MonteCarlo,
 }
 
+impl EnvEstimator {
+    /// The estimator's number in the shaders (`EnvGlobals::estimator` and the
+    /// pipeline constant `SB_ENV_ESTIMATOR`, which equal it): 0 the cells, 1
+    /// Monte Carlo.
+    pub(crate) fn index(self) -> u32 {
+        match self {
+            EnvEstimator::Cells => 0,
+            EnvEstimator::MonteCarlo => 1,
+        }
+    }
+}
+
 /// shaders/environment.wgsl `EnvProposal`.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
@@ -256,10 +268,7 @@ impl EnvScene {
         let layout = layout(device);
         let mut values = EnvGlobals {
             samples: samples.max(1),
-            estimator: match estimator {
-                EnvEstimator::Cells => 0,
-                EnvEstimator::MonteCarlo => 1,
-            },
+            estimator: estimator.index(),
             irr_ior: ior as f32,
             hot_footprint: u32::from(footprint),
             frame_share: 1.0,

@@ -37,7 +37,8 @@ pub(super) fn technique(mode: Mode) -> Option<Technique> {
         label: "baselines.wgsl",
         source: BASELINE_SHADER,
         entry: "fs_baseline",
-        constants: vec![("BASELINE", which)],
+        // (no environment: of_scene refuses one in these modes)
+        constants: vec![("BASELINE", which), super::env_estimator_constant(None)],
     })
 }
 

@@ -321,14 +321,28 @@ pub struct Renderer {
     pub notes: Vec<String>,
 }
 
-/// The default mode's shader (and the Lambert mode's): `fs_main` of [`SHADER`].
-fn default_technique() -> Technique {
+/// The default mode's shader (and the Lambert mode's): `fs_main` of [`SHADER`],
+/// with the environment's estimator as a pipeline constant (none: a scene
+/// without an environment; shaders/environment.wgsl `SB_ENV_ESTIMATOR`: only
+/// the path the scene takes is compiled).
+fn default_technique(estimator: Option<crate::env::EnvEstimator>) -> Technique {
     Technique {
         label: "diffraction.wgsl",
         source: SHADER,
         entry: "fs_main",
-        constants: Vec::new(),
+        constants: vec![env_estimator_constant(estimator)],
     }
+}
+
+/// shaders/environment.wgsl `SB_ENV_ESTIMATOR` for `estimator` (none: the
+/// pipeline shades no environment).
+pub(super) fn env_estimator_constant(
+    estimator: Option<crate::env::EnvEstimator>,
+) -> (&'static str, f64) {
+    (
+        "SB_ENV_ESTIMATOR",
+        f64::from(estimator.map_or(2, |e| e.index())),
+    )
 }
 
 /// Depth format of every pass.
@@ -366,11 +380,15 @@ impl Renderer {
     ) -> Result<Renderer> {
         let device = &gpu.device;
         let mut warnings = Vec::new();
+        // The environment (docs/PLAY.md "Environment"): the default mode shades
+        // it progressively; the Lambert baseline ignores it.
+        let environment = environment::of_scene(p, settings.mode)?;
+        let estimator = environment.as_ref().map(|_| settings.env_estimator);
         // The technique's shader and, for a baseline, its own bind group.
         #[cfg(feature = "baselines")]
         let (technique, mut baselines) = match baselines::technique(settings.mode) {
             Some(t) => (t, Some(baselines::Baselines::new(device))),
-            None => (default_technique(), None),
+            None => (default_technique(estimator), None),
         };
         #[cfg(not(feature = "baselines"))]
         let technique = if settings.mode.is_baseline() {
@@ -378,7 +396,7 @@ impl Renderer {
                 &format!("{:?}", settings.mode).to_lowercase(),
             )));
         } else {
-            default_technique()
+            default_technique(estimator)
         };
         let samples = spectral_samples(settings);
         let spec = spectrum_table(&samples);
@@ -394,9 +412,6 @@ impl Renderer {
             mapped_at_creation: false,
         });
         let [gl0, gl1] = bind_group_layouts(device);
-        // The environment (docs/PLAY.md "Environment"): the default mode shades
-        // it progressively; the Lambert baseline ignores it.
-        let environment = environment::of_scene(p, settings.mode)?;
         // The transmitted irradiance table is built for the first skin's index
         // (meshes with another index shade their diffuse part by Monte Carlo).
         let skin_ior = p
@@ -1029,6 +1044,67 @@ impl Renderer {
         self.draw_meshes(&mut rp);
         if let Some(bg) = &self.background {
             bg.draw(&mut rp);
+        }
+    }
+}
+
+#[cfg(test)]
+mod env_estimator_constant_tests {
+    //! The environment's estimator reaches the shaders twice: the uniform
+    //! `EnvGlobals::estimator` and the pipeline constant `SB_ENV_ESTIMATOR`
+    //! that prunes the other paths. naga resolves the constants as wgpu does
+    //! for each pipeline, so a renamed or retyped override fails here, not
+    //! on the first GPU that builds the pipeline.
+    use super::*;
+    use crate::env::EnvEstimator;
+
+    /// naga's resolution of `technique`'s constants (an error names a
+    /// constant the shader lacks or a value its type refuses).
+    fn resolves(source: &str, technique: &Technique) {
+        let module = naga::front::wgsl::parse_str(source).expect("the shader parses");
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .expect("the shader validates");
+        let constants = technique
+            .constants
+            .iter()
+            .map(|&(k, v)| (k.to_string(), v))
+            .collect();
+        naga::back::pipeline_constants::process_overrides(
+            &module,
+            &info,
+            Some((naga::ShaderStage::Fragment, technique.entry)),
+            &constants,
+        )
+        .unwrap_or_else(|e| panic!("{}: {e:?}", technique.label));
+    }
+
+    #[test]
+    fn each_estimator_is_a_constant_the_shader_takes() {
+        for (estimator, want) in [
+            (Some(EnvEstimator::Cells), 0.0),
+            (Some(EnvEstimator::MonteCarlo), 1.0),
+            (None, 2.0),
+        ] {
+            let t = default_technique(estimator);
+            assert_eq!(t.constants, [("SB_ENV_ESTIMATOR", want)], "{estimator:?}");
+            resolves(t.source, &t);
+        }
+        // the uniform's numbering is the constant's
+        assert_eq!(EnvEstimator::Cells.index(), 0);
+        assert_eq!(EnvEstimator::MonteCarlo.index(), 1);
+    }
+
+    #[cfg(feature = "baselines")]
+    #[test]
+    fn the_baselines_take_no_environment() {
+        for mode in [Mode::Table, Mode::Direct, Mode::Thesis] {
+            let t = baselines::technique(mode).unwrap();
+            assert!(t.constants.contains(&("SB_ENV_ESTIMATOR", 2.0)), "{mode:?}");
+            resolves(t.source, &t);
         }
     }
 }
