@@ -94,24 +94,6 @@ struct EnvProposal {
 };
 
 @group(2) @binding(0) var<uniform> envg: EnvGlobals;
-
-// The environment's estimator as a pipeline constant (0: the cells, 1:
-// Monte Carlo, as envg.estimator; 2: a pipeline that never shades an
-// environment, envg.on 0): the driver then compiles only the path a scene
-// takes. With every path behind the uniforms, llvmpipe took 20-29 s to
-// compile the default pipeline on its first use (docs/bench/play.md
-// "Shader compile time and unused paths").
-override SB_ENV_ESTIMATOR: u32 = 0u;
-
-// Whether the first-frame estimator (the cells) shades the environment.
-fn env_by_cells() -> bool {
-    return SB_ENV_ESTIMATOR == 0u;
-}
-
-// Whether this pipeline shades an environment at all (where envg.on may be 1).
-fn env_in_pipeline() -> bool {
-    return SB_ENV_ESTIMATOR < 2u;
-}
 @group(2) @binding(1) var<uniform> envp: EnvProposal;
 // level l, layer k, cell (x, y) at offsets[l] + (k * H_l + y) * W_l + x
 @group(2) @binding(2) var<storage, read> pyramid: array<f32>;
@@ -134,6 +116,24 @@ fn env_in_pipeline() -> bool {
 // the hot spots' taps (shaders/env_hotspots.wgsl), two vec4 per tap:
 // (world direction, 0) and (the light's basis power times the tap's weight, 0)
 @group(2) @binding(13) var<storage, read> env_lights: array<vec4<f32>>;
+
+// The environment's estimator as a pipeline constant (0: the cells, 1:
+// Monte Carlo, as envg.estimator; 2: a pipeline that never shades an
+// environment, envg.on 0): the driver then compiles only the path a scene
+// takes. With every path behind the uniforms, llvmpipe took 20-29 s to
+// compile the default pipeline on its first use (docs/bench/play.md
+// "Shader compile time and unused paths").
+override SB_ENV_ESTIMATOR: u32 = 0u;
+
+// Whether the first-frame estimator (the cells) shades the environment.
+fn env_by_cells() -> bool {
+    return SB_ENV_ESTIMATOR == 0u;
+}
+
+// Whether this pipeline shades an environment at all (where envg.on may be 1).
+fn env_in_pipeline() -> bool {
+    return SB_ENV_ESTIMATOR < 2u;
+}
 
 // shaders/env_hotspots.wgsl's data access
 fn env_hot_count() -> u32 {
